@@ -1,0 +1,263 @@
+#include "constraints.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace hs {
+
+double curvatureChord(double kappa, double c1, double c2) {
+    kappa = std::abs(kappa);
+    if (kappa == 0) return c1 + c2;
+    const double s1 = std::min(1.0, kappa * c1 / 2), s2 = std::min(1.0, kappa * c2 / 2);
+    const double half = std::asin(s1) + std::asin(s2);  // half the central angle over both chords
+    return 2.0 / kappa * std::sin(half);
+}
+
+int ConstraintSet::interior(int point) const {
+    const int i = std::clamp(point / h_, 1, g_ - 2), j = std::clamp(point % h_, 1, h_ - 2);
+    return i * h_ + j;
+}
+
+Vec3 ConstraintSet::meshNormal(const Points& d, int p) const {
+    const Vec3 du = d.row(p + h_) - d.row(p - h_), dv = d.row(p + 1) - d.row(p - 1);
+    const Vec3 n = du.cross(dv);
+    const double l = n.norm();
+    return l > 0 ? Vec3(n / l) : Vec3::UnitZ();
+}
+
+double ConstraintSet::meshCurvature(const Points& d, int p, int dir) const {
+    const int step = dir == 0 ? h_ : 1;
+    const Vec3 a = d.row(p - step), b = d.row(p), c = d.row(p + step);
+    const double ab = (b - a).norm(), bc = (c - b).norm(), ac = (c - a).norm();
+    const double denom = ab * bc * ac;
+    return denom > 0 ? 2.0 * (b - a).cross(c - a).norm() / denom : 0.0;
+}
+
+int ConstraintSet::add(ConstraintKind kind, int point, double stiffness, const Points& d, const Vec3* target,
+                       const double* curvatureU, const double* curvatureV) {
+    if (!(stiffness > 0) || !std::isfinite(stiffness))
+        throw std::invalid_argument("stiffness: must be finite and > 0");
+    if (point < 0 || point >= g_ * h_) throw std::invalid_argument("point: mesh index out of range");
+    if (target && !target->allFinite()) throw std::invalid_argument("target: must be finite");
+    Constraint c;
+    c.id = nextId_;
+    c.kind = kind;
+    c.stiffness = stiffness;
+    c.point = kind == ConstraintKind::Point ? point : interior(point);
+    if (kind != ConstraintKind::Point && (g_ < 3 || h_ < 3))
+        throw std::invalid_argument("kind: this constraint needs a mesh of at least 3x3");
+    const int p = c.point;
+    switch (kind) {
+        case ConstraintKind::Point:
+            c.target = target ? *target : Vec3(d.row(p));
+            break;
+        case ConstraintKind::Tangent:
+        case ConstraintKind::Normal: {
+            const Vec3 current = meshNormal(d, p);
+            if (target && !(target->norm() > 0)) throw std::invalid_argument("normal: must be a non-zero vector");
+            c.target = target ? Vec3(target->normalized()) : current;
+            const Eigen::Quaterniond turn = Eigen::Quaterniond::FromTwoVectors(current, c.target);
+            const int nb[4] = {p + h_, p - h_, p + 1, p - 1};
+            for (int k = 0; k < 4; ++k) c.offsets[k] = turn * Vec3(d.row(nb[k]) - d.row(p));
+            break;
+        }
+        case ConstraintKind::Curvature: {
+            c.curvatureU = curvatureU ? std::abs(*curvatureU) : meshCurvature(d, p, 0);
+            c.curvatureV = curvatureV ? std::abs(*curvatureV) : meshCurvature(d, p, 1);
+            if (!std::isfinite(c.curvatureU) || !std::isfinite(c.curvatureV))
+                throw std::invalid_argument("curvature: targets must be finite");
+            const double cu = std::max((d.row(p + h_) - d.row(p)).norm(), (d.row(p) - d.row(p - h_)).norm());
+            const double cv = std::max((d.row(p + 1) - d.row(p)).norm(), (d.row(p) - d.row(p - 1)).norm());
+            if (c.curvatureU * cu > 2 || c.curvatureV * cv > 2)
+                throw std::invalid_argument("curvature: target radius is smaller than half the mesh spacing");
+            break;
+        }
+    }
+    ++nextId_;
+    items_.push_back(c);
+    ++structureVersion_;
+    ++version_;
+    return c.id;
+}
+
+void ConstraintSet::remove(int id) {
+    const auto it = std::find_if(items_.begin(), items_.end(), [&](const Constraint& c) { return c.id == id; });
+    if (it == items_.end()) throw std::invalid_argument("id: no constraint " + std::to_string(id));
+    items_.erase(it);
+    ++structureVersion_;
+    ++version_;
+}
+
+void ConstraintSet::clear() {
+    items_.clear();
+    ++structureVersion_;
+    ++version_;
+}
+
+Constraint& ConstraintSet::get(int id) {
+    for (auto& c : items_)
+        if (c.id == id) return c;
+    throw std::invalid_argument("id: no constraint " + std::to_string(id));
+}
+
+void ConstraintSet::setStiffness(int id, double k) {
+    if (!(k > 0) || !std::isfinite(k)) throw std::invalid_argument("stiffness: must be finite and > 0");
+    get(id).stiffness = k;
+    ++structureVersion_;
+    ++version_;
+}
+
+void ConstraintSet::setTarget(int id, const Vec3& target) {
+    if (!target.allFinite()) throw std::invalid_argument("target: must be finite");
+    Constraint& c = get(id);
+    if (c.kind == ConstraintKind::Curvature) throw std::invalid_argument("target: use curvature targets for a curvature constraint");
+    ++version_;
+    if (c.kind == ConstraintKind::Point) { c.target = target; return; }
+    if (!(target.norm() > 0)) throw std::invalid_argument("target: normal must be non-zero");
+    const Vec3 n = target.normalized();
+    const Eigen::Quaterniond turn = Eigen::Quaterniond::FromTwoVectors(c.target, n);
+    for (auto& o : c.offsets) o = turn * o;
+    c.target = n;
+}
+
+void ConstraintSet::setCurvature(int id, double ku, double kv) {
+    if (!std::isfinite(ku) || !std::isfinite(kv)) throw std::invalid_argument("curvature: targets must be finite");
+    Constraint& c = get(id);
+    if (c.kind != ConstraintKind::Curvature) throw std::invalid_argument("id: not a curvature constraint");
+    ++version_;
+    c.curvatureU = std::abs(ku);
+    c.curvatureV = std::abs(kv);
+}
+
+void ConstraintSet::terms(const Points& d, std::vector<ConstraintTerm>& out) const {
+    out.clear();
+    for (const Constraint& c : items_) {
+        const int p = c.point;
+        const Vec3 x = d.row(p);
+        switch (c.kind) {
+            case ConstraintKind::Point:
+                out.push_back({p, -1, c.stiffness, c.target});
+                break;
+            case ConstraintKind::Tangent: {
+                const int nb[4] = {p + h_, p - h_, p + 1, p - 1};
+                for (int k = 0; k < 4; ++k) out.push_back({nb[k], p, c.stiffness, c.offsets[k]});
+                break;
+            }
+            case ConstraintKind::Normal: {
+                // Paper 4.4, alternate method: desired tangents from the actual ones and the desired
+                // normal, mirrored to four desired points at the actual distances; pairing each
+                // neighbour with the centre puts the negated sum on the centre (zero net force).
+                const Vec3 ua = d.row(p + h_) - d.row(p - h_), va = d.row(p + 1) - d.row(p - 1);
+                Vec3 vd = c.target.cross(ua), ud = va.cross(c.target);
+                if (!(vd.norm() > 0) || !(ud.norm() > 0)) break;
+                vd.normalize();
+                ud.normalize();
+                const int nb[4] = {p + h_, p - h_, p + 1, p - 1};
+                const Vec3 dir[4] = {ud, -ud, vd, -vd};
+                for (int k = 0; k < 4; ++k)
+                    out.push_back({nb[k], p, c.stiffness, dir[k] * (d.row(nb[k]) - x.transpose()).norm()});
+                break;
+            }
+            case ConstraintKind::Curvature: {
+                const int step[2] = {h_, 1};
+                const double kappa[2] = {c.curvatureU, c.curvatureV};
+                for (int k = 0; k < 2; ++k) {
+                    const int a = p + step[k], b = p - step[k];
+                    const Vec3 span = d.row(a) - d.row(b);
+                    const double l = span.norm();
+                    if (!(l > 0)) continue;
+                    const double chord = curvatureChord(kappa[k], (d.row(a) - x.transpose()).norm(),
+                                                        (x.transpose() - d.row(b)).norm());
+                    out.push_back({a, b, c.stiffness, span * (chord / l)});
+                }
+                break;
+            }
+        }
+    }
+}
+
+double ConstraintSet::addForces(const Points& d, Points& f, std::vector<ConstraintTerm>& scratch) const {
+    terms(d, scratch);
+    double energy = 0;
+    for (const auto& t : scratch) {
+        const Vec3 xb = t.b >= 0 ? Vec3(d.row(t.b)) : Vec3::Zero();
+        const Vec3 r = Vec3(d.row(t.a)) - xb - t.t;
+        f.row(t.a) -= t.k * r.transpose();
+        if (t.b >= 0) f.row(t.b) += t.k * r.transpose();
+        energy += 0.5 * t.k * r.squaredNorm();
+    }
+    return energy;
+}
+
+void ConstraintSet::addProjections(const Points& d, Points& out, std::vector<ConstraintTerm>& scratch) const {
+    terms(d, scratch);
+    for (const auto& t : scratch) {
+        out.row(t.a) += t.k * t.t.transpose();
+        if (t.b >= 0) out.row(t.b) -= t.k * t.t.transpose();
+    }
+}
+
+void ConstraintSet::addLaplacian(std::vector<Eigen::Triplet<double>>& trip) const {
+    for (const Constraint& c : items_) {
+        const int p = c.point;
+        auto pair = [&](int a, int b) {
+            trip.emplace_back(a, a, c.stiffness);
+            trip.emplace_back(b, b, c.stiffness);
+            trip.emplace_back(a, b, -c.stiffness);
+            trip.emplace_back(b, a, -c.stiffness);
+        };
+        switch (c.kind) {
+            case ConstraintKind::Point: trip.emplace_back(p, p, c.stiffness); break;
+            case ConstraintKind::Tangent:
+            case ConstraintKind::Normal:
+                pair(p + h_, p); pair(p - h_, p); pair(p + 1, p); pair(p - 1, p);
+                break;
+            case ConstraintKind::Curvature:
+                pair(p + h_, p - h_); pair(p + 1, p - 1);
+                break;
+        }
+    }
+}
+
+void ConstraintSet::addStiffness(const Points& y, Points& out) const {
+    for (const Constraint& c : items_) {
+        const int p = c.point;
+        auto pair = [&](int a, int b) {
+            const Vec3 r = c.stiffness * Vec3(y.row(a) - y.row(b));
+            out.row(a) += r.transpose();
+            out.row(b) -= r.transpose();
+        };
+        switch (c.kind) {
+            case ConstraintKind::Point: out.row(p) += c.stiffness * y.row(p); break;
+            case ConstraintKind::Tangent:
+            case ConstraintKind::Normal:
+                pair(p + h_, p); pair(p - h_, p); pair(p + 1, p); pair(p - 1, p);
+                break;
+            case ConstraintKind::Curvature:
+                pair(p + h_, p - h_); pair(p + 1, p - 1);
+                break;
+        }
+    }
+}
+
+double ConstraintSet::error(const Constraint& c, const Points& d) const {
+    const int p = c.point;
+    switch (c.kind) {
+        case ConstraintKind::Point: return (Vec3(d.row(p)) - c.target).norm();
+        case ConstraintKind::Tangent:
+        case ConstraintKind::Normal:
+            return std::acos(std::clamp(meshNormal(d, p).dot(c.target), -1.0, 1.0));
+        case ConstraintKind::Curvature: {
+            auto rel = [](double actual, double want) {
+                return want > 0 ? std::abs(actual - want) / want : std::abs(actual);
+            };
+            return std::max(rel(meshCurvature(d, p, 0), c.curvatureU), rel(meshCurvature(d, p, 1), c.curvatureV));
+        }
+    }
+    return 0;
+}
+
+}  // namespace hs

@@ -1,0 +1,290 @@
+#include "dynamic_surface.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace hs {
+
+DynamicSurface::DynamicSurface(BSplineSurface surface, int g, int h)
+    : surface_(std::move(surface)), A_(surface_, g, h), mass_(1.0, "mass"), damping_(1.0, "damping"),
+      stiffness_(100.0, "stiffness") {
+    const Eigen::Index S = static_cast<Eigen::Index>(g) * h, N = surface_.poles().rows();
+    for (Points* m : {&d_, &dd_, &fext_, &ftool_, &force_, &meshTmp_, &meshTmp2_, &base_, &dPrev_}) m->setZero(S, 3);
+    for (Points* m : {&v_, &fp_, &p0_, &v0_, &a0_, &acc_, &cgR_, &cgZ_, &cgP_, &cgQ_, &x_}) m->setZero(N, 3);
+    m_.setZero(S);
+    gamma_.setZero(S);
+    damping_.allowZero(true);
+    A_.apply(surface_.poles(), d_);
+    springs_ = SpringMesh(g, h, d_);
+    constraints_ = ConstraintSet(g, h);
+    size_ = (d_.colwise().maxCoeff() - d_.colwise().minCoeff()).norm();
+    if (!(size_ > 0)) size_ = (surface_.poles().colwise().maxCoeff() - surface_.poles().colwise().minCoeff()).norm();
+    if (!(size_ > 0)) size_ = 1.0;
+    double su = 0, sv = 0;
+    for (int i = 0; i < g; ++i)
+        for (int j = 0; j < h; ++j) {
+            if (i + 1 < g) su += (d_.row((i + 1) * h + j) - d_.row(i * h + j)).norm();
+            if (j + 1 < h) sv += (d_.row(i * h + j + 1) - d_.row(i * h + j)).norm();
+        }
+    spacingU_ = su / ((g - 1) * h);
+    spacingV_ = sv / (g * (h - 1));
+    setTool("rope");
+    terms_.reserve(64);
+    refreshMaterials();
+}
+
+const Points& DynamicSurface::meshVelocities() {
+    A_.apply(v_, dd_);
+    return dd_;
+}
+
+void DynamicSurface::setPoles(const Points& poles) {
+    if (poles.rows() != surface_.poles().rows()) throw std::invalid_argument("poles: wrong number of rows");
+    if (!poles.allFinite()) throw std::invalid_argument("poles: contain NaN or Inf");
+    surface_.mutablePoles() = poles;
+    v_.setZero();
+    A_.apply(surface_.poles(), d_);
+    touch();
+}
+
+void DynamicSurface::setVelocities(const Points& v) {
+    if (v.rows() != v_.rows()) throw std::invalid_argument("velocities: wrong number of rows");
+    if (!v.allFinite()) throw std::invalid_argument("velocities: contain NaN or Inf");
+    v_ = v;
+    touch();
+}
+
+int DynamicSurface::meshIndexAt(double u, double v) const {
+    if (!std::isfinite(u) || !std::isfinite(v)) throw std::invalid_argument("uv: must be finite");
+    const auto& us = A_.us();
+    const auto& vs = A_.vs();
+    const double fu = (u - us.front()) / (us.back() - us.front()), fv = (v - vs.front()) / (vs.back() - vs.front());
+    if (fu < -1e-12 || fu > 1 + 1e-12 || fv < -1e-12 || fv > 1 + 1e-12)
+        throw std::invalid_argument("uv: outside the parametric domain");
+    const int a = static_cast<int>(std::lround(std::clamp(fu, 0.0, 1.0) * (g() - 1)));
+    const int b = static_cast<int>(std::lround(std::clamp(fv, 0.0, 1.0) * (h() - 1)));
+    return a * h() + b;
+}
+
+std::pair<double, double> DynamicSurface::meshParameters(int index) const {
+    if (index < 0 || index >= g() * h()) throw std::invalid_argument("index: mesh index out of range");
+    return {A_.u(index / h()), A_.v(index % h())};
+}
+
+void DynamicSurface::refreshMaterials() {
+    const std::uint64_t key[3] = {mass_.version(), damping_.version(), stiffness_.version()};
+    if (key[0] == materialKey_[0] && key[1] == materialKey_[1] && key[2] == materialKey_[2]) return;
+    // Densities per unit parameter area, lumped with trapezoid weights that sum to one.
+    const int G = g(), H = h();
+    for (int a = 0; a < G; ++a)
+        for (int b = 0; b < H; ++b) {
+            const double w = ((a == 0 || a == G - 1) ? 0.5 : 1.0) / (G - 1) * ((b == 0 || b == H - 1) ? 0.5 : 1.0) / (H - 1);
+            const double u = static_cast<double>(a) / (G - 1), v = static_cast<double>(b) / (H - 1);
+            m_[a * H + b] = mass_.at(u, v) * w;
+            gamma_[a * H + b] = damping_.at(u, v) * w;
+        }
+    springs_.setStiffness(stiffness_, A_.us(), A_.vs());
+    for (int i = 0; i < 3; ++i) materialKey_[i] = key[i];
+    accelerationValid_ = false;
+}
+
+void DynamicSurface::ensureMassFactor() {
+    if (massSolver_.ready() && massVersion_ == mass_.version()) return;
+    const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
+    const Eigen::SparseMatrix<double> Mp = A.transpose() * m_.asDiagonal() * A;
+    massSolver_.factor(Mp, "mass matrix A^T M A");
+    massVersion_ = mass_.version();
+}
+
+void DynamicSurface::ensureSystem(double dt, bool factor) {
+    const std::uint64_t key[4] = {mass_.version(), damping_.version(), stiffness_.version(),
+                                  constraints_.structureVersion()};
+    bool same = dt == systemDt_ && (systemFactored_ || !factor);
+    for (int i = 0; i < 4; ++i) same = same && key[i] == systemKey_[i];
+    if (same) return;
+    // S = A^T (M + dt D + dt^2 L) A with L the Laplacian of springs and penalty terms.
+    std::vector<Eigen::Triplet<double>> t;
+    const Eigen::Index S = d_.rows();
+    for (Eigen::Index i = 0; i < S; ++i) t.emplace_back(i, i, m_[i] + dt * gamma_[i]);
+    std::vector<Eigen::Triplet<double>> lap;
+    springs_.addLaplacian(lap);
+    constraints_.addLaplacian(lap);
+    for (const auto& e : lap) t.emplace_back(e.row(), e.col(), dt * dt * e.value());
+    Eigen::SparseMatrix<double> Sm(S, S);
+    Sm.setFromTriplets(t.begin(), t.end());
+    const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
+    const Eigen::SparseMatrix<double> sys = A.transpose() * Sm * A;
+    cgDiag_ = sys.diagonal();
+    if (factor) systemSolver_.factor(sys, "system matrix A^T (M + dt D + dt^2 L) A");
+    systemFactored_ = factor;
+    systemDt_ = dt;
+    for (int i = 0; i < 4; ++i) systemKey_[i] = key[i];
+}
+
+void DynamicSurface::setPointForce(int index, const Vec3& force) {
+    if (index < 0 || index >= d_.rows()) throw std::invalid_argument("index: mesh index out of range");
+    if (!force.allFinite()) throw std::invalid_argument("force: must be finite");
+    const double n = force.norm();
+    fext_.row(index) = (n > maxPointForce ? Vec3(force * (maxPointForce / n)) : force).transpose();
+    hasExternal_ = true;
+    touch();
+}
+
+void DynamicSurface::clearForces() {
+    fext_.setZero();
+    hasExternal_ = false;
+    touch();
+}
+
+void DynamicSurface::setTool(const std::string& name) {
+    auto t = makeTool(name);
+    t->reserve(static_cast<size_t>(d_.rows()));
+    tool_ = std::move(t);
+    touch();
+}
+
+void DynamicSurface::setCursor(const Cursor& c) {
+    if (!c.position.allFinite() || !c.orientation.coeffs().allFinite())
+        throw std::invalid_argument("cursor: position and orientation must be finite");
+    if (!(c.orientation.norm() > 0)) throw std::invalid_argument("cursor: orientation must be a non-zero quaternion");
+    Cursor n = c;
+    n.orientation.normalize();
+    if (n.grab && !tool_->grabbed()) {
+        tool_->grab(meshView(), n);
+        touch();
+    } else if (!n.grab && tool_->grabbed()) {
+        tool_->release();
+        touch();
+    }
+    cursor_ = n;
+}
+
+void DynamicSurface::applyToolForces(double dt, StepReport& r) {
+    if (tool_->grabbed()) {
+        ftool_.setZero();
+        r.reaction = tool_->apply(meshView(), cursor_, dt, ftool_);
+        toolForces_ = true;
+        accelerationValid_ = false;
+    } else if (toolForces_) {
+        ftool_.setZero();
+        toolForces_ = false;
+        accelerationValid_ = false;
+    }
+}
+
+double DynamicSurface::meshForces(const Points& d, const Points& dd, double) {
+    force_.setZero();
+    const double energy = springs_.addForces(d, force_);
+    const bool nonlinearDamping = dampingLaw.kind != LawKind::Linear;
+    if (nonlinearDamping)
+        for (Eigen::Index i = 0; i < d.rows(); ++i) meshTmp2_(i, 0) = dampingLaw.dampingFactor(force_.row(i).norm());
+    if (hasExternal_) force_ += fext_;
+    if (toolForces_) force_ += ftool_;
+    double penalty = 0;
+    if (!constraints_.empty()) penalty = constraints_.addForces(d, force_, terms_);
+    if (nonlinearDamping)
+        for (Eigen::Index i = 0; i < d.rows(); ++i) force_.row(i) -= gamma_[i] * meshTmp2_(i, 0) * dd.row(i);
+    else
+        force_ -= gamma_.asDiagonal() * dd;
+    return energy + penalty;
+}
+
+StepReport DynamicSurface::step(double dt) {
+    if (!(dt > 0) || !std::isfinite(dt)) throw std::invalid_argument("dt: must be finite and > 0");
+    refreshMaterials();
+    const std::uint64_t key[4] = {mass_.version(), damping_.version(), stiffness_.version(), constraints_.version()};
+    for (int i = 0; i < 4; ++i)
+        if (key[i] != wakeKey_[i]) { touch(); wakeKey_[i] = key[i]; }
+    if (tool_->grabbed()) touch();
+    StepReport r;
+    if (asleep_) {
+        r.slept = true;
+        return r;
+    }
+    p0_ = surface_.poles();
+    v0_ = v_;
+    const bool tracksWork = hasExternal_ || tool_->grabbed();
+    if (tracksWork) dPrev_ = d_;
+    switch (solver.kind) {
+        case IntegratorKind::Explicit: r = stepExplicit(dt); break;
+        case IntegratorKind::ImplicitCG: r = stepImplicitCG(dt); break;
+        case IntegratorKind::LocalGlobal: r = stepLocalGlobal(dt); break;
+    }
+    if (!surface_.poles().allFinite() || !v_.allFinite()) {
+        surface_.mutablePoles() = p0_;
+        v_ = v0_;
+        A_.apply(surface_.poles(), d_);
+        accelerationValid_ = false;
+        r.refused = true;
+        r.reason = "the step would produce NaN or Inf; state kept (reduce dt or stiffness)";
+        return r;
+    }
+    if (tracksWork) {
+        // Work of the applied forces over the step (forces held over the step).
+        for (Eigen::Index i = 0; i < d_.rows(); ++i) {
+            Vec3 f = Vec3::Zero();
+            if (hasExternal_) f += fext_.row(i).transpose();
+            if (toolForces_) f += ftool_.row(i).transpose();
+            work_ += f.dot((d_.row(i) - dPrev_.row(i)).transpose());
+        }
+    }
+    if (springs_.plasticity.enabled) springs_.applyPlasticity(d_, dt);
+    time_ += dt;
+    ++steps_;
+    checkSleep(dt);
+    return r;
+}
+
+void DynamicSurface::checkSleep(double dt) {
+    if (!sleep.enabled || tool_->grabbed()) { quietSteps_ = 0; return; }
+    const double vmax = v_.cwiseAbs().maxCoeff();
+    if (!(vmax < sleep.tolerance * size_)) { quietSteps_ = 0; return; }
+    if (++quietSteps_ < sleep.steps) return;
+    // Net force check, once, at the moment the surface would fall asleep.
+    dd_.setZero();
+    meshForces(d_, dd_, dt);
+    A_.applyTransposed(force_, fp_);
+    if (fp_.cwiseAbs().maxCoeff() < sleep.tolerance * stiffness_.mean() * size_) {
+        asleep_ = true;
+        v_.setZero();
+    } else {
+        quietSteps_ = 0;
+    }
+}
+
+double DynamicSurface::kineticEnergy() {
+    refreshMaterials();
+    A_.apply(v_, dd_);
+    return 0.5 * (m_.asDiagonal() * dd_).cwiseProduct(dd_).sum();
+}
+
+double DynamicSurface::potentialEnergy() {
+    double e = springs_.energy(d_);
+    if (!constraints_.empty()) {
+        force_.setZero();
+        e += constraints_.addForces(d_, force_, terms_);
+    }
+    return e;
+}
+
+Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> DynamicSurface::curvatureGrid() const {
+    const auto& ops = A_.derivativeOperators(surface_);
+    const Eigen::Index S = d_.rows();
+    Points der[5];
+    for (int k = 0; k < 5; ++k) {
+        der[k].resize(S, 3);
+        ops[k].multiply(surface_.poles(), der[k]);
+    }
+    Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> out(S, 6);
+    for (Eigen::Index i = 0; i < S; ++i) {
+        SurfaceDerivatives sd;
+        sd.s = d_.row(i);
+        sd.su = der[0].row(i); sd.sv = der[1].row(i);
+        sd.suu = der[2].row(i); sd.suv = der[3].row(i); sd.svv = der[4].row(i);
+        const Curvature c = curvatureFrom(sd);
+        out.row(i) << c.ku, c.kv, c.kmin, c.kmax, c.mean, c.gauss;
+    }
+    return out;
+}
+
+}  // namespace hs

@@ -1,0 +1,167 @@
+// The dynamic B-spline surface of paper section 4: control points p driven through the mesh d = A p
+// by  p'' = (A^T M A)^-1 (A^T f_d - A^T D d' - A^T f_springs(d))  (eq. 7).
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bspline_surface.hpp"
+#include "constraints.hpp"
+#include "material_map.hpp"
+#include "prefactored_solver.hpp"
+#include "sampling_operator.hpp"
+#include "spring_mesh.hpp"
+#include "tools.hpp"
+
+namespace hs {
+
+enum class IntegratorKind {
+    Explicit,     ///< paper eq. 8-9 with recursive step halving
+    ImplicitCG,   ///< linearised backward Euler, a fixed number of conjugate-gradient iterations
+    LocalGlobal,  ///< backward Euler by prefactored local/global iterations in control space (default)
+};
+
+struct SolverSettings {
+    IntegratorKind kind = IntegratorKind::LocalGlobal;
+    int iterations = 2;              ///< local/global iterations per step
+    int cgIterations = 5;            ///< implicit: CG iterations per step
+    double accelerationLimit = 1e7;  ///< explicit: halve the step while any acceleration exceeds this
+    int maxHalvings = 16;            ///< explicit: deepest recursion
+};
+
+/// Sleeping: with no tool active, after `steps` consecutive steps whose largest control-point
+/// speed is below tolerance * size per second and whose net force is below tolerance * stiffness * size.
+struct SleepSettings {
+    bool enabled = true;
+    double tolerance = 1e-6;
+    int steps = 10;
+};
+
+/// What one call to step() did.
+struct StepReport {
+    int substeps = 0;     ///< explicit: accepted substeps (1 without halving)
+    int iterations = 0;   ///< local/global or CG iterations in total
+    double residual = 0;  ///< CG: relative residual; local/global: last update / size; explicit: 0
+    bool slept = false;   ///< the surface was at rest and was not stepped
+    bool refused = false; ///< the step would have produced NaN/Inf; the state was kept
+    const char* reason = "";
+    Reaction reaction;  ///< on the cursor
+};
+
+class DynamicSurface {
+public:
+    /// Samples `surface` on a g x h mesh; rest lengths come from the initial shape.
+    DynamicSurface(BSplineSurface surface, int g, int h);
+
+    // --- geometry --------------------------------------------------------------------------
+    const BSplineSurface& surface() const { return surface_; }
+    const SamplingOperator& sampling() const { return A_; }
+    int g() const { return A_.g(); }
+    int h() const { return A_.h(); }
+    const Points& poles() const { return surface_.poles(); }
+    const Points& velocities() const { return v_; }
+    const Points& mesh() const { return d_; }
+    const Points& meshVelocities();  ///< A p', computed on request
+    double size() const { return size_; }
+    /// Replaces the poles (e.g. after undo) and zeroes velocities; rest lengths are kept.
+    void setPoles(const Points& poles);
+    void setVelocities(const Points& v);
+    /// Mesh index nearest to parameter (u, v), and the parameters of a mesh index.
+    int meshIndexAt(double u, double v) const;
+    std::pair<double, double> meshParameters(int index) const;
+    int nearestMeshIndex(const Vec3& x) const { return nearestPoint(d_, x); }
+
+    // --- material ----------------------------------------------------------------------------
+    // Changes to the maps and constraints are seen through their version counters: they wake the
+    // surface and trigger refactoring at the next step, and nothing else.
+    MaterialMap& massMap() { return mass_; }
+    MaterialMap& dampingMap() { return damping_; }
+    MaterialMap& stiffnessMap() { return stiffness_; }
+    const MaterialMap& massMap() const { return mass_; }
+    const MaterialMap& dampingMap() const { return damping_; }
+    const MaterialMap& stiffnessMap() const { return stiffness_; }
+    SpringMesh& springs() { touch(); return springs_; }
+    const SpringMesh& springs() const { return springs_; }
+    ResponseLaw dampingLaw;  ///< non-linear damping: multiplier g(F)/F of each point's spring-force magnitude F
+    const Eigen::VectorXd& pointMasses() { refreshMaterials(); return m_; }
+
+    // --- forces, tools and constraints -------------------------------------------------------
+    /// Persistent external force on a mesh point (clamped to maxPointForce).
+    void setPointForce(int index, const Vec3& force);
+    void clearForces();
+    const Points& externalForces() const { return fext_; }
+    double maxPointForce = 1e6;
+
+    void setTool(const std::string& name);  ///< rope, magnet, orientation, smooth
+    Tool& tool() { return *tool_; }
+    const Tool& tool() const { return *tool_; }
+    /// Latest cursor; a rising grab edge grabs, a falling one releases.
+    void setCursor(const Cursor& cursor);
+    const Cursor& cursor() const { return cursor_; }
+
+    ConstraintSet& constraints() { return constraints_; }
+    const ConstraintSet& constraints() const { return constraints_; }
+    /// Default penalty stiffness: this factor times the mean material stiffness.
+    double constraintStiffnessFactor = 1e3;
+    double defaultConstraintStiffness() const { return constraintStiffnessFactor * stiffness_.mean(); }
+
+    // --- stepping -----------------------------------------------------------------------------
+    SolverSettings solver;
+    SleepSettings sleep;
+    /// Advances by dt seconds; never allocates after the first step with a given configuration.
+    StepReport step(double dt);
+    bool asleep() const { return asleep_; }
+    void wake() { touch(); }
+    std::uint64_t stepCount() const { return steps_; }
+    double time() const { return time_; }
+    double workDone() const { return work_; }  ///< work of external and tool forces so far
+
+    // --- measures -----------------------------------------------------------------------------
+    double kineticEnergy();
+    double potentialEnergy();
+    /// Per mesh point: u and v normal curvature, min and max principal, mean, Gaussian (g*h x 6).
+    Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> curvatureGrid() const;
+
+private:
+    void touch() { asleep_ = false; quietSteps_ = 0; accelerationValid_ = false; }
+    void refreshMaterials();
+    void ensureMassFactor();
+    void ensureSystem(double dt, bool factor);
+    /// Total mesh force (external, tool, springs, constraints, damping) into force_; returns the
+    /// elastic energy. Needs dd_ (mesh velocity) current.
+    double meshForces(const Points& d, const Points& dd, double dt);
+    StepReport stepExplicit(double dt);
+    StepReport stepImplicitCG(double dt);
+    StepReport stepLocalGlobal(double dt);
+    void explicitSubstep(double dt, int depth, StepReport& r);
+    void computeAcceleration();  // acc_ from the current p, v
+    void applyToolForces(double dt, StepReport& r);
+    void checkSleep(double dt);
+    MeshView meshView() const { return {d_, g(), h(), spacingU_, spacingV_}; }
+
+    BSplineSurface surface_;
+    SamplingOperator A_;
+    Points d_, dd_, v_, fext_, ftool_, force_, meshTmp_, meshTmp2_, base_;
+    Points fp_, p0_, v0_, a0_, acc_, cgR_, cgZ_, cgP_, cgQ_, x_, dPrev_;
+    Eigen::VectorXd m_, gamma_, cgDiag_;
+    MaterialMap mass_, damping_, stiffness_;
+    SpringMesh springs_;
+    ConstraintSet constraints_;
+    std::vector<ConstraintTerm> terms_;
+    std::unique_ptr<Tool> tool_;
+    Cursor cursor_;
+    PrefactoredSolver massSolver_, systemSolver_;
+    std::uint64_t massVersion_ = ~0ull, materialKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
+    std::uint64_t systemKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
+    std::uint64_t wakeKey_[4] = {0, 0, 0, 0};
+    double systemDt_ = -1;
+    double size_ = 1, spacingU_ = 1, spacingV_ = 1;
+    double time_ = 0, work_ = 0;
+    bool hasExternal_ = false, toolForces_ = false, asleep_ = false, accelerationValid_ = false;
+    bool systemFactored_ = false;
+    int quietSteps_ = 0;
+    std::uint64_t steps_ = 0;
+};
+
+}  // namespace hs

@@ -1,0 +1,60 @@
+// Linearised backward Euler (Baraff & Witkin 1998) in control-point space, solved matrix-free with
+// a fixed number of Jacobi-preconditioned conjugate-gradient iterations (the paper's Table 1 scheme):
+//   (Mp + dt Dp + dt^2 Kp) dv = dt A^T f - dt^2 Kp v,   Kp = A^T K(d) A.
+#include <cmath>
+
+#include "dynamic_surface.hpp"
+
+namespace hs {
+
+StepReport DynamicSurface::stepImplicitCG(double dt) {
+    StepReport r;
+    ensureSystem(dt, false);
+    applyToolForces(dt, r);
+    A_.apply(v_, dd_);
+    meshForces(d_, dd_, dt);  // also records the springs' tangent stiffness at d
+    auto stiffnessTimes = [&](const Points& y, Points& out) {
+        out.setZero();
+        springs_.addTangentStiffness(y, out);
+        if (!constraints_.empty()) constraints_.addStiffness(y, out);
+    };
+    stiffnessTimes(dd_, meshTmp2_);
+    meshTmp_ = dt * force_ - dt * dt * meshTmp2_;
+    A_.applyTransposed(meshTmp_, cgR_);
+    const double bnorm = std::sqrt(cgR_.squaredNorm());
+    x_.setZero();
+    double rnorm = bnorm;
+    if (bnorm > 0) {
+        cgZ_ = cgDiag_.cwiseInverse().asDiagonal() * cgR_;
+        cgP_ = cgZ_;
+        double rz = cgR_.cwiseProduct(cgZ_).sum();
+        for (int it = 0; it < solver.cgIterations; ++it) {
+            // q = (Mp + dt Dp + dt^2 Kp) p, applied through the mesh.
+            A_.apply(cgP_, meshTmp_);
+            stiffnessTimes(meshTmp_, meshTmp2_);
+            meshTmp2_ = (m_ + dt * gamma_).asDiagonal() * meshTmp_ + dt * dt * meshTmp2_;
+            A_.applyTransposed(meshTmp2_, cgQ_);
+            const double pq = cgP_.cwiseProduct(cgQ_).sum();
+            ++r.iterations;
+            if (!(pq > 0)) break;
+            const double alpha = rz / pq;
+            x_ += alpha * cgP_;
+            cgR_ -= alpha * cgQ_;
+            rnorm = std::sqrt(cgR_.squaredNorm());
+            if (rnorm <= 1e-14 * bnorm) break;
+            cgZ_ = cgDiag_.cwiseInverse().asDiagonal() * cgR_;
+            const double rzNew = cgR_.cwiseProduct(cgZ_).sum();
+            cgP_ = cgZ_ + (rzNew / rz) * cgP_;
+            rz = rzNew;
+        }
+    }
+    r.residual = bnorm > 0 ? rnorm / bnorm : 0.0;
+    v_ += x_;
+    Points& p = surface_.mutablePoles();
+    p += dt * v_;
+    A_.apply(p, d_);
+    accelerationValid_ = false;
+    return r;
+}
+
+}  // namespace hs

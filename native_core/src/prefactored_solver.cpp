@@ -1,0 +1,64 @@
+#include "prefactored_solver.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace hs {
+
+void PrefactoredSolver::factor(const Eigen::SparseMatrix<double>& m, const char* what) {
+    ready_ = false;
+    ldlt_.compute(m);
+    if (ldlt_.info() != Eigen::Success)
+        throw std::runtime_error(std::string(what) + ": factorisation failed (matrix not positive definite)");
+    const Eigen::VectorXd D = ldlt_.vectorD();
+    // A singular or indefinite system (e.g. a sampling too sparse for the knots) shows as D <= 0.
+    const double scale = D.cwiseAbs().maxCoeff();
+    if (!(D.minCoeff() > 1e-14 * scale) || !D.allFinite())
+        throw std::runtime_error(std::string(what) +
+                                 ": matrix is singular; the mesh sampling must see every control point "
+                                 "(use a finer mesh)");
+    L_ = ldlt_.matrixL().nestedExpression();
+    invD_ = D.cwiseInverse();
+    perm_ = ldlt_.permutationP().indices();
+    n_ = static_cast<int>(m.rows());
+    work_.resize(n_, 3);
+    ready_ = true;
+}
+
+void PrefactoredSolver::solve(const Points& b, Points& x) const {
+    double* w = work_.data();
+    for (int i = 0; i < n_; ++i) {
+        const int t = perm_[i];
+        w[3 * t] = b(i, 0); w[3 * t + 1] = b(i, 1); w[3 * t + 2] = b(i, 2);
+    }
+    const int* outer = L_.outerIndexPtr();
+    const int* inner = L_.innerIndexPtr();
+    const double* val = L_.valuePtr();
+    // Forward: L y = w (unit diagonal; column-oriented).
+    for (int c = 0; c < n_; ++c) {
+        const double x0 = w[3 * c], x1 = w[3 * c + 1], x2 = w[3 * c + 2];
+        for (int e = outer[c]; e < outer[c + 1]; ++e) {
+            const int r = inner[e];
+            if (r == c) continue;
+            w[3 * r] -= val[e] * x0; w[3 * r + 1] -= val[e] * x1; w[3 * r + 2] -= val[e] * x2;
+        }
+    }
+    for (int c = 0; c < n_; ++c) { w[3 * c] *= invD_[c]; w[3 * c + 1] *= invD_[c]; w[3 * c + 2] *= invD_[c]; }
+    // Backward: L^T z = y.
+    for (int c = n_ - 1; c >= 0; --c) {
+        double s0 = w[3 * c], s1 = w[3 * c + 1], s2 = w[3 * c + 2];
+        for (int e = outer[c]; e < outer[c + 1]; ++e) {
+            const int r = inner[e];
+            if (r == c) continue;
+            s0 -= val[e] * w[3 * r]; s1 -= val[e] * w[3 * r + 1]; s2 -= val[e] * w[3 * r + 2];
+        }
+        w[3 * c] = s0; w[3 * c + 1] = s1; w[3 * c + 2] = s2;
+    }
+    for (int i = 0; i < n_; ++i) {
+        const int t = perm_[i];
+        x(i, 0) = w[3 * t]; x(i, 1) = w[3 * t + 1]; x(i, 2) = w[3 * t + 2];
+    }
+}
+
+}  // namespace hs

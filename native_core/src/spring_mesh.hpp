@@ -1,0 +1,67 @@
+// The mass-spring network over the g x h mesh: structural springs to the four nearest
+// neighbours and springs along both diagonals, rest lengths from the initial shape.
+#pragma once
+#include <Eigen/Sparse>
+#include <vector>
+
+#include "bspline_surface.hpp"
+#include "material_map.hpp"
+#include "response_law.hpp"
+
+namespace hs {
+
+/// Plastic flow: past `yieldStrain` the rest length creeps toward the current length at `rate` (1/s).
+struct Plasticity {
+    bool enabled = false;
+    double yieldStrain = 0.05;
+    double rate = 1.0;
+};
+
+class SpringMesh {
+public:
+    SpringMesh() = default;
+    /// Builds the springs of a g x h mesh with rest lengths from `d`.
+    SpringMesh(int g, int h, const Points& d);
+
+    int size() const { return static_cast<int>(a_.size()); }
+    int g() const { return g_; }
+    int h() const { return h_; }
+    const std::vector<int>& first() const { return a_; }
+    const std::vector<int>& second() const { return b_; }
+    const std::vector<double>& rest() const { return rest_; }
+    const std::vector<double>& initialRest() const { return rest0_; }
+    void setRest(const std::vector<double>& rest);
+    void resetRest(const Points& d);  ///< rest lengths from the shape d (the current one becomes relaxed)
+
+    /// Stiffness: one value per spring from the map at each spring's midpoint (no per-step lookups).
+    void setStiffness(const MaterialMap& map, const std::vector<double>& us, const std::vector<double>& vs);
+    bool uniformStiffness() const { return k_.empty(); }
+    double stiffness(int s) const { return k_.empty() ? kUniform_ : k_[s]; }
+
+    ResponseLaw law;
+    Plasticity plasticity;
+    double minLength = 1e-12;  ///< below this a spring has no direction and exerts no force
+
+    /// Adds spring forces on the mesh points to f; returns the elastic energy. Also records each
+    /// spring's direction and tension for tangentStiffness().
+    double addForces(const Points& d, Points& f);
+    /// out += K y with K the tangent stiffness at the last addForces() state (clamped to be PSD).
+    void addTangentStiffness(const Points& y, Points& out) const;
+    /// Local step of the local/global solver: out += J t with t the projected spring vectors.
+    void addProjections(const Points& d, Points& out) const;
+    /// Plastic flow over a step of length dt.
+    void applyPlasticity(const Points& d, double dt);
+    /// Triplets of the weighted graph Laplacian sum_s k_s (e_a - e_b)(e_a - e_b)^T.
+    void addLaplacian(std::vector<Eigen::Triplet<double>>& t) const;
+    double energy(const Points& d) const;
+
+private:
+    int g_ = 0, h_ = 0;
+    std::vector<int> a_, b_;
+    std::vector<double> rest_, rest0_, k_;
+    double kUniform_ = 1.0;
+    // Per-spring state of the last force evaluation, reused by the implicit solver.
+    std::vector<double> dirx_, diry_, dirz_, axial_, lateral_;
+};
+
+}  // namespace hs

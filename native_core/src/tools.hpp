@@ -1,0 +1,146 @@
+// Sculpting tools: each adds forces on the mesh points and returns the exact reaction on the cursor.
+#pragma once
+#include <Eigen/Geometry>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bspline_surface.hpp"
+#include "falloff.hpp"
+
+namespace hs {
+
+/// The device's cursor: position, orientation and whether the grab button is held.
+struct Cursor {
+    Vec3 position = Vec3::Zero();
+    Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+    bool grab = false;
+};
+
+/// Force and torque the tool exerts on the cursor (minus what it exerts on the surface).
+struct Reaction {
+    Vec3 force = Vec3::Zero();
+    Vec3 torque = Vec3::Zero();
+};
+
+/// What a tool may read of the mesh.
+struct MeshView {
+    const Points& d;
+    int g, h;
+    double spacingU, spacingV;  ///< mean rest distance between neighbours along u and v
+};
+
+/// Settings shared by every tool: force ramp on grab and clamp.
+struct ToolLimits {
+    double maxForce = 1e3;   ///< clamp on the total force, in force units
+    double rampTime = 0.05;  ///< seconds for the force to ramp in after a grab
+};
+
+class Tool {
+public:
+    virtual ~Tool() = default;
+    virtual const char* name() const = 0;
+    /// Starts a grab at the current cursor (selects mass points, records rest state).
+    virtual void grab(const MeshView& mesh, const Cursor& cursor) = 0;
+    virtual void release() { grabbed_ = false; }
+    bool grabbed() const { return grabbed_; }
+    /// Advances the tool's clock by dt and adds its forces to f; returns the reaction on the cursor.
+    Reaction apply(const MeshView& mesh, const Cursor& cursor, double dt, Points& f);
+    /// Mass point the tool is attached to (nearest point for the rope), -1 if none.
+    virtual int anchor() const { return -1; }
+    ToolLimits limits;
+    /// Reserves room for n points so that stepping never allocates.
+    void reserve(size_t n) { index_.reserve(n); force_.reserve(n); }
+
+protected:
+    /// Writes the unclamped forces on the selected points into the tool's own buffer via emit().
+    virtual void computeForces(const MeshView& mesh, const Cursor& cursor) = 0;
+    void emit(int index, const Vec3& force);
+    bool grabbed_ = false;
+    double time_ = 0;  ///< seconds since grab
+
+private:
+    std::vector<int> index_;
+    std::vector<Vec3> force_;
+};
+
+/// Index of the mesh point nearest to x.
+int nearestPoint(const Points& d, const Vec3& x);
+
+/// Attached to the nearest point by a rope: pulls, never pushes; stiff past `threshold`;
+/// its rest length reels in from the grab distance to zero over `reelTime`.
+class RopeTool final : public Tool {
+public:
+    const char* name() const override { return "rope"; }
+    void grab(const MeshView& mesh, const Cursor& cursor) override;
+    int anchor() const override { return grabbed_ ? point_ : -1; }
+    double restLength() const;
+    double stiffness = 10.0;        ///< force per length while slack is below threshold
+    double stiffStiffness = 200.0;  ///< past the threshold
+    double threshold = 5.0;         ///< extension beyond rest where the rope turns stiff
+    double reelTime = 1.0;
+
+protected:
+    void computeForces(const MeshView& mesh, const Cursor& cursor) override;
+
+private:
+    int point_ = -1;
+    double length0_ = 0;
+};
+
+/// All points within `radius` at grab time, each on a spring to its grab offset from the cursor,
+/// weighted by the falloff (cylindrical: distance to the cursor's z axis).
+class MagnetTool final : public Tool {
+public:
+    const char* name() const override { return "magnet"; }
+    void grab(const MeshView& mesh, const Cursor& cursor) override;
+    int selected() const { return static_cast<int>(points_.size()); }
+    double radius = 10.0;
+    double stiffness = 10.0;
+    Falloff falloff = Falloff::Spherical;
+
+protected:
+    void computeForces(const MeshView& mesh, const Cursor& cursor) override;
+
+private:
+    std::vector<int> points_;
+    std::vector<double> weights_;
+    std::vector<Vec3> offsets_;
+};
+
+/// Five springs: the nearest point to the cursor, and its four neighbours to the ends of the
+/// cursor's x (along u) and y (along v) axes scaled to the mesh spacing.
+class OrientationTool final : public Tool {
+public:
+    const char* name() const override { return "orientation"; }
+    void grab(const MeshView& mesh, const Cursor& cursor) override;
+    int anchor() const override { return grabbed_ ? center_ : -1; }
+    double stiffness = 10.0;
+
+protected:
+    void computeForces(const MeshView& mesh, const Cursor& cursor) override;
+
+private:
+    int center_ = -1;
+};
+
+/// Fairing brush: points within `radius` of the cursor are pulled along U^3 x (U the umbrella
+/// operator), the gradient flow of the discrete curvature variation, weighted by the falloff.
+class SmoothTool final : public Tool {
+public:
+    const char* name() const override { return "smooth"; }
+    void grab(const MeshView& mesh, const Cursor& cursor) override;
+    double radius = 10.0;
+    double strength = 1.0;
+    Falloff falloff = Falloff::Spherical;
+
+protected:
+    void computeForces(const MeshView& mesh, const Cursor& cursor) override;
+
+private:
+    Points u1_, u2_, u3_;
+};
+
+std::unique_ptr<Tool> makeTool(const std::string& name);
+
+}  // namespace hs
