@@ -24,10 +24,12 @@ enum class IntegratorKind {
 
 struct SolverSettings {
     IntegratorKind kind = IntegratorKind::LocalGlobal;
-    int iterations = 2;              ///< local/global iterations per step
+    int iterations = 1;              ///< local/global iterations per step
     int cgIterations = 5;            ///< implicit: CG iterations per step
-    double accelerationLimit = 1e7;  ///< explicit: halve the step while any acceleration exceeds this
-    int maxHalvings = 16;            ///< explicit: deepest recursion
+    /// explicit: halve the step while any control-point acceleration exceeds this;
+    /// 0 = automatic, 0.1 * size / dt^2 (no point may be flung a tenth of the surface in one step)
+    double accelerationLimit = 0;
+    int maxHalvings = 10;            ///< explicit: deepest recursion (at most 2^10 substeps a step)
 };
 
 /// Sleeping: with no tool active, after `steps` consecutive steps whose largest control-point
@@ -155,7 +157,7 @@ private:
     std::uint64_t massVersion_ = ~0ull, materialKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
     std::uint64_t systemKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
     std::uint64_t wakeKey_[4] = {0, 0, 0, 0};
-    double systemDt_ = -1;
+    double systemDt_ = -1, stepDt_ = 1;
     double size_ = 1, spacingU_ = 1, spacingV_ = 1;
     double time_ = 0, work_ = 0;
     bool hasExternal_ = false, toolForces_ = false, asleep_ = false, accelerationValid_ = false;

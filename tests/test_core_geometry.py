@@ -1,0 +1,135 @@
+"""B-spline evaluation against OCCT (FreeCAD's Part.BSplineSurface), and d = A p."""
+import numpy as np
+import pytest
+
+from HapticSculpt import core
+
+import FreeCAD  # noqa: E402  (FreeCAD is a hard test dependency: `make test` installs it; import it before Part)
+import Part  # noqa: E402
+
+
+def random_surface(rng, p, q, rational, nonuniform):
+    nu, nv = p + 1 + int(rng.integers(0, 4)), q + 1 + int(rng.integers(0, 4))
+    poles = rng.normal(size=(nu, nv, 3)) * 10.0
+    poles[..., 0] += np.arange(nu)[:, None] * 10
+    poles[..., 1] += np.arange(nv)[None, :] * 10
+
+    def knots(n, d):
+        inner = n - d - 1
+        if nonuniform and inner > 0:
+            vals = np.sort(rng.uniform(0.05, 0.95, inner))
+            if inner >= 2 and d >= 2:
+                vals[1] = vals[0]  # a double knot (multiplicity 2 <= degree)
+        else:
+            vals = np.linspace(0, 1, inner + 2)[1:-1]
+        return [0.0] * (d + 1) + list(vals) + [1.0] * (d + 1)
+
+    ku, kv = knots(nu, p), knots(nv, q)
+    w = rng.uniform(0.5, 2.0, size=(nu, nv)) if rational else None
+    return core.BSplineSurface(poles, (p, q), ku, kv, w), poles, ku, kv, w
+
+
+def to_occt(poles, ku, kv, p, q, w):
+    def compress(k):
+        vals, mults = [], []
+        for x in k:
+            if vals and x == vals[-1]:
+                mults[-1] += 1
+            else:
+                vals.append(x)
+                mults.append(1)
+        return vals, mults
+
+    uk, um = compress(ku)
+    vk, vm = compress(kv)
+    bs = Part.BSplineSurface()
+    vec = [[FreeCAD.Vector(*map(float, poles[i, j])) for j in range(poles.shape[1])] for i in range(poles.shape[0])]
+    weights = None if w is None else [[float(x) for x in row] for row in w]
+    if weights is None:
+        bs.buildFromPolesMultsKnots(vec, um, vm, uk, vk, False, False, p, q)
+    else:
+        bs.buildFromPolesMultsKnots(vec, um, vm, uk, vk, False, False, p, q, weights)
+    return bs
+
+
+@pytest.mark.parametrize("rational", [False, True])
+@pytest.mark.parametrize("degree", [(1, 1), (2, 3), (3, 3), (4, 2), (5, 5), (1, 5)])
+def test_evaluation_matches_occt(degree, rational):
+    rng = np.random.default_rng(hash((degree, rational)) % 2**32)
+    p, q = degree
+    for nonuniform in (False, True):
+        s, poles, ku, kv, w = random_surface(rng, p, q, rational, nonuniform)
+        bs = to_occt(poles, ku, kv, p, q, w)
+        scale = np.abs(poles).max()
+        for u, v in rng.uniform(0, 1, size=(60, 2)):
+            ours = s.evaluate(u, v)
+            ref = [np.array(bs.getD0(u, v))] if hasattr(bs, "getD0") else [np.array(bs.value(u, v))]
+            ref.append(np.array(bs.getDN(u, v, 1, 0)))
+            ref.append(np.array(bs.getDN(u, v, 0, 1)))
+            names = ["point", "du", "dv"]
+            if p >= 2:
+                ref.append(np.array(bs.getDN(u, v, 2, 0))); names.append("duu")
+            ref.append(np.array(bs.getDN(u, v, 1, 1))); names.append("duv")
+            if q >= 2:
+                ref.append(np.array(bs.getDN(u, v, 0, 2))); names.append("dvv")
+            for name, r in zip(names, ref):
+                err = np.linalg.norm(ours[name] - r) / max(np.linalg.norm(r), scale)
+                assert err <= 1e-12, (name, u, v, err)
+
+
+def test_normal_and_curvature_match_occt():
+    rng = np.random.default_rng(3)
+    s, poles, ku, kv, w = random_surface(rng, 3, 3, True, False)
+    bs = to_occt(poles, ku, kv, 3, 3, w)
+    for u, v in rng.uniform(0.05, 0.95, size=(50, 2)):
+        n = s.normal(u, v)
+        assert np.allclose(n, np.array(bs.normal(u, v)), atol=1e-10)
+        c = s.curvature(u, v)
+        for ours, name in ((c["mean"], "Mean"), (c["gauss"], "Gauss"), (c["max"], "Max"), (c["min"], "Min")):
+            ref = bs.curvature(u, v, name)
+            assert abs(ours - ref) <= 1e-9 * max(1.0, abs(ref)), (name, ours, ref)
+
+
+@pytest.mark.parametrize("rational", [False, True])
+def test_d_equals_A_p_and_rows_sum_to_one(rational):
+    rng = np.random.default_rng(7)
+    s, poles, ku, kv, w = random_surface(rng, 3, 2, rational, True)
+    ds = core.DynamicSurface(s, (17, 13))
+    indptr, indices, data, shape = ds.sampling_matrix()
+    A = np.zeros(shape)
+    for r in range(shape[0]):
+        A[r, indices[indptr[r]:indptr[r + 1]]] = data[indptr[r]:indptr[r + 1]]
+    assert np.allclose(A.sum(axis=1), 1.0, atol=1e-14)
+    d = A @ ds.poles.reshape(-1, 3)
+    assert np.allclose(d, ds.mesh.reshape(-1, 3), atol=1e-12 * np.abs(poles).max())
+    # and the mesh points lie on the surface at their parameters
+    us, vs = ds.mesh_parameters_u, ds.mesh_parameters_v
+    for a in (0, 5, 16):
+        for b in (0, 7, 12):
+            assert np.allclose(ds.mesh[a, b], s.evaluate(us[a], vs[b])["point"], atol=1e-11)
+
+
+def test_curvature_grid_matches_pointwise():
+    ds = core.patch((6, 6), (3, 3), (9, 11))
+    rng = np.random.default_rng(1)
+    p = ds.poles.copy()
+    p[..., 2] += rng.normal(size=p.shape[:2])
+    ds.set_poles(p)
+    grid = ds.curvature_grid()
+    s = ds.surface
+    for a in range(9):
+        for b in range(11):
+            c = s.curvature(ds.mesh_parameters_u[a], ds.mesh_parameters_v[b])
+            assert np.allclose(grid[a, b], [c["u"], c["v"], c["min"], c["max"], c["mean"], c["gauss"]], atol=1e-12)
+
+
+def test_views_share_memory_and_are_read_only():
+    ds = core.patch((5, 5), (3, 3), (10, 10))
+    poles, mesh = ds.poles, ds.mesh
+    assert not poles.flags.writeable and not mesh.flags.writeable
+    ds.set_cursor([0, 0, 3], grab=True)
+    ds.step(1e-3, 20)
+    assert np.array_equal(poles, ds.poles) and np.array_equal(mesh, ds.mesh)  # same memory, updated
+    assert mesh[..., 2].max() > 0
+    with pytest.raises(ValueError):
+        poles[0, 0, 0] = 1.0
