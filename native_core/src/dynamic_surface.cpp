@@ -84,6 +84,7 @@ void DynamicSurface::refreshMaterials() {
             gamma_[a * H + b] = damping_.at(u, v) * w;
         }
     springs_.setStiffness(stiffness_, A_.us(), A_.vs());
+    minMass_ = m_.minCoeff();
     for (int i = 0; i < 3; ++i) materialKey_[i] = key[i];
     accelerationValid_ = false;
 }

@@ -158,7 +158,7 @@ private:
     std::uint64_t systemKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
     std::uint64_t wakeKey_[4] = {0, 0, 0, 0};
     double systemDt_ = -1, stepDt_ = 1;
-    double size_ = 1, spacingU_ = 1, spacingV_ = 1;
+    double minMass_ = 0, size_ = 1, spacingU_ = 1, spacingV_ = 1;
     double time_ = 0, work_ = 0;
     bool hasExternal_ = false, toolForces_ = false, asleep_ = false, accelerationValid_ = false;
     bool systemFactored_ = false;

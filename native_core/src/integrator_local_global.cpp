@@ -35,7 +35,7 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     for (int it = 0; it < solver.iterations; ++it) {
         if (it > 0) A_.apply(x_, meshTmp_);
         force_.setZero();
-        springs_.addProjections(meshTmp_, force_);
+        springs_.addProjections(meshTmp_, force_, 0.25 * minMass_ / (dt * dt));
         if (!constraints_.empty()) constraints_.addProjections(meshTmp_, force_, terms_);
         meshTmp2_ = base_ + (dt * dt) * force_;
         A_.applyTransposed(meshTmp2_, fp_);

@@ -1,5 +1,6 @@
 #include "spring_mesh.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -112,7 +113,7 @@ void SpringMesh::addTangentStiffness(const Points& y, Points& out) const {
     }
 }
 
-void SpringMesh::addProjections(const Points& d, Points& out) const {
+void SpringMesh::addProjections(const Points& d, Points& out, double maxExtraStiffness) const {
     // Each spring's energy 1/2 k |x_a - x_b - t|^2 is minimised over |t| = target length;
     // a non-linear law changes the target length so that k (l - |t|) = g(k (l - r)).
     withLaw(law, [&](auto lw) {
@@ -123,7 +124,11 @@ void SpringMesh::addProjections(const Points& d, Points& out) const {
             const double l = std::sqrt(dx * dx + dy * dy + dz * dz);
             if (!(l > minLength)) continue;
             const double k = stiffness(static_cast<int>(s));
-            const double target = l - lw.value(k * (l - rest_[s])) / k;
+            const double e = l - rest_[s];
+            double force = lw.value(k * e);
+            const double cap = maxExtraStiffness * std::abs(e);
+            force = std::clamp(force, k * e - cap, k * e + cap);
+            const double target = l - force / k;
             const double c = k * target / l;
             double* oa = out.data() + 3 * a_[s];
             double* ob = out.data() + 3 * b_[s];

@@ -1,0 +1,363 @@
+"""Tools, constraints, energy and integrators of the dynamics core."""
+import math
+
+import numpy as np
+import pytest
+
+from HapticSculpt import core
+
+DT = 1e-3
+
+
+@pytest.mark.parametrize("tool", core.TOOLS)
+def test_reaction_is_exact_newton_third_law(tool):
+    ds = core.patch((8, 8), (3, 3), (20, 20))
+    ds.set_tool(tool)
+    if tool in ("magnet", "smooth"):
+        ds.tool.radius = 30.0
+    if tool == "smooth":
+        p = ds.poles.copy()
+        p[3, 4, 2] += 8.0
+        ds.set_poles(p)
+    ds.set_cursor([2.0, 1.0, 1.0], grab=True)
+    # The force on the surface is read back from the change of total momentum with all else off.
+    ds.damping_map.set_uniform(1e-12)
+    ds.stiffness_map.set_uniform(1e-9)
+    for k in range(30):
+        q = [math.cos(0.02 * k), 0.0, math.sin(0.02 * k), 0.0]
+        ds.set_cursor([2.0 + 0.3 * k, 1.0, 1.0 + 0.5 * k], orientation=q, grab=True)
+        m = ds.point_masses()
+        before = (m[:, None] * ds.mesh_velocities().reshape(-1, 3)).sum(axis=0)
+        r = ds.step(DT)
+        after = (m[:, None] * ds.mesh_velocities().reshape(-1, 3)).sum(axis=0)
+        impulse = after - before
+        reaction = np.asarray(r.force)
+        assert np.linalg.norm(reaction) > 0 or k == 0
+        # momentum of the mesh changes by (force on surface) * dt = -reaction * dt
+        assert np.allclose(impulse, -reaction * DT, rtol=1e-6, atol=1e-9 * max(1, np.linalg.norm(reaction))), (k, impulse, reaction)
+
+
+def test_rope_cannot_push_and_reels_in():
+    ds = core.patch((8, 8), (3, 3), (20, 20))
+    ds.tool.ramp_time = 0.0
+    ds.tool.reel_time = 1e9  # keep the rest length: a rope at rest length is slack
+    ds.set_cursor([0, 0, 10.0], grab=True)
+    assert ds.tool.anchor >= 0
+    rope = ds.tool
+    anchor0 = ds.mesh.reshape(-1, 3)[rope.anchor]
+    assert rope.rest_length == pytest.approx(np.linalg.norm(anchor0 - [0, 0, 10.0]), rel=1e-12)
+    r = ds.step(DT)
+    assert np.linalg.norm(r.force) < 1e-8  # slack: rope at its rest length transmits nothing
+    # pushing: cursor moves through the surface toward the other side -> never a pushing force
+    for k in range(100):
+        ds.set_cursor([0, 0, 10.0 - 0.15 * k], grab=True)
+        r = ds.step(DT)
+        anchor = ds.mesh.reshape(-1, 3)[rope.anchor]
+        to_cursor = np.array([0, 0, 10.0 - 0.15 * k]) - anchor
+        # the reaction always pulls the cursor toward the surface point (tension only)
+        assert np.dot(np.asarray(r.force), to_cursor) <= 1e-12
+    # reel-in: the rest length reaches zero at reel_time after the grab
+    ds2 = core.patch((8, 8), (3, 3), (20, 20))
+    ds2.tool.reel_time = 0.25
+    ds2.set_cursor([0, 0, 10.0], grab=True)
+    l0 = ds2.tool.rest_length
+    ds2.step(DT, 125)
+    assert ds2.tool.rest_length == pytest.approx(0.5 * l0, rel=1e-6)
+    ds2.step(DT, 125)
+    assert ds2.tool.rest_length == 0.0
+
+
+def test_rope_force_ramps_in_and_is_clamped():
+    ds = core.patch((8, 8), (3, 3), (20, 20))
+    ds.tool.max_force = 5.0
+    ds.tool.ramp_time = 0.01
+    ds.tool.stiffness = 0.1
+    ds.set_cursor([0, 0, 0.0], grab=True)
+    ds.set_cursor([0, 0, 3.0], grab=True)
+    mags = [np.linalg.norm(ds.step(DT).force) for _ in range(10)]
+    assert all(a < b for a, b in zip(mags, mags[1:]))  # ramping in
+    assert mags[0] < 0.2 * mags[-1]
+    ds.set_cursor([0, 0, 500.0], grab=True)
+    mags = [np.linalg.norm(ds.step(DT).force) for _ in range(10)]
+    assert max(mags) <= 5.0 * (1 + 1e-12) and mags[-1] == pytest.approx(5.0)
+
+
+def test_magnet_falloffs_select_and_weight():
+    for falloff in core.FALLOFFS:
+        ds = core.patch((8, 8), (3, 3), (20, 20))
+        ds.set_tool("magnet")
+        ds.tool.radius = 20.0
+        ds.tool.falloff = falloff
+        ds.set_cursor([0, 0, 1.0], grab=True)
+        assert ds.tool.selected > 1
+        ds.set_cursor([0, 0, 6.0], grab=True)
+        ds.step(DT, 50)
+        z = ds.mesh[..., 2]
+        assert z.max() > 0.5 and np.isfinite(z).all()
+
+
+def test_orientation_tool_turns_the_surface():
+    ds = core.patch((8, 8), (3, 3), (20, 20))
+    ds.set_tool("orientation")
+    ds.tool.stiffness = 50.0
+    ds.set_cursor([0, 0, 0], grab=True)
+    angle = 0.4
+    q = [math.cos(angle / 2), math.sin(angle / 2), 0, 0]  # about x: v axis tilts up
+    for _ in range(400):
+        r = ds.step(DT)
+        ds.set_cursor([0, 0, 0], orientation=q, grab=True)
+    c = ds.tool.anchor
+    i, j = divmod(c, 20)
+    m = ds.mesh
+    tv = m[i, j + 1] - m[i, j - 1]
+    tilt = math.atan2(tv[2], tv[1])
+    assert tilt == pytest.approx(angle, abs=0.15)
+    assert np.linalg.norm(r.torque) > 0
+
+
+def test_smooth_tool_reduces_a_bump():
+    ds = core.patch((10, 10), (3, 3), (30, 30))
+    p = ds.poles.copy()
+    p[4, 5, 2] += 10.0
+    ds.set_poles(p)
+    ds.relax()
+    ds.set_tool("smooth")
+    ds.tool.radius = 40.0
+    ds.tool.strength = 400.0
+    before = np.abs(ds.curvature_grid()[..., 4]).max()
+    ds.set_cursor(list(ds.mesh[15, 15]), grab=True)
+    ds.step(DT, 1000)
+    after = np.abs(ds.curvature_grid()[..., 4]).max()
+    assert after < 0.8 * before
+
+
+def settle(ds, seconds=3.0, dt=DT):
+    ds.step(dt, int(seconds / dt))
+
+
+def test_point_constraint_reaches_target():
+    ds = core.patch((8, 8), (3, 3), (20, 20))
+    size = 100.0
+    target = list(ds.mesh[10, 10] + np.array([0, 0, 10.0]))
+    cid = ds.add_constraint("point", uv=(0.5, 0.5), target=target)
+    settle(ds)
+    assert ds.constraint_error(cid) <= 1e-3 * size
+
+
+def test_point_constraint_defaults_to_current_value_and_is_removable():
+    ds = core.patch((6, 6), (3, 3), (12, 12))
+    cid = ds.add_constraint("point", near=[10, 10, 5])
+    assert ds.constraint_error(cid) == 0.0
+    assert len(ds.constraints) == 1
+    ds.set_constraint_stiffness(cid, 123.0)
+    assert ds.constraints[0]["stiffness"] == 123.0
+    ds.remove_constraint(cid)
+    assert ds.constraints == []
+    with pytest.raises(ValueError, match="id"):
+        ds.remove_constraint(cid)
+
+
+def test_normal_constraint_reaches_target():
+    ds = core.patch((8, 8), (3, 3), (21, 21))
+    n = np.array([0.0, math.sin(0.3), math.cos(0.3)])
+    cid = ds.add_constraint("normal", uv=(0.5, 0.5), target=list(n))
+    settle(ds)
+    err = math.degrees(ds.constraint_error(cid))
+    assert err <= 0.5
+    # rotation free / no net translation: the centre point stays where it was
+    assert np.linalg.norm(ds.mesh[10, 10]) < 1.0
+
+
+def test_tangent_constraint_holds_plane():
+    ds = core.patch((8, 8), (3, 3), (21, 21))
+    n = [0.0, math.sin(0.2), math.cos(0.2)]
+    cid = ds.add_constraint("tangent", uv=(0.5, 0.5), target=n)
+    settle(ds)
+    assert math.degrees(ds.constraint_error(cid)) <= 0.5
+
+
+@pytest.mark.xfail(strict=True, reason="open in issue 2: the two chord springs settle 10-60 % off the target "
+                   "(the smooth surface resists a local bend and stiff penalties oscillate); see the issue note")
+def test_curvature_constraint_reaches_target():
+    ds = core.patch((10, 10), (3, 3), (21, 21))
+    p = ds.poles.copy()
+    p[..., 2] += 0.002 * (p[..., 0] ** 2 + p[..., 1] ** 2)  # a slight bowl breaks the flat symmetry
+    ds.set_poles(p)
+    ds.relax()
+    target = 0.02  # radius 50 mm over a 5 mm spacing
+    ds.damping_map.set_uniform(30.0)
+    idx = ds.mesh_index_at(0.5, 0.5)
+    cid = ds.add_constraint("curvature", index=idx, curvature=(target, target))
+    settle(ds, 6.0)
+    assert ds.constraint_error(cid) <= 0.02
+    assert ds.mesh_curvature(idx, 0) == pytest.approx(target, rel=0.02)
+
+
+def test_conflicting_constraints_settle_to_finite_least_energy():
+    ds = core.patch((8, 8), (3, 3), (20, 20))
+    a = ds.add_constraint("point", index=ds.mesh_index_at(0.5, 0.5), target=[0, 0, 20.0])
+    b = ds.add_constraint("point", index=ds.mesh_index_at(0.5, 0.5), target=[0, 0, -20.0])
+    settle(ds, 2.0)
+    assert np.isfinite(ds.mesh).all()
+    assert abs(ds.mesh.reshape(-1, 3)[ds.mesh_index_at(0.5, 0.5)][2]) < 0.5  # the least-energy compromise
+    assert ds.constraint_error(a) == pytest.approx(ds.constraint_error(b), rel=1e-3)
+
+
+@pytest.mark.parametrize("integrator", core.INTEGRATORS)
+def test_damped_energy_decays_monotonically(integrator):
+    ds = core.patch((6, 6), (3, 3), (15, 15))
+    ds.integrator = integrator
+    ds.damping_map.set_uniform(5.0)
+    ds.sleep_enabled = False
+    p = ds.poles.copy()
+    p[2, 3, 2] += 5.0
+    ds.set_poles(p)
+    energies = []
+    for _ in range(300):
+        ds.step(DT)
+        energies.append(ds.kinetic_energy() + ds.potential_energy())
+    if integrator == "explicit":
+        # semi-implicit Euler's energy carries an O(dt) ripple: monotone over 10 ms windows
+        energies = energies[::10]
+    diffs = np.diff(energies)
+    assert (diffs <= 1e-12 * energies[0]).all()
+    assert energies[-1] < 0.7 * energies[0]
+
+
+def test_undamped_explicit_conserves_energy():
+    ds = core.patch((6, 6), (3, 3), (15, 15))
+    ds.integrator = "explicit"
+    ds.damping_map.set_uniform(0.0)
+    ds.sleep_enabled = False
+    p = ds.poles.copy()
+    p[2, 3, :] += [1.0, -1.0, 3.0]
+    ds.set_poles(p)
+    e0 = ds.kinetic_energy() + ds.potential_energy()
+    energies = []
+    for _ in range(2000):
+        ds.step(1e-4)
+        energies.append(ds.kinetic_energy() + ds.potential_energy())
+    # semi-implicit Euler: bounded oscillation, stated bound 1 % at dt = 1e-4 over 0.2 s
+    assert max(abs(e - e0) for e in energies) <= 0.01 * e0
+
+
+def test_adaptive_halving_and_default_solver_stabilise_a_diverging_case():
+    def run(integrator, halvings):
+        ds = core.patch((8, 8), (3, 3), (30, 30))
+        ds.stiffness_map.set_uniform(1e5)
+        ds.damping_map.set_uniform(0.0)
+        ds.sleep_enabled = False
+        ds.integrator = integrator
+        if integrator == "explicit":
+            ds.max_halvings = halvings
+        p = ds.poles.copy()
+        p[3, 3, 2] += 5.0
+        ds.set_poles(p)
+        refused = False
+        for _ in range(200):
+            r = ds.step(2e-3)
+            refused = refused or r.refused
+        return ds, refused
+
+    fixed, refused = run("explicit", 0)
+    exploded = refused or np.abs(fixed.mesh).max() > 1e3 or fixed.kinetic_energy() > 1e6
+    assert exploded
+    adaptive, refused = run("explicit", 12)
+    assert not refused and np.abs(adaptive.mesh).max() < 200
+    default, refused = run("local_global", 0)
+    assert not refused and np.abs(default.mesh).max() < 200
+
+
+def test_plastic_deformation_keeps_shape_after_release():
+    ds = core.patch((8, 8), (3, 3), (20, 20))
+    ds.set_plasticity(True, yield_strain=0.01, rate=20.0)
+    rest0 = np.array(ds.rest_lengths)
+    ds.tool.reel_time = 0.1
+    ds.set_cursor([0, 0, 0], grab=True)
+    for k in range(400):
+        ds.set_cursor([0, 0, min(30.0, 0.2 * k)], grab=True)
+        ds.step(DT)
+    ds.set_cursor([0, 0, 30.0], grab=False)
+    ds.step(DT, 2000)
+    assert np.array(ds.rest_lengths).max() > rest0.max() * 1.02
+    assert ds.mesh[..., 2].max() > 3.0  # stays deformed
+
+
+@pytest.mark.parametrize("law", ["cubic", "saturating"])
+def test_nonlinear_stiffness_changes_response(law):
+    def pull(kind):
+        ds = core.patch((8, 8), (3, 3), (20, 20))
+        ds.damping_map.set_uniform(20.0)
+        for uv in ((0, 0), (0, 1), (1, 0), (1, 1)):
+            ds.add_constraint("point", uv=uv)  # anchor the corners
+        ds.set_stiffness_law(kind, scale=5.0)
+        ds.set_point_force(ds.mesh_index_at(0.5, 0.5), [0, 0, 300.0])
+        ds.step(DT, 3000)
+        return ds.mesh[..., 2].max()
+
+    lin, nl = pull("linear"), pull(law)
+    assert np.isfinite(nl)
+    assert (nl < lin) if law == "cubic" else (nl > lin)
+
+
+def test_nonlinear_damping_runs_and_stays_finite():
+    for law in ("cubic", "saturating"):
+        for integrator in core.INTEGRATORS:
+            ds = core.patch((6, 6), (3, 3), (15, 15))
+            ds.integrator = integrator
+            ds.set_damping_law(law, scale=1.0)
+            ds.set_point_force(40, [0, 0, 50.0])
+            r = ds.step(DT, 200)
+            assert not r.refused and np.isfinite(ds.mesh).all()
+
+
+def test_painting_maps_changes_masses_and_response():
+    ds = core.patch((8, 8), (3, 3), (20, 20))
+    m0 = ds.point_masses().copy()
+    assert ds.mass_map.uniform
+    ds.mass_map.dab((0.25, 0.25), 0.2, 10.0, "conical", 1.0)
+    assert not ds.mass_map.uniform and ds.mass_map.shape == (64, 64)
+    m1 = ds.point_masses()
+    assert m1.max() > m0.max() * 2 and m1.min() == pytest.approx(m0.min())
+    ds.stiffness_map.dab((0.5, 0.5), 0.3, 10.0, "spherical", 1.0)
+    ds.set_point_force(ds.mesh_index_at(0.5, 0.5), [0, 0, 100.0])
+    ds.step(DT, 100)
+    assert np.isfinite(ds.mesh).all()
+    v = ds.stiffness_map.values
+    assert v.shape == (64, 64) and not v.flags.writeable
+
+
+def test_sleeps_at_rest_and_wakes_on_grab():
+    ds = core.patch((6, 6), (3, 3), (12, 12))
+    r = ds.step(DT, 50)
+    assert ds.asleep and r.slept
+    before = ds.step_count
+    ds.step(DT, 100)
+    assert ds.step_count == before  # nothing stepped
+    ds.set_cursor([0, 0, 1], grab=True)
+    ds.set_cursor([0, 0, 5], grab=True)
+    ds.step(DT, 10)
+    assert not ds.asleep and ds.step_count == before + 10
+    ds.add_constraint("point", index=3)
+    assert ds.step(DT).slept is False
+
+
+def test_stepping_is_deterministic():
+    def run():
+        ds = core.patch((8, 8), (3, 3), (20, 20))
+        ds.add_constraint("normal", uv=(0.3, 0.3))
+        rng = np.random.default_rng(5)
+        for k in range(200):
+            ds.set_cursor(list(rng.normal(size=3) * 5 + [0, 0, 10]), grab=k > 10)
+            ds.step(DT)
+        return ds.poles.copy(), ds.velocities.copy()
+
+    (p1, v1), (p2, v2) = run(), run()
+    assert p1.tobytes() == p2.tobytes() and v1.tobytes() == v2.tobytes()
+
+
+def test_work_accounting_bounds_energy():
+    ds = core.patch((6, 6), (3, 3), (15, 15))
+    ds.set_point_force(30, [0, 0, 20.0])
+    ds.step(DT, 500)
+    assert ds.kinetic_energy() + ds.potential_energy() <= ds.work_done * 1.0001 + 1e-9
