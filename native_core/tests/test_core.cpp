@@ -1,0 +1,118 @@
+// C++ tests of the core: basis, prefactored solve, allocation-free stepping, reactions.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include "dynamic_surface.hpp"
+
+// Counts heap allocations so a test can assert that stepping allocates nothing.
+static std::atomic<long> g_allocations{0};
+void* operator new(std::size_t n) {
+    ++g_allocations;
+    if (void* p = std::malloc(n ? n : 1)) return p;
+    throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+using namespace hs;
+
+TEST(KnotVector, BasisIsPartitionOfUnityWithMatchingDerivatives) {
+    for (int p = 1; p <= kMaxDegree; ++p) {
+        std::vector<double> k(static_cast<size_t>(p + 1), 0.0);
+        if (p >= 2) k.push_back(0.2);  // a double knot where the degree allows it
+        for (double x : {0.2, 0.5, 0.7}) k.push_back(x);
+        for (int i = 0; i <= p; ++i) k.push_back(1.0);
+        const int n = static_cast<int>(k.size()) - p - 1;
+        KnotVector kv(k, n, p, "knots");
+        for (double t = 0; t <= 1.0; t += 0.0625) {
+            Eigen::Matrix<double, 3, kMaxDegree + 1> d;
+            kv.basis(t, 2, d);
+            EXPECT_NEAR(d.row(0).sum(), 1.0, 1e-14);
+            EXPECT_NEAR(d.row(1).sum(), 0.0, 1e-11);
+        }
+    }
+}
+
+TEST(KnotVector, ValidationNamesTheArgument) {
+    EXPECT_THROW(KnotVector({0, 0, 1, 1}, 3, 1, "knots_u"), std::invalid_argument);
+    try {
+        KnotVector({0, 0, 0, 0, 0.5, 0.5, 0.5, 0.5, 1, 1, 1, 1}, 8, 3, "knots_v");
+        FAIL();
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("knots_v"), std::string::npos);
+    }
+}
+
+TEST(PrefactoredSolver, MatchesEigenSolve) {
+    DynamicSurface s(BSplineSurface::plane(9, 7, 3, 2, 50, 30), 20, 15);
+    const Eigen::SparseMatrix<double> A = s.sampling().matrix().toEigen();
+    Eigen::SparseMatrix<double> M = A.transpose() * A;
+    for (int i = 0; i < M.rows(); ++i) M.coeffRef(i, i) += 0.1 * (i % 5 + 1);
+    PrefactoredSolver solver;
+    solver.factor(M, "test");
+    Points b = Points::Random(M.rows(), 3), x(M.rows(), 3);
+    solver.solve(b, x);
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ref(M);
+    const Eigen::MatrixXd expect = ref.solve(Eigen::MatrixXd(b));
+    EXPECT_LT((Eigen::MatrixXd(x) - expect).cwiseAbs().maxCoeff(), 1e-10);
+}
+
+TEST(PrefactoredSolver, RejectsSingularMatrix) {
+    Eigen::SparseMatrix<double> m(3, 3);
+    m.insert(0, 0) = 1;
+    m.insert(1, 1) = 1;
+    PrefactoredSolver solver;
+    EXPECT_ANY_THROW(solver.factor(m, "test"));
+}
+
+class AllocationFree : public ::testing::TestWithParam<IntegratorKind> {};
+
+TEST_P(AllocationFree, SteppingWithToolConstraintsAndLawsDoesNotAllocate) {
+    DynamicSurface s(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 30, 30);
+    s.solver.kind = GetParam();
+    s.sleep.enabled = false;
+    s.constraints().add(ConstraintKind::Point, 40, 1e4, s.mesh(), nullptr, nullptr, nullptr);
+    s.constraints().add(ConstraintKind::Normal, 300, 1e4, s.mesh(), nullptr, nullptr, nullptr);
+    s.springs().law = {LawKind::Saturating, 50.0};
+    s.dampingLaw = {LawKind::CubicHardening, 10.0};
+    s.springs().plasticity.enabled = true;
+    s.stiffnessMap().dab(0.5, 0.5, 0.2, 50.0, Falloff::Conical, 1.0);
+    Cursor c;
+    c.position = Vec3(1, 2, 3);
+    c.grab = true;
+    s.setCursor(c);
+    s.setPointForce(100, Vec3(0, 0, 5));
+    s.step(1e-3);  // warm-up: factorisations and first-use buffers
+    s.step(1e-3);
+    const long before = g_allocations.load();
+    for (int i = 0; i < 50; ++i) {
+        c.position.z() += 0.05;
+        s.setCursor(c);
+        const StepReport r = s.step(1e-3);
+        ASSERT_FALSE(r.refused);
+    }
+    EXPECT_EQ(g_allocations.load() - before, 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Integrators, AllocationFree,
+                         ::testing::Values(IntegratorKind::Explicit, IntegratorKind::ImplicitCG, IntegratorKind::LocalGlobal));
+
+TEST(Tools, ReactionIsMinusTheForceOnTheSurface) {
+    for (const char* name : {"rope", "magnet", "orientation", "smooth"}) {
+        DynamicSurface s(BSplineSurface::plane(6, 6, 3, 3, 40, 40), 15, 15);
+        Points f = Points::Zero(s.mesh().rows(), 3);
+        auto tool = makeTool(name);
+        Cursor c;
+        c.position = Vec3(3, -2, 4);
+        c.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Vec3::UnitX()));
+        MeshView view{s.mesh(), 15, 15, 40.0 / 14, 40.0 / 14};
+        tool->grab(view, c);
+        c.position.z() += 20;
+        const Reaction r = tool->apply(view, c, 0.5, f);
+        const Vec3 total = f.colwise().sum().transpose();
+        EXPECT_LT((total + r.force).norm(), 1e-12 * (1 + total.norm())) << name;
+    }
+}
