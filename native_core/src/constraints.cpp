@@ -252,7 +252,8 @@ double ConstraintSet::error(const Constraint& c, const Points& d) const {
             return std::acos(std::clamp(meshNormal(d, p).dot(c.target), -1.0, 1.0));
         case ConstraintKind::Curvature: {
             auto rel = [](double actual, double want) {
-                return want > 0 ? std::abs(actual - want) / want : std::abs(actual);
+                // relative where a curvature is wanted, absolute (1/length) for a flat target
+                return want > 1e-9 ? std::abs(actual - want) / want : std::abs(actual - want);
             };
             return std::max(rel(meshCurvature(d, p, 0), c.curvatureU), rel(meshCurvature(d, p, 1), c.curvatureV));
         }

@@ -64,7 +64,7 @@ public:
     /// out += K y with K the penalty springs' stiffness (targets held fixed).
     void addStiffness(const Points& y, Points& out) const;
     /// How far each constraint is from its target: position error, normal angle (rad) or the larger
-    /// relative curvature error, measured on the mesh.
+    /// curvature error (relative; absolute for a flat target), measured on the mesh.
     double error(const Constraint& c, const Points& d) const;
     /// Discrete curvature of the circle through the three mesh points around `point` along u (dir 0) or v (1).
     double meshCurvature(const Points& d, int point, int dir) const;

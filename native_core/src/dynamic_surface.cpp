@@ -10,7 +10,7 @@ DynamicSurface::DynamicSurface(BSplineSurface surface, int g, int h)
       stiffness_(100.0, "stiffness") {
     const Eigen::Index S = static_cast<Eigen::Index>(g) * h, N = surface_.poles().rows();
     for (Points* m : {&d_, &dd_, &fext_, &ftool_, &force_, &meshTmp_, &meshTmp2_, &base_, &dPrev_}) m->setZero(S, 3);
-    for (Points* m : {&v_, &fp_, &p0_, &v0_, &a0_, &acc_, &cgR_, &cgZ_, &cgP_, &cgQ_, &x_}) m->setZero(N, 3);
+    for (Points* m : {&v_, &fp_, &p0_, &v0_, &a0_, &pStep_, &vStep_, &acc_, &cgR_, &cgZ_, &cgP_, &cgQ_, &x_}) m->setZero(N, 3);
     m_.setZero(S);
     gamma_.setZero(S);
     damping_.allowZero(true);
@@ -202,8 +202,9 @@ StepReport DynamicSurface::step(double dt) {
         r.slept = true;
         return r;
     }
-    p0_ = surface_.poles();
-    v0_ = v_;
+    // Backup for a refused step (separate from the explicit integrator's substep buffers).
+    pStep_ = surface_.poles();
+    vStep_ = v_;
     const bool tracksWork = hasExternal_ || tool_->grabbed();
     if (tracksWork) dPrev_ = d_;
     switch (solver.kind) {
@@ -212,8 +213,8 @@ StepReport DynamicSurface::step(double dt) {
         case IntegratorKind::LocalGlobal: r = stepLocalGlobal(dt); break;
     }
     if (!surface_.poles().allFinite() || !v_.allFinite()) {
-        surface_.mutablePoles() = p0_;
-        v_ = v0_;
+        surface_.mutablePoles() = pStep_;
+        v_ = vStep_;
         A_.apply(surface_.poles(), d_);
         accelerationValid_ = false;
         r.refused = true;

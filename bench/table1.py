@@ -1,0 +1,116 @@
+#!/usr/bin/env python3
+"""Paper Table 1: time per simulation step for each integrator, beside the paper's figures.
+
+Prints a table, writes bench/results/table1.json (records: controls, mesh, solver, us_per_step,
+paper_ms, plus iterations and the rope-pull displacement error against a converged reference)
+and bench/results/table1.png. One core, median of repeated blocks, all measured in one run.
+"""
+from __future__ import annotations
+
+import json
+import os
+import sys
+import time
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+from HapticSculpt import core  # noqa: E402
+
+# (controls, mesh, paper explicit ms, paper implicit ms)
+CONFIGS = [((4, 4), (10, 10), 0.5, 10), ((4, 4), (20, 20), 2, 11), ((4, 4), (40, 40), 10, 19),
+           ((8, 8), (20, 20), 5, 100), ((8, 8), (40, 40), 25, 120), ((12, 12), (25, 25), 42, 780),
+           ((12, 12), (40, 40), None, None), ((32, 32), (128, 128), None, None)]
+SOLVERS = [("explicit", {}), ("implicit", {"cg_iterations": 5}), ("local_global", {"iterations": 1}),
+           ("local_global", {"iterations": 4})]
+DT = 1e-3
+
+
+def scene(controls, mesh, solver, settings):
+    ds = core.patch(controls, (3, 3), mesh, (100.0, 100.0))
+    ds.integrator = solver
+    for k, v in settings.items():
+        setattr(ds, k, v)
+    ds.sleep_enabled = False
+    ds.tool.reel_time = 0.2
+    ds.set_cursor([0.0, 0.0, 2.0], grab=True)
+    return ds
+
+
+def pull(ds, steps):
+    """The rope pulls the centre up 20 mm over `steps` steps; returns the mesh afterwards."""
+    for k in range(steps):
+        ds.set_cursor([0.0, 0.0, 2.0 + 20.0 * (k + 1) / steps], grab=True)
+        r = ds.step(DT)
+        if r.refused:
+            raise RuntimeError("refused step")
+    return ds.mesh.copy()
+
+
+def time_per_step(ds, block=50, repeats=7):
+    pull(ds, 20)  # warm-up: factorisations
+    z = 22.0
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        for _ in range(block):
+            z += 0.01
+            ds.set_cursor([0.0, 0.0, z], grab=True)
+            ds.step(DT)
+        times.append((time.perf_counter() - t0) / block * 1e6)
+    return float(np.median(times))
+
+
+def main() -> None:
+    os.makedirs(os.path.join(ROOT, "bench", "results"), exist_ok=True)
+    records = []
+    print(f"{'controls':>9} {'mesh':>9} {'solver':>16} {'us/step':>10} {'paper ms':>9} {'error/size':>11}")
+    for controls, mesh, paper_exp, paper_imp in CONFIGS:
+        # converged reference of the same pull: local/global, 10 iterations, 8x smaller step
+        steps = 100 if mesh[0] <= 40 else 20
+        ref = scene(controls, mesh, "local_global", {"iterations": 10})
+        for k in range(steps * 8):
+            ref.set_cursor([0.0, 0.0, 2.0 + 20.0 * (k + 1) / (steps * 8)], grab=True)
+            ref.step(DT / 8)
+        ref_mesh = ref.mesh.copy()
+        for solver, settings in SOLVERS:
+            ds = scene(controls, mesh, solver, settings)
+            try:
+                err = float(np.abs(pull(ds, steps) - ref_mesh).max() / ds.size)
+            except RuntimeError:
+                err = float("inf")
+            us = time_per_step(scene(controls, mesh, solver, settings))
+            paper = paper_exp if solver == "explicit" else paper_imp if solver == "implicit" else None
+            name = solver + (f"/{settings['iterations']}it" if "iterations" in settings else "")
+            rec = {"controls": f"{controls[0]}x{controls[1]}", "mesh": f"{mesh[0]}x{mesh[1]}", "solver": name,
+                   "us_per_step": us, "paper_ms": paper, "error": err}
+            records.append(rec)
+            print(f"{rec['controls']:>9} {rec['mesh']:>9} {name:>16} {us:10.1f} {str(paper or '-'):>9} {err:11.2e}")
+    with open(os.path.join(ROOT, "bench", "results", "table1.json"), "w") as f:
+        json.dump(records, f, indent=1)
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, ax = plt.subplots(figsize=(9, 5))
+        labels = [f"{r['controls']}/{r['mesh']}" for r in records if r["solver"] == "explicit"]
+        for name in dict.fromkeys(r["solver"] for r in records):
+            ys = [r["us_per_step"] for r in records if r["solver"] == name]
+            ax.plot(labels, ys, marker="o", label=name)
+        for key, lab in ((3, "paper explicit"), (4, "paper implicit")):
+            ys = [c[key - 1] * 1e3 if c[key - 1] else np.nan for c in CONFIGS]
+            ax.plot(labels, ys, "k--" if key == 3 else "k:", label=lab)
+        ax.set_yscale("log")
+        ax.set_ylabel("µs per step")
+        ax.set_title("Paper Table 1 configurations: time per step (this machine, one core)")
+        ax.legend()
+        plt.xticks(rotation=30)
+        fig.tight_layout()
+        fig.savefig(os.path.join(ROOT, "bench", "results", "table1.png"), dpi=100)
+    except ImportError:
+        print("matplotlib missing: no plot")
+
+
+if __name__ == "__main__":
+    main()
