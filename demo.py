@@ -46,26 +46,9 @@ def sculpt() -> tuple[core.DynamicSurface, dict]:
 
 
 def to_face(ds: core.DynamicSurface):
-    import FreeCAD
-    import Part
+    from HapticSculpt.part_surface import part_bspline
     s = ds.surface
-
-    def compress(k):
-        vals, mults = [], []
-        for x in k:
-            if vals and x == vals[-1]:
-                mults[-1] += 1
-            else:
-                vals.append(x)
-                mults.append(1)
-        return vals, mults
-
-    uk, um = compress(s.knots_u)
-    vk, vm = compress(s.knots_v)
-    p = s.poles
-    bs = Part.BSplineSurface()
-    bs.buildFromPolesMultsKnots([[FreeCAD.Vector(*map(float, p[i, j])) for j in range(p.shape[1])] for i in range(p.shape[0])],
-                                um, vm, uk, vk, False, False, s.degree[0], s.degree[1])
+    bs = part_bspline(s.poles, s.knots_u, s.knots_v, s.degree, s.weights)
     return bs, bs.toShape()
 
 

@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 
 from HapticSculpt import core
+from HapticSculpt.part_surface import part_bspline
 
 import FreeCAD  # noqa: E402  (FreeCAD is a hard test dependency: `make test` installs it; import it before Part)
 import Part  # noqa: E402
@@ -30,26 +31,7 @@ def random_surface(rng, p, q, rational, nonuniform):
 
 
 def to_occt(poles, ku, kv, p, q, w):
-    def compress(k):
-        vals, mults = [], []
-        for x in k:
-            if vals and x == vals[-1]:
-                mults[-1] += 1
-            else:
-                vals.append(x)
-                mults.append(1)
-        return vals, mults
-
-    uk, um = compress(ku)
-    vk, vm = compress(kv)
-    bs = Part.BSplineSurface()
-    vec = [[FreeCAD.Vector(*map(float, poles[i, j])) for j in range(poles.shape[1])] for i in range(poles.shape[0])]
-    weights = None if w is None else [[float(x) for x in row] for row in w]
-    if weights is None:
-        bs.buildFromPolesMultsKnots(vec, um, vm, uk, vk, False, False, p, q)
-    else:
-        bs.buildFromPolesMultsKnots(vec, um, vm, uk, vk, False, False, p, q, weights)
-    return bs
+    return part_bspline(poles, ku, kv, (p, q), w)
 
 
 @pytest.mark.parametrize("rational", [False, True])

@@ -115,7 +115,7 @@ void DynamicSurface::ensureSystem(double dt, bool factor) {
     Sm.setFromTriplets(t.begin(), t.end());
     const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
     const Eigen::SparseMatrix<double> sys = A.transpose() * Sm * A;
-    cgDiag_ = sys.diagonal();
+    cgInvDiag_ = sys.diagonal().cwiseInverse();  // Jacobi preconditioner
     if (factor) systemSolver_.factor(sys, "system matrix A^T (M + dt D + dt^2 L) A");
     systemFactored_ = factor;
     systemDt_ = dt;

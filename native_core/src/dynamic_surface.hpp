@@ -146,7 +146,7 @@ private:
     SamplingOperator A_;
     Points d_, dd_, v_, fext_, ftool_, force_, meshTmp_, meshTmp2_, base_;
     Points fp_, p0_, v0_, a0_, pStep_, vStep_, acc_, cgR_, cgZ_, cgP_, cgQ_, x_, dPrev_;
-    Eigen::VectorXd m_, gamma_, cgDiag_;
+    Eigen::VectorXd m_, gamma_, cgInvDiag_;
     MaterialMap mass_, damping_, stiffness_;
     SpringMesh springs_;
     ConstraintSet constraints_;

@@ -25,7 +25,7 @@ StepReport DynamicSurface::stepImplicitCG(double dt) {
     x_.setZero();
     double rnorm = bnorm;
     if (bnorm > 0) {
-        cgZ_ = cgDiag_.cwiseInverse().asDiagonal() * cgR_;
+        cgZ_ = cgInvDiag_.asDiagonal() * cgR_;
         cgP_ = cgZ_;
         double rz = cgR_.cwiseProduct(cgZ_).sum();
         for (int it = 0; it < solver.cgIterations; ++it) {
@@ -42,7 +42,7 @@ StepReport DynamicSurface::stepImplicitCG(double dt) {
             cgR_ -= alpha * cgQ_;
             rnorm = std::sqrt(cgR_.squaredNorm());
             if (rnorm <= 1e-14 * bnorm) break;
-            cgZ_ = cgDiag_.cwiseInverse().asDiagonal() * cgR_;
+            cgZ_ = cgInvDiag_.asDiagonal() * cgR_;
             const double rzNew = cgR_.cwiseProduct(cgZ_).sum();
             cgP_ = cgZ_ + (rzNew / rz) * cgP_;
             rz = rzNew;
