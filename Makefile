@@ -4,10 +4,17 @@ BUILD       := build
 JOBS        ?= 2
 APT_PACKAGES := build-essential cmake ninja-build pkg-config libeigen3-dev pybind11-dev libgtest-dev \
                 python3-dev python3-numpy python3-scipy python3-pytest python3-matplotlib \
-                freecad-python3 libhidapi-dev xvfb xauth
+                python3-venv freecad-python3 freecad libhidapi-dev xvfb xauth
 SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: all deps build build-asan test test-cpp test-asan test-python demo bench clean
+.PHONY: all deps build build-asan test test-cpp test-asan test-python test-freecad ocp-venv demo bench install uninstall clean
+# A private FreeCAD user folder whose Mod/HapticSculpt links this checkout (tests, demo render).
+FC_HOME     := $(BUILD)/freecad-home
+# cadquery (with its own OCCT, OCP) in its own virtual environment: its numpy must not shadow Debian's.
+OCP_VENV    := $(BUILD)/ocp-venv
+CADQUERY    := cadquery==2.8.0
+# Where `make install` links the addon (FreeCAD 0.20/1.0; 1.1 uses ~/.local/share/FreeCAD/v1-1/Mod).
+FREECAD_MOD ?= $(HOME)/.local/share/FreeCAD/Mod
 
 all: build
 
@@ -36,13 +43,37 @@ test-asan: build-asan
 	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  ctest --test-dir $(BUILD)/asan --output-on-failure -j $(JOBS)
 
-test-python: build
-	$(PY) -m pytest -q tests
+$(OCP_VENV)/.installed:
+	$(PY) -m venv $(OCP_VENV)
+	$(OCP_VENV)/bin/pip install -q --disable-pip-version-check $(CADQUERY)
+	touch $@
 
-test: test-cpp test-asan test-python
+ocp-venv: deps $(OCP_VENV)/.installed
+
+$(FC_HOME)/Mod/HapticSculpt:
+	mkdir -p $(FC_HOME)/Mod
+	ln -sfn $(CURDIR) $@
+
+test-python: build ocp-venv
+	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) -m pytest -q tests
+
+# The FreeCAD-layer tests once more through FreeCAD's own runner, with the checkout installed as an addon.
+test-freecad: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
+	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python FREECAD_USER_HOME=$(CURDIR)/$(FC_HOME) \
+	  freecadcmd -t TestHapticSculpt
+
+test: test-cpp test-asan test-python test-freecad
 
 demo: build
 	$(PY) demo.py --out out
+
+install: build
+	mkdir -p $(FREECAD_MOD)
+	ln -sfn $(CURDIR) $(FREECAD_MOD)/HapticSculpt
+	@echo "linked $(FREECAD_MOD)/HapticSculpt -> $(CURDIR); restart FreeCAD and pick the HapticSculpt workbench"
+
+uninstall:
+	rm -f $(FREECAD_MOD)/HapticSculpt
 
 bench: build
 	$(PY) bench/table1.py

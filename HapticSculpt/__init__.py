@@ -1,5 +1,13 @@
 """HapticSculpt: sculpt dynamic B-spline surfaces in FreeCAD (Dachille, Qin, Kaufman, El-Sana).
 
-The dynamics core is :mod:`HapticSculpt.core`; importing this package never imports FreeCAD or a GUI.
+The dynamics core is :mod:`HapticSculpt.core`; the scripting API below imports FreeCAD only when a
+function that needs it is called, so importing this package never imports FreeCAD or a GUI.
 """
 __version__ = "0.1.0"
+
+from .api import (RunReport, add_constraint, export_step, make_sculpt, remove_constraint, run, thicken,
+                  to_cadquery)
+from .replay_device import CursorSample, ReplayDevice
+
+__all__ = ["make_sculpt", "run", "add_constraint", "remove_constraint", "export_step", "thicken",
+           "to_cadquery", "ReplayDevice", "CursorSample", "RunReport", "__version__"]

@@ -8,3 +8,6 @@ if ROOT not in sys.path:
 FREECAD_LIB = "/usr/lib/freecad-python3/lib"
 if os.path.isdir(FREECAD_LIB) and FREECAD_LIB not in sys.path:
     sys.path.append(FREECAD_LIB)
+TESTS = os.path.dirname(os.path.abspath(__file__))
+if TESTS not in sys.path:
+    sys.path.insert(0, TESTS)  # freecad_support

@@ -294,6 +294,8 @@ PYBIND11_MODULE(_core, m) {
             return view(s.externalForces().data(), {s.g(), s.h(), 3}, self);
         })
         .def_property_readonly("size", &DynamicSurface::size, "Diagonal of the initial mesh's bounding box")
+        .def_property("reference", &DynamicSurface::reference, &DynamicSurface::setReference,
+                      "(size, spacing_u, spacing_v) of the initial mesh; they scale tolerances and tools")
         .def("set_poles", [](DynamicSurface& s, py::array_t<double, py::array::c_style | py::array::forcecast> p) {
             s.setPoles(pointsFrom(p, s.poles().rows(), "poles"));
         }, py::arg("poles"), "Replace the poles (velocities zeroed, rest lengths kept).")
@@ -392,10 +394,38 @@ PYBIND11_MODULE(_core, m) {
                 d["uv"] = s.meshParameters(c.point);
                 if (c.kind == ConstraintKind::Curvature) d["curvature"] = std::make_pair(c.curvatureU, c.curvatureV);
                 else d["target"] = std::vector<double>{c.target.x(), c.target.y(), c.target.z()};
+                if (c.kind == ConstraintKind::Tangent || c.kind == ConstraintKind::Normal) {
+                    std::vector<double> o;
+                    for (const Vec3& x : c.offsets) o.insert(o.end(), {x.x(), x.y(), x.z()});
+                    d["offsets"] = o;
+                }
                 out.append(d);
             }
             return out;
         }, "List of constraints as dicts (id, kind, index, uv, stiffness, target or curvature)")
+        .def("restore_constraint", [](DynamicSurface& s, int id, const std::string& kind, int index, double stiffness,
+                                      std::optional<std::vector<double>> target, std::optional<std::pair<double, double>> curvature,
+                                      std::optional<std::vector<double>> offsets) {
+            Constraint c;
+            c.id = id;
+            c.kind = constraintFrom(kind);
+            c.point = index;
+            c.stiffness = stiffness;
+            const bool needsTarget = c.kind != ConstraintKind::Curvature;
+            if (needsTarget != bool(target)) throw std::invalid_argument(needsTarget ? "target: required" : "target: not for curvature");
+            if (!needsTarget && !curvature) throw std::invalid_argument("curvature: required");
+            if (target) c.target = vec3(*target, "target");
+            if (curvature) { c.curvatureU = std::abs(curvature->first); c.curvatureV = std::abs(curvature->second); }
+            const bool framed = c.kind == ConstraintKind::Tangent || c.kind == ConstraintKind::Normal;
+            if (framed != bool(offsets)) throw std::invalid_argument(framed ? "offsets: required" : "offsets: only for tangent and normal");
+            if (offsets) {
+                if (offsets->size() != 12) throw std::invalid_argument("offsets: expected 12 numbers");
+                for (int k = 0; k < 4; ++k) c.offsets[k] = Vec3((*offsets)[3 * k], (*offsets)[3 * k + 1], (*offsets)[3 * k + 2]);
+            }
+            s.constraints().restore(c);
+        }, py::arg("id"), py::arg("kind"), py::arg("index"), py::arg("stiffness"), py::arg("target") = py::none(),
+           py::arg("curvature") = py::none(), py::arg("offsets") = py::none(),
+           "Re-insert a constraint exactly as listed by `constraints` (id, offsets and targets kept).")
         .def_readwrite("constraint_stiffness_factor", &DynamicSurface::constraintStiffnessFactor,
                        "default penalty stiffness = factor * mean material stiffness")
         .def("mesh_curvature", [](const DynamicSurface& s, int index, int dir) {

@@ -83,6 +83,26 @@ int ConstraintSet::add(ConstraintKind kind, int point, double stiffness, const P
     return c.id;
 }
 
+void ConstraintSet::restore(const Constraint& c) {
+    if (c.id <= 0) throw std::invalid_argument("id: must be > 0");
+    for (const auto& o : items_)
+        if (o.id == c.id) throw std::invalid_argument("id: constraint " + std::to_string(c.id) + " exists");
+    if (!(c.stiffness > 0) || !std::isfinite(c.stiffness)) throw std::invalid_argument("stiffness: must be finite and > 0");
+    if (c.point < 0 || c.point >= g_ * h_) throw std::invalid_argument("index: mesh index out of range");
+    if (c.kind != ConstraintKind::Point && c.point != interior(c.point))
+        throw std::invalid_argument("index: this constraint needs an interior mesh point");
+    if (!c.target.allFinite() || !std::isfinite(c.curvatureU) || !std::isfinite(c.curvatureV))
+        throw std::invalid_argument("target: must be finite");
+    for (const auto& o : c.offsets)
+        if (!o.allFinite()) throw std::invalid_argument("offsets: must be finite");
+    if ((c.kind == ConstraintKind::Tangent || c.kind == ConstraintKind::Normal) && std::abs(c.target.norm() - 1) > 1e-9)
+        throw std::invalid_argument("target: normal must be a unit vector");
+    items_.push_back(c);
+    nextId_ = std::max(nextId_, c.id + 1);
+    ++structureVersion_;
+    ++version_;
+}
+
 void ConstraintSet::remove(int id) {
     const auto it = std::find_if(items_.begin(), items_.end(), [&](const Constraint& c) { return c.id == id; });
     if (it == items_.end()) throw std::invalid_argument("id: no constraint " + std::to_string(id));

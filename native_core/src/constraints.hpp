@@ -19,7 +19,7 @@ struct Constraint {
     double stiffness = 1.0;
     Vec3 target = Vec3::Zero();  ///< point: position; normal and tangent: unit normal
     double curvatureU = 0, curvatureV = 0;  ///< curvature targets (magnitude; sign is not forced)
-    Vec3 offsets[4];  ///< tangent: stored neighbour offsets (+u, -u, +v, -v) from the centre
+    Vec3 offsets[4] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};  ///< tangent/normal: neighbour offsets (+u, -u, +v, -v)
 };
 
 /// One penalty term; b < 0 means the term ties a single point to a fixed target.
@@ -47,6 +47,8 @@ public:
     /// points without the neighbours a constraint needs are moved to the nearest interior point.
     int add(ConstraintKind kind, int point, double stiffness, const Points& d, const Vec3* target,
             const double* curvatureU, const double* curvatureV);
+    /// Re-inserts a saved constraint exactly (id, stored offsets and targets), e.g. from a document.
+    void restore(const Constraint& c);
     void remove(int id);
     void clear();
     Constraint& get(int id);

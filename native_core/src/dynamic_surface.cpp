@@ -33,6 +33,15 @@ DynamicSurface::DynamicSurface(BSplineSurface surface, int g, int h)
     refreshMaterials();
 }
 
+void DynamicSurface::setReference(const std::array<double, 3>& r) {
+    for (double x : r)
+        if (!(x > 0) || !std::isfinite(x)) throw std::invalid_argument("reference: size and spacings must be finite and > 0");
+    size_ = r[0];
+    spacingU_ = r[1];
+    spacingV_ = r[2];
+    touch();
+}
+
 const Points& DynamicSurface::meshVelocities() {
     A_.apply(v_, dd_);
     return dd_;

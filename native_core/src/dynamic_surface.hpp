@@ -1,6 +1,7 @@
 // The dynamic B-spline surface of paper section 4: control points p driven through the mesh d = A p
 // by  p'' = (A^T M A)^-1 (A^T f_d - A^T D d' - A^T f_springs(d))  (eq. 7).
 #pragma once
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -66,6 +67,10 @@ public:
     const Points& mesh() const { return d_; }
     const Points& meshVelocities();  ///< A p', computed on request
     double size() const { return size_; }
+    /// The initial shape's measures that scale tolerances and tools: size (bounding-box diagonal) and
+    /// mean mesh spacing along u and v. Restoring a saved surface sets them back exactly.
+    std::array<double, 3> reference() const { return {size_, spacingU_, spacingV_}; }
+    void setReference(const std::array<double, 3>& r);
     /// Replaces the poles (e.g. after undo) and zeroes velocities; rest lengths are kept.
     void setPoles(const Points& poles);
     void setVelocities(const Points& v);

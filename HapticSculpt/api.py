@@ -1,0 +1,334 @@
+"""The scripting API of the FreeCAD layer (a contract scripts rely on; see the README).
+
+Every function validates its arguments before it touches the document and raises ``ValueError`` or
+``TypeError`` naming the argument, so a bad call leaves the document as it was. FreeCAD is imported
+inside the functions: importing :mod:`HapticSculpt` never needs it.
+"""
+from __future__ import annotations
+
+import math
+import os
+import time
+from dataclasses import dataclass
+from typing import Any, Iterable, Sequence
+
+import numpy as np
+
+from . import core, sculpt_state
+from .replay_device import ReplayDevice
+from .sculpt_feature import SculptFeature, face_of, is_sculpt
+from .source_surface import source_surface
+
+
+def _int_pair(value: Any, name: str, minimum: int) -> tuple[int, int]:
+    try:
+        a, b = value
+    except (TypeError, ValueError):
+        raise TypeError(f"{name}: expected a pair of integers, got {value!r}") from None
+    for x in (a, b):
+        if isinstance(x, bool) or not isinstance(x, (int, np.integer)):
+            raise TypeError(f"{name}: expected integers, got {value!r}")
+        if x < minimum:
+            raise ValueError(f"{name}: each must be >= {minimum}, got {value!r}")
+    return int(a), int(b)
+
+
+def _finite(value: Any, name: str, positive: bool = False, nonnegative: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise TypeError(f"{name}: expected a number, got {type(value).__name__}")
+    x = float(value)
+    if not math.isfinite(x):
+        raise ValueError(f"{name}: must be finite, got {x}")
+    if positive and not x > 0:
+        raise ValueError(f"{name}: must be > 0, got {x}")
+    if nonnegative and not x >= 0:
+        raise ValueError(f"{name}: must be >= 0, got {x}")
+    return x
+
+
+def _document(doc: Any) -> Any:
+    import FreeCAD
+    if doc is None:
+        doc = FreeCAD.ActiveDocument or FreeCAD.newDocument()
+    if not hasattr(doc, "addObject") or not hasattr(doc, "openTransaction"):
+        raise TypeError(f"doc: expected a FreeCAD document, got {type(doc).__name__}")
+    return doc
+
+
+def _sculpt(obj: Any, name: str = "obj") -> Any:
+    if not is_sculpt(obj):
+        raise TypeError(f"{name}: expected a HapticSculpt Sculpt object, got {getattr(obj, 'TypeId', type(obj).__name__)}")
+    return obj
+
+
+def make_sculpt(doc: Any = None, source: Any = None, controls: tuple[int, int] = (8, 8),
+                degree: tuple[int, int] = (3, 3), mesh: tuple[int, int] = (40, 40),
+                size: tuple[float, float] = (100.0, 100.0), name: str = "Sculpt") -> Any:
+    """A new Sculpt object in ``doc`` (the active or a new document when None).
+
+    ``source``: None (a flat ``size`` patch in XY, centred at the origin), a ``Part.Face``, a
+    ``Part.BSplineSurface`` or ``(document_object, "FaceN")``. Faces with an exact B-spline form are
+    converted exactly and refined exactly to at least ``controls`` poles of at least ``degree``;
+    others are fitted at ``controls``/``degree``. The conversion error (mm) is stored in
+    ``obj.ConversionError``. ``mesh`` is the g x h mass-point sampling (at least the control count).
+    Undo is switched on for the document if it was off, so each stroke can be undone.
+    """
+    doc = _document(doc)
+    degree = _int_pair(degree, "degree", 1)
+    if max(degree) > core.MAX_DEGREE:
+        raise ValueError(f"degree: at most {core.MAX_DEGREE}, got {degree}")
+    controls = _int_pair(controls, "controls", 2)
+    if controls[0] < degree[0] + 1 or controls[1] < degree[1] + 1:
+        raise ValueError(f"controls: need at least degree+1 = {(degree[0] + 1, degree[1] + 1)}, got {controls}")
+    mesh = _int_pair(mesh, "mesh", 2)
+    try:
+        sx, sy = size
+    except (TypeError, ValueError):
+        raise TypeError(f"size: expected (width, height), got {size!r}") from None
+    size = (_finite(sx, "size", positive=True), _finite(sy, "size", positive=True))
+    if not isinstance(name, str) or not name:
+        raise TypeError("name: expected a non-empty string")
+    made = source_surface(source, controls, degree, size, doc)
+    nu, nv = made.surface.controls
+    if mesh[0] < nu or mesh[1] < nv:
+        raise ValueError(f"mesh: must be at least the control resolution {(nu, nv)}, got {mesh}")
+    state = sculpt_state.capture(core.DynamicSurface(made.surface, mesh))
+    if doc.UndoMode == 0:
+        doc.UndoMode = 1
+    doc.openTransaction("Create sculpt")
+    try:
+        obj = doc.addObject("Part::FeaturePython", name)
+        SculptFeature(obj, state, made.method, made.error, made.description)
+        import FreeCAD
+        if FreeCAD.GuiUp:
+            from .view_provider import SculptViewProvider
+            SculptViewProvider(obj.ViewObject)
+        obj.Shape = face_of(state)
+        obj.purgeTouched()
+    except BaseException:
+        doc.abortTransaction()
+        raise
+    doc.commitTransaction()
+    return obj
+
+
+@dataclass(frozen=True)
+class RunReport:
+    """What :func:`run` did."""
+
+    steps: int
+    simulated_seconds: float
+    wall_seconds: float
+    refused_steps: int
+    slept_steps: int
+    max_force: float        #: largest reaction force on the cursor (mN with mm, s, kg)
+
+    @property
+    def steps_per_second(self) -> float:
+        """Steps per wall-clock second."""
+        return self.steps / self.wall_seconds if self.wall_seconds > 0 else math.inf
+
+
+def run(obj: Any, seconds: float, device: ReplayDevice | None = None, tool: str | None = "rope",
+        dt: float = 1e-3, integrator: str | None = None) -> RunReport:
+    """Steps the sculpt synchronously and deterministically for ``seconds`` of simulated time.
+
+    At each step of ``dt`` seconds the cursor is read from ``device`` at the simulated time (button
+    1 held = grab); without a device the surface just evolves. The tool (None keeps the current
+    one) releases at the end; the result is written back to the object as one undo transaction.
+    """
+    _sculpt(obj)
+    seconds = _finite(seconds, "seconds", nonnegative=True)
+    dt = _finite(dt, "dt", positive=True)
+    if device is not None and not hasattr(device, "sample"):
+        raise TypeError(f"device: expected a device with sample(t), got {type(device).__name__}")
+    if tool is not None and tool not in core.TOOLS:
+        raise ValueError(f"tool: unknown tool {tool!r} (one of {', '.join(core.TOOLS)})")
+    if integrator is not None and integrator not in core.INTEGRATORS:
+        raise ValueError(f"integrator: unknown integrator {integrator!r} (one of {', '.join(core.INTEGRATORS)})")
+    surface = obj.Proxy.surface
+    if tool is not None and surface.tool.name != tool:
+        surface.set_tool(tool)
+    if integrator is not None:
+        surface.integrator = integrator
+    steps = int(round(seconds / dt))
+    refused = slept = 0
+    max_force = 0.0
+    t0 = time.perf_counter()
+    for k in range(steps):
+        if device is not None:
+            c = device.sample(k * dt)
+            surface.set_cursor(c.position, c.orientation, c.grab)
+        r = surface.step(dt)
+        refused += r.refused
+        slept += r.slept
+        max_force = max(max_force, float(np.linalg.norm(r.force)))
+    wall = time.perf_counter() - t0
+    if surface.tool.grabbed:
+        c = device.sample(steps * dt) if device is not None else None
+        surface.set_cursor(c.position if c else (0.0, 0.0, 0.0), c.orientation if c else (1.0, 0.0, 0.0, 0.0), False)
+    _commit(obj, "Sculpt stroke", strokes=1)
+    return RunReport(steps, steps * dt, wall, refused, slept, max_force)
+
+
+def _commit(obj: Any, title: str, strokes: int = 0) -> None:
+    doc = obj.Document
+    doc.openTransaction(title)
+    try:
+        obj.Proxy.write_back()
+        if strokes:
+            obj.Strokes = obj.Strokes + strokes
+        obj.purgeTouched()
+    except BaseException:
+        doc.abortTransaction()
+        raise
+    doc.commitTransaction()
+
+
+def add_constraint(obj: Any, kind: str, uv: tuple[float, float] | None = None,
+                   near: Sequence[float] | None = None, **target: Any) -> int:
+    """Adds a penalty constraint at parameter ``uv`` or at the mass point nearest ``near``.
+
+    kind: "point" (``target=(x, y, z)``), "tangent" or "normal" (``normal=(nx, ny, nz)``), "curvature"
+    (``curvature=(ku, kv)``); each defaults to the current value. ``stiffness=`` overrides the
+    default penalty stiffness. One undo transaction; returns the constraint id.
+    """
+    _sculpt(obj)
+    if kind not in core.CONSTRAINTS:
+        raise ValueError(f"kind: unknown constraint {kind!r} (one of {', '.join(core.CONSTRAINTS)})")
+    if (uv is None) == (near is None):
+        raise ValueError("uv/near: give exactly one of them")
+    allowed = {"point": {"target"}, "tangent": {"normal"}, "normal": {"normal"}, "curvature": {"curvature"}}[kind]
+    unknown = set(target) - allowed - {"stiffness"}
+    if unknown:
+        raise TypeError(f"{', '.join(sorted(unknown))}: not a target of a {kind} constraint "
+                        f"(use {', '.join(sorted(allowed | {'stiffness'}))})")
+    surface = obj.Proxy.surface
+    kwargs: dict[str, Any] = {}
+    if uv is not None:
+        u, v = (_finite(x, "uv") for x in uv)
+        (u0, u1), (v0, v1) = surface.surface.domain
+        if not (u0 <= u <= u1 and v0 <= v <= v1):
+            raise ValueError(f"uv: {(u, v)} is outside the surface's domain {surface.surface.domain}")
+        kwargs["uv"] = (u, v)
+    else:
+        kwargs["near"] = [_finite(x, "near") for x in near]
+    if "stiffness" in target:
+        kwargs["stiffness"] = _finite(target["stiffness"], "stiffness", positive=True)
+    if "target" in target:
+        kwargs["target"] = [_finite(x, "target") for x in target["target"]]
+    if "normal" in target:
+        kwargs["target"] = [_finite(x, "normal") for x in target["normal"]]
+    if "curvature" in target:
+        kwargs["curvature"] = tuple(_finite(x, "curvature") for x in target["curvature"])
+    cid = surface.add_constraint(kind, **kwargs)
+    _commit(obj, f"Add {kind} constraint")
+    return cid
+
+
+def remove_constraint(obj: Any, cid: int) -> None:
+    """Removes constraint ``cid`` (one undo transaction)."""
+    _sculpt(obj)
+    obj.Proxy.surface.remove_constraint(cid)
+    _commit(obj, "Remove constraint")
+
+
+def _objects(objs: Any) -> list[Any]:
+    items = [objs] if hasattr(objs, "Shape") else list(objs) if isinstance(objs, Iterable) else None
+    if not items:
+        raise TypeError("objs: expected a document object with a Shape or a non-empty list of them")
+    for o in items:
+        if not hasattr(o, "Shape") or not hasattr(o, "Document"):
+            raise TypeError(f"objs: {o!r} is not a document object with a Shape")
+        if o.Shape.isNull():
+            raise ValueError(f"objs: {o.Name} has an empty Shape")
+    return items
+
+
+def export_step(objs: Any, path: str | os.PathLike[str]) -> str:
+    """Writes the objects' shapes to a STEP file (AP214) and returns its path."""
+    items = _objects(objs)
+    path = os.fspath(path)
+    if not path.lower().endswith((".step", ".stp")):
+        raise ValueError(f"path: expected a .step or .stp file name, got {path!r}")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise ValueError(f"path: folder {folder!r} does not exist")
+    import Import
+    Import.export(items, path)
+    if not os.path.isfile(path) or os.path.getsize(path) == 0:
+        raise RuntimeError(f"export_step: FreeCAD wrote nothing to {path!r}")
+    return path
+
+
+def thicken(obj: Any, thickness: float, tolerance: float = 1e-6) -> Any:
+    """A solid made by offsetting the sculpt face by ``thickness`` (mm; negative: the other side)
+    and closing the gap; raises ``ValueError`` when OCCT cannot make a valid solid."""
+    _sculpt(obj)
+    thickness = _finite(thickness, "thickness")
+    if thickness == 0:
+        raise ValueError("thickness: must be non-zero")
+    tolerance = _finite(tolerance, "tolerance", positive=True)
+    face = obj.Shape.Faces[0]
+    try:
+        shape = face.makeOffsetShape(thickness, tolerance, fill=True)
+    except Exception as exc:  # OCCT raises Part.OCCError and others
+        raise ValueError(f"thickness: OCCT could not offset the face by {thickness} ({exc})") from exc
+    solids = shape.Solids
+    if len(solids) != 1 or not solids[0].isValid():
+        raise ValueError(f"thickness: offsetting by {thickness} does not give one valid solid")
+    return solids[0]
+
+
+def to_cadquery(obj: Any) -> Any:
+    """A ``cadquery.Face`` on the same B-spline (poles, knots, degrees, weights) as the sculpt.
+
+    cadquery is imported here, only when called."""
+    _sculpt(obj)
+    try:
+        import cadquery as cq
+        from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+        from OCP.Geom import Geom_BSplineSurface
+        from OCP.gp import gp_Pnt
+        from OCP.TColgp import TColgp_Array2OfPnt
+        from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_Array2OfReal
+    except ImportError as exc:
+        raise ImportError("to_cadquery: cadquery is not installed in this Python (pip install cadquery)") from exc
+    from .part_surface import compress_knots
+    state = sculpt_feature_state(obj)
+    s, a = state.settings, state.arrays
+    nu, nv = s["controls"]
+    poles = a["Poles"].reshape(nu, nv, 3)
+    pts = TColgp_Array2OfPnt(1, nu, 1, nv)
+    for i in range(nu):
+        for j in range(nv):
+            pts.SetValue(i + 1, j + 1, gp_Pnt(*map(float, poles[i, j])))
+
+    def reals(values: Sequence[float]) -> Any:
+        arr = TColStd_Array1OfReal(1, len(values))
+        for k, x in enumerate(values):
+            arr.SetValue(k + 1, float(x))
+        return arr
+
+    def ints(values: Sequence[int]) -> Any:
+        arr = TColStd_Array1OfInteger(1, len(values))
+        for k, x in enumerate(values):
+            arr.SetValue(k + 1, int(x))
+        return arr
+    uk, um = compress_knots(a["KnotsU"])
+    vk, vm = compress_knots(a["KnotsV"])
+    p, q = s["degree"]
+    if a["Weights"].size:
+        w = TColStd_Array2OfReal(1, nu, 1, nv)
+        for (i, j), x in np.ndenumerate(a["Weights"].reshape(nu, nv)):
+            w.SetValue(i + 1, j + 1, float(x))
+        geom = Geom_BSplineSurface(pts, w, reals(uk), reals(vk), ints(um), ints(vm), p, q, False, False)
+    else:
+        geom = Geom_BSplineSurface(pts, reals(uk), reals(vk), ints(um), ints(vm), p, q, False, False)
+    return cq.Face(BRepBuilderAPI_MakeFace(geom, 1e-6).Face())
+
+
+def sculpt_feature_state(obj: Any) -> sculpt_state.SculptState:
+    """The sculpt state stored in a Sculpt object's properties."""
+    from .sculpt_feature import read_state
+    return read_state(_sculpt(obj))

@@ -1,0 +1,209 @@
+"""The complete sculpt state of a core surface as flat float arrays plus one JSON document.
+
+This is what a FreeCAD document stores (float lists are saved as binary doubles, JSON floats are
+written with ``repr``), so ``restore(capture(s))`` reproduces ``s`` bit for bit: poles, velocities,
+knots, weights, sampling, rest lengths, material maps, constraints (with their ids), laws,
+plasticity, tool and integrator settings. No FreeCAD import here.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from . import core
+
+FORMAT_VERSION = 1
+#: The float arrays of a state, by the name of the document property that holds each.
+ARRAY_NAMES = ("Poles", "Velocities", "KnotsU", "KnotsV", "Weights", "RestLengths",
+               "MassMap", "DampingMap", "StiffnessMap")
+_MAPS = {"MassMap": "mass_map", "DampingMap": "damping_map", "StiffnessMap": "stiffness_map"}
+_TOOL_PARAMS = {
+    "rope": ("stiffness", "stiff_stiffness", "threshold", "reel_time"),
+    "magnet": ("radius", "stiffness", "falloff"),
+    "orientation": ("stiffness",),
+    "smooth": ("radius", "strength", "falloff"),
+}
+
+
+@dataclass
+class SculptState:
+    """Arrays (flat float64) and settings (JSON-compatible) that fully describe a surface."""
+
+    arrays: dict[str, np.ndarray] = field(default_factory=dict)
+    settings: dict[str, Any] = field(default_factory=dict)
+
+    def settings_json(self) -> str:
+        """Settings as JSON; floats round-trip exactly (``repr``), non-finite values are refused."""
+        return json.dumps(self.settings, allow_nan=False, sort_keys=True)
+
+
+def tool_settings(surface: core.DynamicSurface) -> dict[str, Any]:
+    """The current tool's name and parameters."""
+    tool = surface.tool
+    params = {k: getattr(tool, k) for k in _TOOL_PARAMS[tool.name]}
+    params.update(max_force=tool.max_force, ramp_time=tool.ramp_time)
+    return {"name": tool.name, "params": params}
+
+
+def apply_tool(surface: core.DynamicSurface, settings: dict[str, Any]) -> None:
+    """Select a tool and set its parameters (unknown names raise ``ValueError``)."""
+    name = settings.get("name")
+    if name not in core.TOOLS:
+        raise ValueError(f"tool: unknown tool {name!r} (one of {', '.join(core.TOOLS)})")
+    params = dict(settings.get("params", {}))
+    allowed = set(_TOOL_PARAMS[name]) | {"max_force", "ramp_time"}
+    unknown = set(params) - allowed
+    if unknown:
+        raise ValueError(f"tool: {name} has no parameter(s) {', '.join(sorted(unknown))}")
+    surface.set_tool(name)
+    for key, value in params.items():
+        setattr(surface.tool, key, value)
+
+
+def capture(surface: core.DynamicSurface) -> SculptState:
+    """Everything needed to rebuild ``surface`` exactly."""
+    bs = surface.surface
+    weights = bs.weights
+    arrays = {
+        "Poles": np.array(surface.poles, dtype=float).ravel(),
+        "Velocities": np.array(surface.velocities, dtype=float).ravel(),
+        "KnotsU": np.array(bs.knots_u, dtype=float),
+        "KnotsV": np.array(bs.knots_v, dtype=float),
+        "Weights": np.zeros(0) if weights is None else np.array(weights, dtype=float).ravel(),
+        "RestLengths": np.array(surface.rest_lengths, dtype=float),
+    }
+    maps = {}
+    for prop, attr in _MAPS.items():
+        m = getattr(surface, attr)
+        arrays[prop] = np.array(m.values, dtype=float).ravel()
+        maps[prop] = list(m.shape)
+    constraints = []
+    for c in surface.constraints:
+        item = {k: c[k] for k in ("id", "kind", "index", "stiffness")}
+        for k in ("target", "curvature", "offsets"):
+            if k in c:
+                item[k] = list(c[k])
+        constraints.append(item)
+    settings = {
+        "format": FORMAT_VERSION,
+        "controls": list(bs.controls),
+        "degree": list(bs.degree),
+        "mesh": list(surface.mesh_shape),
+        "reference": list(surface.reference),
+        "maps": maps,
+        "integrator": surface.integrator,
+        "iterations": surface.iterations,
+        "cg_iterations": surface.cg_iterations,
+        "acceleration_limit": surface.acceleration_limit,
+        "max_halvings": surface.max_halvings,
+        "sleep_enabled": surface.sleep_enabled,
+        "sleep_tolerance": surface.sleep_tolerance,
+        "stiffness_law": list(surface.stiffness_law),
+        "damping_law": list(surface.damping_law),
+        "plasticity": list(surface.plasticity),
+        "constraint_stiffness_factor": surface.constraint_stiffness_factor,
+        "max_point_force": surface.max_point_force,
+        "tool": tool_settings(surface),
+        "constraints": constraints,
+    }
+    return SculptState(arrays, settings)
+
+
+def parse_settings(text: str) -> dict[str, Any]:
+    """Settings from JSON, refusing malformed text and non-finite numbers with a clear message."""
+    def no_constants(name: str) -> float:
+        raise ValueError(f"SculptSettings: non-finite number {name} in the JSON")
+    try:
+        settings = json.loads(text, parse_constant=no_constants)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"SculptSettings: malformed JSON ({exc})") from exc
+    if not isinstance(settings, dict):
+        raise ValueError("SculptSettings: expected a JSON object")
+    return settings
+
+
+def _pair(settings: dict[str, Any], key: str) -> tuple[int, int]:
+    value = settings.get(key)
+    if (not isinstance(value, list) or len(value) != 2
+            or not all(isinstance(x, int) and not isinstance(x, bool) and x > 0 for x in value)):
+        raise ValueError(f"SculptSettings.{key}: expected two positive integers, got {value!r}")
+    return value[0], value[1]
+
+
+def _array(arrays: dict[str, np.ndarray], name: str, size: int | None) -> np.ndarray:
+    if name not in arrays:
+        raise ValueError(f"{name}: missing")
+    a = np.asarray(arrays[name], dtype=float).ravel()
+    if size is not None and a.size != size:
+        raise ValueError(f"{name}: expected {size} numbers, got {a.size}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name}: contains NaN or Inf")
+    return a
+
+
+def restore(state: SculptState) -> core.DynamicSurface:
+    """Rebuild a surface from a state; any inconsistency raises ``ValueError`` naming the property."""
+    s, arrays = state.settings, state.arrays
+    if s.get("format") != FORMAT_VERSION:
+        raise ValueError(f"SculptSettings.format: unsupported version {s.get('format')!r}")
+    nu, nv = _pair(s, "controls")
+    degree = _pair(s, "degree")
+    mesh = _pair(s, "mesh")
+    poles = _array(arrays, "Poles", nu * nv * 3).reshape(nu, nv, 3)
+    weights = _array(arrays, "Weights", None)
+    if weights.size not in (0, nu * nv):
+        raise ValueError(f"Weights: expected 0 or {nu * nv} numbers, got {weights.size}")
+    try:
+        bs = core.BSplineSurface(poles, degree, list(_array(arrays, "KnotsU", None)),
+                                 list(_array(arrays, "KnotsV", None)),
+                                 weights.reshape(nu, nv) if weights.size else None)
+        surface = core.DynamicSurface(bs, mesh)
+    except ValueError as exc:
+        raise ValueError(f"SculptSettings: the stored surface is invalid: {exc}") from exc
+    surface.set_velocities(_array(arrays, "Velocities", nu * nv * 3).reshape(nu, nv, 3))
+    surface.set_rest_lengths(list(_array(arrays, "RestLengths", surface.spring_count)))
+    surface.reference = tuple(_float_list(s, "reference", 3))
+    maps = s.get("maps", {})
+    for prop, attr in _MAPS.items():
+        rows, cols = _pair(maps, prop) if prop in maps else (1, 1)
+        values = _array(arrays, prop, rows * cols).reshape(rows, cols)
+        getattr(surface, attr).set_values(values)
+    _apply_settings(surface, s)
+    for c in s.get("constraints", []):
+        try:
+            surface.restore_constraint(c["id"], c["kind"], c["index"], c["stiffness"], c.get("target"),
+                                       tuple(c["curvature"]) if "curvature" in c else None, c.get("offsets"))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ValueError(f"SculptSettings.constraints: invalid constraint {c!r}: {exc}") from exc
+    return surface
+
+
+def _float_list(s: dict[str, Any], key: str, n: int) -> list[float]:
+    value = s.get(key)
+    if not isinstance(value, list) or len(value) != n or not all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in value):
+        raise ValueError(f"SculptSettings.{key}: expected {n} finite numbers, got {value!r}")
+    return [float(x) for x in value]
+
+
+def _apply_settings(surface: core.DynamicSurface, s: dict[str, Any]) -> None:
+    """Solver, laws, plasticity and tool; a missing key keeps the core's default (older files)."""
+    try:
+        for key in ("integrator", "iterations", "cg_iterations", "acceleration_limit", "max_halvings",
+                    "sleep_enabled", "sleep_tolerance", "constraint_stiffness_factor", "max_point_force"):
+            if key in s:
+                setattr(surface, key, s[key])
+        if "stiffness_law" in s:
+            surface.set_stiffness_law(*s["stiffness_law"])
+        if "damping_law" in s:
+            surface.set_damping_law(*s["damping_law"])
+        if "plasticity" in s:
+            surface.set_plasticity(*s["plasticity"])
+        if "tool" in s:
+            apply_tool(surface, s["tool"])
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"SculptSettings: {exc}") from exc

@@ -1,0 +1,34 @@
+# HapticSculpt workbench (GUI start-up). Imports are lazy: nothing loads until the workbench is
+# activated. No Qt/PySide import anywhere in the project.
+import FreeCADGui as Gui
+
+
+class HapticSculptWorkbench(Gui.Workbench):
+    """Sculpt dynamic B-spline surfaces with a haptic device, a SpaceMouse or the mouse."""
+
+    MenuText = "HapticSculpt"
+    ToolTip = "Sculpt physics-based B-spline surfaces; results are Part.BSplineSurface faces"
+
+    def __init__(self):
+        import os
+        import HapticSculpt
+        self.__class__.Icon = os.path.join(os.path.dirname(HapticSculpt.__file__), "resources", "icons",
+                                           "HapticSculpt.svg")
+
+    def Initialize(self):
+        from HapticSculpt import commands
+        commands.register()
+        self.appendToolbar("HapticSculpt", commands.TOOLBAR)
+        self.appendMenu("HapticSculpt", commands.TOOLBAR)
+
+    def Activated(self):
+        pass
+
+    def Deactivated(self):
+        pass
+
+    def GetClassName(self):
+        return "Gui::PythonWorkbench"
+
+
+Gui.addWorkbench(HapticSculptWorkbench())

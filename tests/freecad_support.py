@@ -1,0 +1,77 @@
+"""Helpers shared by the FreeCAD-layer tests (plain unittest: they run under pytest and under
+``freecadcmd -t TestHapticSculpt``)."""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import textwrap
+import unittest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+for path in (ROOT, "/usr/lib/freecad-python3/lib"):
+    if os.path.isdir(path) and path not in sys.path:
+        sys.path.append(path)
+
+import FreeCAD  # noqa: E402  (before Part, or Part segfaults on import)
+import Part  # noqa: E402,F401
+
+FREECADCMD = shutil.which("freecadcmd") or shutil.which("FreeCADCmd")
+#: cadquery/OCP in its own virtual environment (its numpy must not shadow FreeCAD's): `make ocp-venv`.
+OCP_PYTHON = os.environ.get("HS_OCP_PYTHON", os.path.join(ROOT, "build", "ocp-venv", "bin", "python"))
+
+
+class DocumentTestCase(unittest.TestCase):
+    """A fresh document per test, closed afterwards."""
+
+    def setUp(self) -> None:
+        self.doc = FreeCAD.newDocument("HSTest")
+        self.tmp = tempfile.mkdtemp(prefix="hs-test-")
+
+    def tearDown(self) -> None:
+        FreeCAD.closeDocument(self.doc.Name)
+        shutil.rmtree(self.tmp, ignore_errors=True)
+
+
+def run_freecadcmd(script: str, tmp: str, timeout: float = 300) -> dict:
+    """Runs ``script`` in a new ``freecadcmd`` process with this checkout installed as an addon (a
+    private FREECAD_USER_HOME whose Mod/HapticSculpt links here); the script stores its answer with
+    ``answer(dict)``, which this returns."""
+    if FREECADCMD is None:
+        raise unittest.SkipTest("freecadcmd is not installed")
+    home = os.path.join(tmp, "fchome")
+    os.makedirs(os.path.join(home, "Mod"), exist_ok=True)
+    link = os.path.join(home, "Mod", "HapticSculpt")
+    if not os.path.lexists(link):
+        os.symlink(ROOT, link)
+    out = os.path.join(tmp, "answer.json")
+    path = os.path.join(tmp, "script.py")
+    with open(path, "w") as f:
+        f.write("import json\n"
+                f"def answer(d):\n    json.dump(d, open({out!r}, 'w'))\n"
+                + textwrap.dedent(script))
+    env = dict(os.environ, FREECAD_USER_HOME=home)
+    proc = subprocess.run([FREECADCMD, path], env=env, capture_output=True, text=True, timeout=timeout)
+    if not os.path.exists(out):
+        raise AssertionError(f"freecadcmd gave no answer (rc {proc.returncode}):\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
+    with open(out) as f:
+        return json.load(f)
+
+
+def run_ocp(script: str, tmp: str, timeout: float = 300) -> dict:
+    """Runs ``script`` with the cadquery/OCP virtual environment's Python; it prints one JSON line."""
+    if not os.path.exists(OCP_PYTHON):
+        if os.environ.get("HS_REQUIRE_OCP"):
+            raise AssertionError(f"{OCP_PYTHON} is missing: run `make ocp-venv`")
+        raise unittest.SkipTest(f"{OCP_PYTHON} is missing: run `make ocp-venv`")
+    path = os.path.join(tmp, "ocp_script.py")
+    with open(path, "w") as f:
+        f.write(textwrap.dedent(script))
+    proc = subprocess.run([OCP_PYTHON, path], capture_output=True, text=True, timeout=timeout,
+                          env=dict(os.environ, PYTHONPATH=""))
+    if proc.returncode != 0:
+        raise AssertionError(f"OCP script failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
+    return json.loads(proc.stdout.strip().splitlines()[-1])
