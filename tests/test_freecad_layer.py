@@ -324,3 +324,18 @@ class TestReadme(DocumentTestCase):
         self.assertTrue(scope["solid"].isValid())
         self.assertEqual(scope["obj"].Strokes, 0)  # the example ends with an undo
         FreeCAD.closeDocument(scope["doc"].Name)
+
+
+class TestPackage(DocumentTestCase):
+    def test_package_xml_is_read_by_freecad(self):
+        import os
+        from freecad_support import ROOT
+        meta = FreeCAD.Metadata(os.path.join(ROOT, "package.xml"))
+        self.assertEqual(meta.Name, "HapticSculpt")
+        bench = meta.Content["workbench"][0]
+        self.assertEqual(bench.Classname, "HapticSculptWorkbench")
+        self.assertEqual(bench.FreeCADMin, "0.20.0")  # higher makes 0.20 skip the addon
+        self.assertTrue(os.path.isfile(os.path.join(ROOT, bench.Icon)))
+        self.assertIn("numpy", [d["package"] for d in bench.Depend])
+        with open(os.path.join(ROOT, "InitGui.py")) as f:
+            self.assertIn(f"class {bench.Classname}(", f.read())
