@@ -25,7 +25,8 @@ class HapticSculptWorkbench(Gui.Workbench):
         pass
 
     def Deactivated(self):
-        pass
+        import HapticSculpt
+        HapticSculpt.stop_all()  # leaving the workbench ends every sculpting session
 
     def GetClassName(self):
         return "Gui::PythonWorkbench"

@@ -7,7 +7,8 @@ APT_PACKAGES := build-essential cmake ninja-build pkg-config libeigen3-dev pybin
                 python3-venv freecad-python3 freecad libhidapi-dev xvfb xauth
 SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: all deps build build-asan test test-cpp test-asan test-python test-freecad ocp-venv demo bench install uninstall clean
+PHONY_TSAN := build-tsan test-tsan
+.PHONY: all deps build build-asan $(PHONY_TSAN) test test-cpp test-asan test-python test-freecad ocp-venv demo bench install uninstall clean
 # A private FreeCAD user folder whose Mod/HapticSculpt links this checkout (tests, demo render).
 FC_HOME     := $(BUILD)/freecad-home
 # cadquery (with its own OCCT, OCP) in its own virtual environment: its numpy must not shadow Debian's.
@@ -36,6 +37,14 @@ build-asan: deps
 	cmake -S native_core -B $(BUILD)/asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DHS_SANITIZE=ON -DHS_PYTHON=OFF
 	cmake --build $(BUILD)/asan -j $(JOBS)
 
+# The threaded runtime under ThreadSanitizer.
+build-tsan: deps
+	cmake -S native_core -B $(BUILD)/tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHS_TSAN=ON -DHS_PYTHON=OFF
+	cmake --build $(BUILD)/tsan -j $(JOBS)
+
+test-tsan: build-tsan
+	TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 ctest --test-dir $(BUILD)/tsan --output-on-failure -R "Runtime|TripleBuffer|HapticEstimate"
+
 test-cpp: build
 	ctest --test-dir $(BUILD)/release --output-on-failure -j $(JOBS)
 
@@ -62,7 +71,7 @@ test-freecad: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
 	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python FREECAD_USER_HOME=$(CURDIR)/$(FC_HOME) \
 	  freecadcmd -t TestHapticSculpt
 
-test: test-cpp test-asan test-python test-freecad
+test: test-cpp test-asan test-tsan test-python test-freecad
 
 demo: build
 	$(PY) demo.py --out out

@@ -8,6 +8,7 @@ __version__ = "0.1.0"
 from .api import (RunReport, add_constraint, export_step, make_sculpt, remove_constraint, run, thicken,
                   to_cadquery)
 from .replay_device import CursorSample, ReplayDevice
+from .session import Session, stop_all
 
 __all__ = ["make_sculpt", "run", "add_constraint", "remove_constraint", "export_step", "thicken",
-           "to_cadquery", "ReplayDevice", "CursorSample", "RunReport", "__version__"]
+           "to_cadquery", "ReplayDevice", "CursorSample", "RunReport", "Session", "stop_all", "__version__"]

@@ -79,6 +79,7 @@ class SculptFeature:
         self._surface: core.DynamicSurface | None = None
         self._stale = True
         self._writing = False
+        self.session = None  # the running Session, if any (it owns the surface meanwhile)
         ensure_properties(obj)
         obj.Proxy = self
         self._writing = True
@@ -95,8 +96,12 @@ class SculptFeature:
     def surface(self) -> core.DynamicSurface:
         """The live core surface, rebuilt from the properties if they changed (Undo, Redo, open).
 
-        Raises ``ValueError`` with the reason when the stored state is corrupt."""
+        Raises ``ValueError`` with the reason when the stored state is corrupt, and
+        ``RuntimeError`` while a session's threads are stepping it."""
         obj = self._object()
+        session = getattr(self, "session", None)
+        if session is not None and session.running:
+            raise RuntimeError(f"{obj.Label}: a sculpting session is running on this surface; stop it first")
         if self._surface is None or getattr(self, "_stale", True):
             try:
                 surface = sculpt_state.restore(read_state(obj))
@@ -120,6 +125,31 @@ class SculptFeature:
         finally:
             self._writing = False
 
+    def write_arrays(self, poles: np.ndarray, velocities: np.ndarray, rest_lengths: Any) -> None:
+        """Stores a stroke's end state (from a session's snapshot) and rebuilds the Shape."""
+        obj = self._object()
+        state = read_state(obj)
+        state.arrays["Poles"] = np.asarray(poles, dtype=float).ravel()
+        state.arrays["Velocities"] = np.asarray(velocities, dtype=float).ravel()
+        state.arrays["RestLengths"] = np.asarray(rest_lengths, dtype=float).ravel()
+        self._writing = True
+        try:
+            write_state(obj, state)
+            obj.Shape = face_of(state)
+        finally:
+            self._writing = False
+
+    def show_poles(self, poles: np.ndarray) -> None:
+        """Redraws the Shape from intermediate poles (GUI frame; not stored, not an undo step)."""
+        obj = self._object()
+        state = read_state(obj)
+        state.arrays["Poles"] = np.asarray(poles, dtype=float).ravel()
+        self._writing = True
+        try:
+            obj.Shape = face_of(state)
+        finally:
+            self._writing = False
+
     # --- FreeCAD callbacks ----------------------------------------------------------------------
     def execute(self, obj: Any) -> None:
         """Recompute: the Shape from the stored state (raises, marking the object, if it is corrupt)."""
@@ -140,7 +170,7 @@ class SculptFeature:
         """Opening a file: add properties older files lack, then load the state (errors are reported
         on this object only; the rest of the document is unaffected)."""
         self._obj = obj
-        self._surface, self._stale, self._writing = None, True, False
+        self._surface, self._stale, self._writing, self.session = None, True, False, None
         ensure_properties(obj)
         try:
             self.surface  # noqa: B018 - loads and validates
@@ -156,7 +186,7 @@ class SculptFeature:
     def loads(self, state: Any) -> None:
         """Restores the proxy after the file's properties are read (see ``onDocumentRestored``)."""
         self.Type = TYPE
-        self._obj, self._surface, self._stale, self._writing = None, None, True, False
+        self._obj, self._surface, self._stale, self._writing, self.session = None, None, True, False, None
 
     def __getstate__(self) -> dict[str, Any]:
         return self.dumps()

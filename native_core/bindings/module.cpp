@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "dynamic_surface.hpp"
+#include "runtime_bindings.hpp"
 
 namespace py = pybind11;
 using namespace hs;
@@ -264,10 +265,10 @@ PYBIND11_MODULE(_core, m) {
                    ", refused=" + (r.refused ? "True" : "False") + ")";
         });
 
-    py::class_<DynamicSurface> ds(m, "DynamicSurface", "A B-spline surface driven by a mass-spring mesh d = A p (paper section 4).");
+    py::class_<DynamicSurface, std::shared_ptr<DynamicSurface>> ds(m, "DynamicSurface", "A B-spline surface driven by a mass-spring mesh d = A p (paper section 4).");
     ds.def(py::init([](const BSplineSurface& s, std::pair<int, int> mesh) {
                if (mesh.first < 2 || mesh.second < 2) throw std::invalid_argument("mesh: need at least 2x2 samples");
-               return std::make_unique<DynamicSurface>(s, mesh.first, mesh.second);
+               return std::make_shared<DynamicSurface>(s, mesh.first, mesh.second);
            }), py::arg("surface"), py::arg("mesh") = std::make_pair(40, 40),
            "Samples surface on a g x h mesh (at least the control resolution); rest lengths from its shape.")
         .def_property_readonly("controls", [](const DynamicSurface& s) { return std::make_pair(s.surface().nu(), s.surface().nv()); })
@@ -489,4 +490,6 @@ PYBIND11_MODULE(_core, m) {
             std::copy(c.data(), c.data() + c.size(), a.mutable_data());
             return a;
         }, "(g, h, 6): u and v normal curvature, min and max principal, mean, Gaussian at the mesh parameters");
+
+    bindRuntime(m);
 }

@@ -106,6 +106,8 @@ public:
     /// Latest cursor; a rising grab edge grabs, a falling one releases.
     void setCursor(const Cursor& cursor);
     const Cursor& cursor() const { return cursor_; }
+    /// The active tool's local model for the haptic loop (see haptic_estimate.hpp).
+    void describeTool(const Reaction& last, HapticEstimate& e) const { tool_->describe(meshView(), last, e); }
 
     ConstraintSet& constraints() { return constraints_; }
     const ConstraintSet& constraints() const { return constraints_; }

@@ -38,6 +38,65 @@ Reaction Tool::apply(const MeshView& mesh, const Cursor& cursor, double dt, Poin
     return r;
 }
 
+void Tool::describe(const MeshView& mesh, const Reaction& last, HapticEstimate& e) const {
+    e.toolTime = time_;
+    e.maxForce = limits.maxForce;
+    e.rampTime = limits.rampTime;
+    e.points = 0;
+    e.heldForce = last.force;
+    e.slope = 0;
+    if (!grabbed_) {
+        e.kind = EstimateKind::None;
+        return;
+    }
+    if (!describeLaw(mesh, e)) e.kind = EstimateKind::Hold;
+}
+
+bool RopeTool::describeLaw(const MeshView& mesh, HapticEstimate& e) const {
+    e.kind = EstimateKind::Rope;
+    e.points = 1;
+    e.x[0] = mesh.d.row(point_).transpose();
+    e.stiffness = stiffness;
+    e.stiffStiffness = stiffStiffness;
+    e.threshold = threshold;
+    e.length0 = length0_;
+    e.reelTime = reelTime;
+    e.slope = std::max(stiffness, stiffStiffness);
+    return true;
+}
+
+bool MagnetTool::describeLaw(const MeshView& mesh, HapticEstimate& e) const {
+    e.kind = EstimateKind::Magnet;
+    e.stiffness = stiffness;
+    e.weightSum = 0;
+    e.offsetSum.setZero();
+    for (size_t k = 0; k < points_.size(); ++k) {
+        e.weightSum += weights_[k];
+        e.offsetSum += weights_[k] * (offsets_[k] - mesh.d.row(points_[k]).transpose());
+    }
+    e.slope = stiffness * e.weightSum;
+    return true;
+}
+
+bool OrientationTool::describeLaw(const MeshView& mesh, HapticEstimate& e) const {
+    e.kind = EstimateKind::Orientation;
+    e.stiffness = stiffness;
+    const int i = center_ / mesh.h, j = center_ % mesh.h;
+    const int di[5] = {0, 1, -1, 0, 0}, dj[5] = {0, 0, 0, 1, -1}, axis[5] = {0, 1, 1, 2, 2};
+    const double spacing[5] = {0, mesh.spacingU, -mesh.spacingU, mesh.spacingV, -mesh.spacingV};
+    e.points = 0;
+    for (int k = 0; k < 5; ++k) {
+        const int ii = i + di[k], jj = j + dj[k];
+        if (ii < 0 || jj < 0 || ii >= mesh.g || jj >= mesh.h) continue;
+        e.x[e.points] = mesh.d.row(ii * mesh.h + jj).transpose();
+        e.axis[e.points] = axis[k];
+        e.spacing[e.points] = spacing[k];
+        ++e.points;
+    }
+    e.slope = stiffness * e.points;
+    return true;
+}
+
 void RopeTool::grab(const MeshView& mesh, const Cursor& cursor) {
     point_ = nearestPoint(mesh.d, cursor.position);
     length0_ = (mesh.d.row(point_).transpose() - cursor.position).norm();

@@ -7,6 +7,7 @@
 
 #include "bspline_surface.hpp"
 #include "falloff.hpp"
+#include "haptic_estimate.hpp"
 
 namespace hs {
 
@@ -48,11 +49,16 @@ public:
     Reaction apply(const MeshView& mesh, const Cursor& cursor, double dt, Points& f);
     /// Mass point the tool is attached to (nearest point for the rope), -1 if none.
     virtual int anchor() const { return -1; }
+    /// Fills the local model the haptic loop renders between steps (positions, law, parameters;
+    /// velocities are left to the caller). The default holds the last reaction.
+    void describe(const MeshView& mesh, const Reaction& last, HapticEstimate& e) const;
     ToolLimits limits;
     /// Reserves room for n points so that stepping never allocates.
     void reserve(size_t n) { index_.reserve(n); force_.reserve(n); }
 
 protected:
+    /// Tool-specific part of describe(); returns false to hold the last reaction instead.
+    virtual bool describeLaw(const MeshView&, HapticEstimate&) const { return false; }
     /// Writes the unclamped forces on the selected points into the tool's own buffer via emit().
     virtual void computeForces(const MeshView& mesh, const Cursor& cursor) = 0;
     void emit(int index, const Vec3& force);
@@ -82,6 +88,7 @@ public:
 
 protected:
     void computeForces(const MeshView& mesh, const Cursor& cursor) override;
+    bool describeLaw(const MeshView& mesh, HapticEstimate& e) const override;
 
 private:
     int point_ = -1;
@@ -101,6 +108,7 @@ public:
 
 protected:
     void computeForces(const MeshView& mesh, const Cursor& cursor) override;
+    bool describeLaw(const MeshView& mesh, HapticEstimate& e) const override;
 
 private:
     std::vector<int> points_;
@@ -119,6 +127,7 @@ public:
 
 protected:
     void computeForces(const MeshView& mesh, const Cursor& cursor) override;
+    bool describeLaw(const MeshView& mesh, HapticEstimate& e) const override;
 
 private:
     int center_ = -1;

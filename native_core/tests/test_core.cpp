@@ -18,6 +18,7 @@ void* operator new(std::size_t n) {
 }
 void operator delete(void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+long allocationCount() { return g_allocations.load(); }  // for the other test files
 
 using namespace hs;
 

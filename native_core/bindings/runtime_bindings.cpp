@@ -1,0 +1,181 @@
+// Binds the threaded runtime (HapticRuntime) and the C++ devices. The loops never take the GIL;
+// calls that wait (stop) release it.
+#include "runtime_bindings.hpp"
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+
+#include "external_device.hpp"
+#include "haptic_runtime.hpp"
+#include "replay_device.hpp"
+
+namespace py = pybind11;
+
+namespace hs {
+
+namespace {
+py::dict sampleDict(const DeviceSample& s) {
+    py::dict d;
+    d["position"] = Vec3(s.position);
+    d["orientation"] = std::vector<double>{s.orientation.w(), s.orientation.x(), s.orientation.y(), s.orientation.z()};
+    d["buttons"] = s.buttons;
+    d["valid"] = s.valid;
+    return d;
+}
+}  // namespace
+
+void bindRuntime(py::module_& m) {
+    py::class_<Device, std::shared_ptr<Device>>(m, "Device", "A cursor device the haptic loop reads and renders forces to.")
+        .def_property_readonly("name", &Device::name)
+        .def_property_readonly("capabilities", [](const Device& d) {
+            const DeviceCaps c = d.caps();
+            py::dict out;
+            out["dof"] = c.dof;
+            out["force_output"] = c.forceOutput;
+            out["rate_hz"] = c.rateHz;
+            out["max_force"] = c.maxForce;
+            out["max_stiffness"] = c.maxStiffness;
+            return out;
+        })
+        .def("sample", [](Device& d, double t) {
+            DeviceSample s;
+            if (!d.sample(t, s)) throw std::runtime_error("device lost");
+            return sampleDict(s);
+        }, py::arg("t"), "The cursor at session time t (for tests and tools; the haptic loop calls it natively).");
+
+    py::class_<ReplayDevice, Device, std::shared_ptr<ReplayDevice>>(m, "NativeReplayDevice",
+                                                                 "C++ side of HapticSculpt.ReplayDevice (same interpolation).")
+        .def(py::init([](std::vector<double> t, py::array_t<double, py::array::c_style | py::array::forcecast> xyz,
+                         py::array_t<double, py::array::c_style | py::array::forcecast> quat, std::vector<std::uint32_t> buttons) {
+                 const auto n = static_cast<Eigen::Index>(t.size());
+                 if (xyz.ndim() != 2 || xyz.shape(0) != n || xyz.shape(1) != 3) throw std::invalid_argument("xyz: expected (n, 3)");
+                 if (quat.ndim() != 2 || quat.shape(0) != n || quat.shape(1) != 4) throw std::invalid_argument("quat: expected (n, 4)");
+                 Points p = Eigen::Map<const Points>(xyz.data(), n, 3);
+                 Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> q =
+                     Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor>>(quat.data(), n, 4);
+                 return std::make_shared<ReplayDevice>(std::move(t), std::move(p), std::move(q), std::move(buttons));
+             }), py::arg("t"), py::arg("xyz"), py::arg("quat"), py::arg("buttons"))
+        .def_property_readonly("duration", &ReplayDevice::duration);
+
+    py::class_<ExternalDevice, Device, std::shared_ptr<ExternalDevice>>(m, "ExternalDevice",
+                                                                     "A cursor pushed from outside (the mouse in the 3D view).")
+        .def(py::init<std::string>(), py::arg("name") = "mouse")
+        .def("push", [](ExternalDevice& d, const std::vector<double>& position, const std::vector<double>& orientation,
+                        std::uint32_t buttons) {
+            if (position.size() != 3 || orientation.size() != 4) throw std::invalid_argument("position/orientation: expected 3 and 4 numbers");
+            DeviceSample s;
+            s.position = Vec3(position[0], position[1], position[2]);
+            s.orientation = Eigen::Quaterniond(orientation[0], orientation[1], orientation[2], orientation[3]);
+            if (!s.position.allFinite() || !s.orientation.coeffs().allFinite() || !(s.orientation.norm() > 0))
+                throw std::invalid_argument("position/orientation: must be finite (and a non-zero quaternion)");
+            s.orientation.normalize();
+            s.buttons = buttons;
+            s.valid = true;
+            d.push(s);
+        }, py::arg("position"), py::arg("orientation") = std::vector<double>{1, 0, 0, 0}, py::arg("buttons") = 0)
+        .def("lose", &ExternalDevice::lose, "Mark the device lost: its session stops.")
+        .def_property_readonly("last_force", &ExternalDevice::lastForce);
+
+    py::class_<HapticRuntime, std::shared_ptr<HapticRuntime>>(m, "HapticRuntime",
+        "The simulation and haptic threads of one session over a surface and a device.")
+        .def(py::init([](std::shared_ptr<DynamicSurface> surface, std::shared_ptr<Device> device, double hapticRate,
+                         double simDt, double graphicsRate, double maxForce, double maxStiffness, double staleLimit,
+                         double fadeTime, double maxLag, double logSeconds, bool stopWhenFinished, bool realtime) {
+                 RuntimeSettings s;
+                 s.hapticRate = hapticRate;
+                 s.simDt = simDt;
+                 s.graphicsRate = graphicsRate;
+                 s.maxForce = maxForce;
+                 s.maxStiffness = maxStiffness;
+                 s.staleLimit = staleLimit;
+                 s.fadeTime = fadeTime;
+                 s.maxLag = maxLag;
+                 s.logSeconds = logSeconds;
+                 s.stopWhenFinished = stopWhenFinished;
+                 s.realtime = realtime;
+                 return std::make_shared<HapticRuntime>(std::move(surface), std::move(device), s);
+             }), py::arg("surface"), py::arg("device"), py::arg("haptic_rate") = 1000.0, py::arg("sim_dt") = 5e-4,
+             py::arg("graphics_rate") = 60.0, py::arg("max_force") = 0.0, py::arg("max_stiffness") = 0.0,
+             py::arg("stale_limit") = 0.02, py::arg("fade_time") = 0.05, py::arg("max_lag") = 0.005,
+             py::arg("log_seconds") = 0.0, py::arg("stop_when_finished") = false, py::arg("realtime") = false)
+        .def("start", &HapticRuntime::start)
+        .def("stop", &HapticRuntime::stop, py::call_guard<py::gil_scoped_release>(),
+             "Zero the force, join both threads (GIL released while waiting).")
+        .def_property_readonly("running", &HapticRuntime::running)
+        .def("status", [](const HapticRuntime& r) {
+            const RuntimeStatus s = r.status();
+            py::dict d;
+            d["running"] = s.running;
+            d["elapsed"] = s.elapsed;
+            d["haptic_hz"] = s.hapticHz;
+            d["sim_hz"] = s.simHz;
+            d["haptic_period_p50_ms"] = s.periodP50 * 1e3;
+            d["haptic_period_p99_ms"] = s.periodP99 * 1e3;
+            d["haptic_period_max_ms"] = s.periodMax * 1e3;
+            d["haptic_ticks"] = s.hapticTicks;
+            d["sim_steps"] = s.simSteps;
+            d["refused_steps"] = s.refusedSteps;
+            d["strokes"] = s.strokes;
+            d["dropped_sim_time"] = s.droppedSimTime;
+            d["force"] = Vec3(s.force);
+            d["estimate_age_ms"] = s.estimateAge * 1e3;
+            d["realtime_priority"] = s.realtimePriority;
+            d["error"] = s.error;
+            return d;
+        })
+        .def("take_poles", [](HapticRuntime& r) -> py::object {
+            Points p;
+            if (!r.takePoles(p)) return py::none();
+            return py::cast(p);
+        }, "Newest pole snapshot ((nu*nv, 3) array) if one arrived since the last call, else None.")
+        .def("take_stroke", [](HapticRuntime& r) -> py::object {
+            StrokeSnapshot s;
+            if (!r.takeStroke(s)) return py::none();
+            py::dict d;
+            d["time"] = s.time;
+            d["poles"] = py::cast(s.poles);
+            d["velocities"] = py::cast(s.velocities);
+            d["rest_lengths"] = py::cast(s.restLengths);
+            return d;
+        }, "The oldest uncollected stroke end (poles, velocities, rest lengths), else None.")
+        .def("ticks", [](const HapticRuntime& r) {
+            const auto& ticks = r.ticks();
+            const auto n = static_cast<py::ssize_t>(ticks.size());
+            py::array_t<double> t(n), cursor({n, py::ssize_t(3)}), est({n, py::ssize_t(3)}), ren({n, py::ssize_t(3)});
+            py::array_t<std::uint32_t> buttons(n);
+            for (py::ssize_t i = 0; i < n; ++i) {
+                const HapticTick& k = ticks[static_cast<size_t>(i)];
+                t.mutable_at(i) = k.t;
+                buttons.mutable_at(i) = k.cursor.buttons;
+                for (py::ssize_t c = 0; c < 3; ++c) {
+                    cursor.mutable_at(i, c) = k.cursor.position[c];
+                    est.mutable_at(i, c) = k.estimated[c];
+                    ren.mutable_at(i, c) = k.rendered[c];
+                }
+            }
+            py::array_t<double> quat({n, py::ssize_t(4)});
+            for (py::ssize_t i = 0; i < n; ++i) {
+                const auto& q = ticks[static_cast<size_t>(i)].cursor.orientation;
+                quat.mutable_at(i, 0) = q.w(); quat.mutable_at(i, 1) = q.x(); quat.mutable_at(i, 2) = q.y(); quat.mutable_at(i, 3) = q.z();
+            }
+            py::dict d;
+            d["t"] = t; d["position"] = cursor; d["orientation"] = quat; d["buttons"] = buttons;
+            d["estimated_force"] = est; d["rendered_force"] = ren;
+            return d;
+        }, "Logged haptic ticks (after stop, with log_seconds > 0): t, cursor, buttons, estimated and rendered force.")
+        .def("force_errors", [](const HapticRuntime& r, double floor) {
+            std::vector<double> e;
+            {
+                py::gil_scoped_release release;
+                e = r.forceErrors(floor);
+            }
+            return e;
+        }, py::arg("floor") = 0.05,
+           "Per logged tick: |estimated - exact| / max(|exact|, floor * max|exact|), exact from the surface the "
+           "simulation computed around that time.");
+}
+
+}  // namespace hs

@@ -1,0 +1,304 @@
+#include "haptic_runtime.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <stdexcept>
+
+namespace hs {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+
+void atomicMax(std::atomic<double>& a, double v) {
+    double cur = a.load(std::memory_order_relaxed);
+    while (v > cur && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {
+    }
+}
+
+bool finiteSample(const DeviceSample& s) {
+    return s.position.allFinite() && s.orientation.coeffs().allFinite() && s.orientation.norm() > 0;
+}
+}  // namespace
+
+HapticRuntime::HapticRuntime(std::shared_ptr<DynamicSurface> surface, std::shared_ptr<Device> device, RuntimeSettings settings)
+    : surface_(std::move(surface)), device_(std::move(device)), settings_(settings),
+      periodBins_(new std::atomic<std::uint32_t>[kBins + 1]) {
+    if (!surface_) throw std::invalid_argument("surface: required");
+    if (!device_) throw std::invalid_argument("device: required");
+    auto positive = [](double v, const char* name) {
+        if (!(v > 0) || !std::isfinite(v)) throw std::invalid_argument(std::string(name) + ": must be finite and > 0");
+    };
+    if (!(settings_.hapticRate >= 100 && settings_.hapticRate <= 4000))
+        throw std::invalid_argument("haptic_rate: must be between 100 and 4000 Hz");
+    positive(settings_.simDt, "sim_dt");
+    positive(settings_.staleLimit, "stale_limit");
+    positive(settings_.fadeTime, "fade_time");
+    positive(settings_.maxLag, "max_lag");
+    for (double v : {settings_.graphicsRate, settings_.maxForce, settings_.maxStiffness, settings_.logSeconds})
+        if (!(v >= 0) || !std::isfinite(v)) throw std::invalid_argument("settings: rates, limits and log length must be finite and >= 0");
+    for (int i = 0; i <= kBins; ++i) periodBins_[i].store(0, std::memory_order_relaxed);
+    caps_ = device_->caps();
+    if (settings_.maxForce == 0) settings_.maxForce = caps_.maxForce > 0 ? caps_.maxForce : INFINITY;
+    if (settings_.maxStiffness == 0) settings_.maxStiffness = caps_.maxStiffness > 0 ? caps_.maxStiffness : INFINITY;
+    limits_ = {settings_.maxForce, settings_.maxStiffness, settings_.staleLimit, settings_.fadeTime};
+}
+
+HapticRuntime::~HapticRuntime() { stop(); }
+
+double HapticRuntime::now() const { return std::chrono::duration<double>(Clock::now() - t0_).count(); }
+
+void HapticRuntime::fail(const char* message) {
+    bool expected = false;
+    if (failed_.compare_exchange_strong(expected, true)) {
+        std::strncpy(error_.data(), message, error_.size() - 1);
+        stopRequested_.store(true, std::memory_order_release);
+    }
+}
+
+void HapticRuntime::start() {
+    if (started_) throw std::runtime_error("session: already started");
+    const Points& p = surface_->poles();
+    poles_.forEachSlot([&](Points& s) { s = p; });
+    for (auto& s : strokes_) {
+        s.poles = p;
+        s.velocities = surface_->velocities();
+        s.restLengths = static_cast<const DynamicSurface&>(*surface_).springs().rest();
+    }
+    if (settings_.logSeconds > 0) {
+        ticks_.resize(static_cast<size_t>(settings_.logSeconds * settings_.hapticRate) + 16);
+        snapshots_.resize(static_cast<size_t>(settings_.logSeconds / settings_.simDt) + 16);
+    }
+    device_->start();
+    t0_ = Clock::now();
+    started_ = true;
+    sim_ = std::thread([this] { simLoop(); });
+    haptic_ = std::thread([this] { hapticLoop(); });
+}
+
+void HapticRuntime::stop() {
+    if (!started_ || joined_) return;
+    stopRequested_.store(true, std::memory_order_release);
+    if (haptic_.joinable()) haptic_.join();  // it writes a zero force on its way out
+    if (sim_.joinable()) sim_.join();
+    stoppedAt_.store(now(), std::memory_order_relaxed);
+    device_->setForce(Vec3::Zero());
+    device_->stop();
+    joined_ = true;
+    ticks_.resize(tickCount_);
+    snapshots_.resize(snapshotCount_);
+}
+
+void HapticRuntime::hapticLoop() {
+    if (settings_.realtime) {
+        sched_param sp{};
+        sp.sched_priority = std::max(1, sched_get_priority_max(SCHED_FIFO) - 1);
+        realtimeOk_.store(pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0, std::memory_order_relaxed);
+    }
+    const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / settings_.hapticRate));
+    auto next = t0_;
+    auto last = t0_;
+    bool first = true;
+    DeviceSample sample;
+    const HapticEstimate idle;  // before the first snapshot: no force
+    try {
+        while (!stopRequested_.load(std::memory_order_acquire)) {
+            next += period;
+            std::this_thread::sleep_until(next);
+            const auto tick = Clock::now();
+            if (!first) {
+                const double p = std::chrono::duration<double>(tick - last).count();
+                const int bin = std::min(kBins, static_cast<int>(p / kBinWidth));
+                periodBins_[bin].fetch_add(1, std::memory_order_relaxed);
+                atomicMax(periodMax_, p);
+            }
+            first = false;
+            last = tick;
+            if (tick - next > 20 * period) next = tick;  // after a long stall, do not burst to catch up
+            const double t = std::chrono::duration<double>(tick - t0_).count();
+            if (!device_->sample(t, sample)) {
+                fail("device lost");
+                break;
+            }
+            if (finiteSample(sample)) cursor_.write(sample);
+            estimate_.update();
+            const HapticEstimate& e = estimate_.front().sequence ? estimate_.front() : idle;
+            const Vec3 estimated = finiteSample(sample) ? estimateForce(e, sample.position, sample.orientation, t) : Vec3::Zero();
+            const Vec3 rendered = e.sequence ? limitForce(e, estimated, t, limits_) : Vec3::Zero();
+            device_->setForce(rendered);
+            for (int i = 0; i < 3; ++i) force_[i].store(rendered[i], std::memory_order_relaxed);
+            estimateAge_.store(t - e.time, std::memory_order_relaxed);
+            if (tickCount_ < ticks_.size()) ticks_[tickCount_++] = {t, sample, estimated, rendered};
+            hapticTicks_.fetch_add(1, std::memory_order_relaxed);
+            if (settings_.stopWhenFinished && device_->finished(t)) {
+                stopRequested_.store(true, std::memory_order_release);
+                break;
+            }
+        }
+    } catch (const std::exception& ex) {
+        fail(ex.what());
+    } catch (...) {
+        fail("unknown error in the haptic loop");
+    }
+    device_->setForce(Vec3::Zero());
+    for (auto& f : force_) f.store(0.0, std::memory_order_relaxed);
+}
+
+void HapticRuntime::simLoop() {
+    const double dt = settings_.simDt;
+    const double graphicsEvery = settings_.graphicsRate > 0 ? 1.0 / settings_.graphicsRate : INFINITY;
+    double simTime = 0, nextGraphics = 0;
+    bool grabbed = surface_->tool().grabbed();
+    HapticEstimate previous, current;
+    Reaction reaction;
+    std::uint64_t sequence = 0;
+    try {
+        while (!stopRequested_.load(std::memory_order_acquire)) {
+            // Keep pace with real time: step when the interval it represents has passed.
+            double wall = now();
+            if (wall < simTime + dt) {
+                std::this_thread::sleep_until(t0_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(simTime + dt)));
+                continue;
+            }
+            if (wall - simTime > settings_.maxLag) {  // too slow for real time: drop the backlog
+                const double drop = wall - simTime - dt;
+                droppedSimTime_.store(droppedSimTime_.load(std::memory_order_relaxed) + drop, std::memory_order_relaxed);
+                simTime += drop;
+            }
+            if (cursor_.update()) {
+                const DeviceSample& s = cursor_.front();
+                Cursor c;
+                c.position = s.position;
+                c.orientation = s.orientation;
+                c.grab = (s.buttons & 1u) != 0;
+                surface_->setCursor(c);
+            }
+            const StepReport r = surface_->step(dt);
+            simTime += dt;
+            simSteps_.fetch_add(1, std::memory_order_relaxed);
+            if (r.refused) refused_.fetch_add(1, std::memory_order_relaxed);
+            if (!r.slept) reaction = r.reaction;
+            // Publish the tool's local model, velocities by finite differences over this step.
+            surface_->describeTool(reaction, current);
+            current.time = simTime;
+            current.sequence = ++sequence;
+            const bool sameGrab = previous.kind == current.kind && previous.points == current.points &&
+                                  current.kind != EstimateKind::None && previous.sequence + 1 == current.sequence &&
+                                  current.toolTime > previous.toolTime;
+            for (int k = 0; k < current.points; ++k) current.v[k] = sameGrab ? Vec3((current.x[k] - previous.x[k]) / dt) : Vec3::Zero();
+            current.offsetRate = sameGrab ? Vec3((current.offsetSum - previous.offsetSum) / dt) : Vec3::Zero();
+            estimate_.write(current);
+            if (snapshotCount_ < snapshots_.size()) snapshots_[snapshotCount_++] = current;
+            previous = current;
+            // Stroke ends: a release edge hands the state over for one undo transaction.
+            const bool nowGrabbed = surface_->tool().grabbed();
+            if (grabbed && !nowGrabbed) {
+                const std::uint64_t head = strokeHead_.load(std::memory_order_relaxed);
+                // A full queue (nobody collecting) merges this stroke into the next one.
+                if (head - strokeTail_.load(std::memory_order_acquire) < kStrokeSlots) {
+                    StrokeSnapshot& s = strokes_[head % kStrokeSlots];
+                    s.time = simTime;
+                    s.poles = surface_->poles();
+                    s.velocities = surface_->velocities();
+                    const auto& rest = static_cast<const DynamicSurface&>(*surface_).springs().rest();
+                    std::copy(rest.begin(), rest.end(), s.restLengths.begin());
+                    strokeHead_.store(head + 1, std::memory_order_release);
+                }
+                strokeCount_.fetch_add(1, std::memory_order_relaxed);
+            }
+            grabbed = nowGrabbed;
+            if (simTime >= nextGraphics) {
+                poles_.back() = surface_->poles();
+                poles_.publish();
+                nextGraphics = simTime + graphicsEvery;
+            }
+        }
+    } catch (const std::exception& ex) {
+        fail(ex.what());
+    } catch (...) {
+        fail("unknown error in the simulation loop");
+    }
+}
+
+bool HapticRuntime::takePoles(Points& out) {
+    if (!poles_.update()) return false;
+    out = poles_.front();
+    return true;
+}
+
+bool HapticRuntime::takeStroke(StrokeSnapshot& out) {
+    const std::uint64_t tail = strokeTail_.load(std::memory_order_relaxed);
+    if (tail == strokeHead_.load(std::memory_order_acquire)) return false;
+    out = strokes_[tail % kStrokeSlots];
+    strokeTail_.store(tail + 1, std::memory_order_release);
+    return true;
+}
+
+RuntimeStatus HapticRuntime::status() const {
+    RuntimeStatus s;
+    s.running = running();
+    s.elapsed = started_ ? (joined_ ? stoppedAt_.load(std::memory_order_relaxed) : now()) : 0.0;
+    s.hapticTicks = hapticTicks_.load(std::memory_order_relaxed);
+    s.simSteps = simSteps_.load(std::memory_order_relaxed);
+    s.refusedSteps = refused_.load(std::memory_order_relaxed);
+    s.strokes = strokeCount_.load(std::memory_order_relaxed);
+    s.droppedSimTime = droppedSimTime_.load(std::memory_order_relaxed);
+    if (s.elapsed > 0) {
+        s.hapticHz = static_cast<double>(s.hapticTicks) / s.elapsed;
+        s.simHz = static_cast<double>(s.simSteps) / s.elapsed;
+    }
+    std::uint64_t total = 0;
+    for (int i = 0; i <= kBins; ++i) total += periodBins_[i].load(std::memory_order_relaxed);
+    auto percentile = [&](double q) {
+        if (total == 0) return 0.0;
+        const auto want = static_cast<std::uint64_t>(std::ceil(q * static_cast<double>(total)));
+        std::uint64_t seen = 0;
+        for (int i = 0; i <= kBins; ++i) {
+            seen += periodBins_[i].load(std::memory_order_relaxed);
+            if (seen >= want) return (i + 0.5) * kBinWidth;
+        }
+        return kBins * kBinWidth;
+    };
+    s.periodP50 = percentile(0.5);
+    s.periodP99 = percentile(0.99);
+    s.periodMax = periodMax_.load(std::memory_order_relaxed);
+    s.force = Vec3(force_[0].load(std::memory_order_relaxed), force_[1].load(std::memory_order_relaxed),
+                   force_[2].load(std::memory_order_relaxed));
+    s.estimateAge = estimateAge_.load(std::memory_order_relaxed);
+    s.realtimePriority = realtimeOk_.load(std::memory_order_relaxed);
+    if (failed_.load(std::memory_order_acquire)) s.error = error_.data();
+    return s;
+}
+
+std::vector<double> HapticRuntime::forceErrors(double floor) const {
+    if (!joined_) throw std::runtime_error("session: stop it before analysing its logs");
+    std::vector<double> exactMag(ticks_.size(), 0.0), err(ticks_.size(), 0.0);
+    std::vector<char> ok(ticks_.size(), 0);
+    double largest = 0;
+    size_t j = 0;
+    for (size_t i = 0; i < ticks_.size(); ++i) {
+        const HapticTick& k = ticks_[i];
+        while (j + 1 < snapshots_.size() && snapshots_[j + 1].time <= k.t) ++j;
+        if (j + 1 >= snapshots_.size() || snapshots_[j].time > k.t) continue;  // no later snapshot to compare with
+        const HapticEstimate& a = snapshots_[j];
+        const HapticEstimate& b = snapshots_[j + 1];
+        if (a.kind != b.kind || a.kind == EstimateKind::None || !k.cursor.valid) continue;
+        const double s = (k.t - a.time) / (b.time - a.time);
+        const Vec3 exact = estimateForce(blendEstimates(a, b, s), k.cursor.position, k.cursor.orientation, k.t);
+        exactMag[i] = exact.norm();
+        err[i] = (k.estimated - exact).norm();
+        ok[i] = 1;
+        largest = std::max(largest, exactMag[i]);
+    }
+    std::vector<double> out;
+    out.reserve(ticks_.size());
+    for (size_t i = 0; i < ticks_.size(); ++i)
+        if (ok[i]) out.push_back(err[i] / std::max(exactMag[i], floor * largest));
+    return out;
+}
+
+}  // namespace hs

@@ -1,0 +1,129 @@
+// Paper section 5: haptics at a fixed high rate, simulation as fast as real time allows, graphics
+// at up to 60 Hz, weakly synchronised by lock-free triple buffers, so a slow simulation never
+// stalls the device. The haptic thread never allocates, locks or touches Python.
+#pragma once
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "device.hpp"
+#include "dynamic_surface.hpp"
+#include "haptic_estimate.hpp"
+#include "triple_buffer.hpp"
+
+namespace hs {
+
+struct RuntimeSettings {
+    double hapticRate = 1000;   ///< Hz, 100 to 4000
+    double simDt = 5e-4;        ///< simulation step (s); the simulation keeps pace with real time
+    double graphicsRate = 60;   ///< pole snapshots per second for the GUI (0: none)
+    double maxForce = 0;        ///< clamp on the rendered force; 0: the device's limit (none if it has none)
+    double maxStiffness = 0;    ///< limit on the rendered force-displacement slope; 0: the device's
+    double staleLimit = 0.02;   ///< s: a simulation snapshot older than this starts fading the force
+    double fadeTime = 0.05;     ///< s: from full force to zero once stale
+    double maxLag = 0.005;      ///< s: a simulation further behind real time drops the difference (it
+                                ///< runs in slow motion rather than let the estimate extrapolate far)
+    double logSeconds = 0;      ///< > 0: keep every haptic tick and simulation snapshot for analysis
+    bool stopWhenFinished = false;  ///< stop when a finite (replay) device has played out
+    bool realtime = false;      ///< try SCHED_FIFO for the haptic thread (needs privileges)
+};
+
+struct RuntimeStatus {
+    bool running = false;
+    double elapsed = 0;             ///< s since start
+    double hapticHz = 0, simHz = 0;
+    double periodP50 = 0, periodP99 = 0, periodMax = 0;  ///< haptic period (s)
+    std::uint64_t hapticTicks = 0, simSteps = 0, refusedSteps = 0, strokes = 0;
+    double droppedSimTime = 0;      ///< s of simulated time dropped to keep up with real time
+    Vec3 force = Vec3::Zero();      ///< last rendered force
+    double estimateAge = 0;         ///< s: age of the snapshot the last tick used
+    bool realtimePriority = false;
+    std::string error;              ///< why the session stopped by itself ("" if it did not)
+};
+
+/// One haptic tick, kept when logging.
+struct HapticTick {
+    double t = 0;
+    DeviceSample cursor;
+    Vec3 estimated = Vec3::Zero();  ///< the estimate's force before the safety layer
+    Vec3 rendered = Vec3::Zero();   ///< what was sent to the device
+};
+
+/// Sculpt state at the end of a stroke (a grab released), for one undo transaction each.
+struct StrokeSnapshot {
+    double time = 0;
+    Points poles, velocities;
+    std::vector<double> restLengths;
+};
+
+class HapticRuntime {
+public:
+    HapticRuntime(std::shared_ptr<DynamicSurface> surface, std::shared_ptr<Device> device, RuntimeSettings settings);
+    ~HapticRuntime();
+    HapticRuntime(const HapticRuntime&) = delete;
+    HapticRuntime& operator=(const HapticRuntime&) = delete;
+
+    void start();
+    /// Zeroes the force, then joins both threads. Idempotent.
+    void stop();
+    /// False once stopped or once a loop asked to stop (error, device lost, replay finished).
+    bool running() const { return started_ && !stopRequested_.load(std::memory_order_acquire); }
+    RuntimeStatus status() const;
+
+    /// Newest pole snapshot if one arrived since the last call (GUI thread).
+    bool takePoles(Points& out);
+    /// Oldest unclaimed stroke end, if any (session thread).
+    bool takeStroke(StrokeSnapshot& out);
+
+    // --- analysis (after stop, with logSeconds > 0) --------------------------------------------
+    const std::vector<HapticTick>& ticks() const { return ticks_; }
+    const std::vector<HapticEstimate>& snapshots() const { return snapshots_; }
+    /// Per tick: |estimated - exact| / max(|exact|, floor * max|exact|), exact from the snapshots
+    /// around the tick's time (the surface as the simulation computed it then).
+    std::vector<double> forceErrors(double floor = 0.05) const;
+
+private:
+    void hapticLoop();
+    void simLoop();
+    double now() const;
+    void fail(const char* message);
+
+    std::shared_ptr<DynamicSurface> surface_;
+    std::shared_ptr<Device> device_;
+    RuntimeSettings settings_;
+    DeviceCaps caps_;
+    ForceLimits limits_;
+    std::chrono::steady_clock::time_point t0_;
+    std::thread haptic_, sim_;
+    bool started_ = false, joined_ = false;
+    std::atomic<bool> stopRequested_{false};
+
+    TripleBuffer<DeviceSample> cursor_;     // haptic -> simulation
+    TripleBuffer<HapticEstimate> estimate_; // simulation -> haptic
+    TripleBuffer<Points> poles_;            // simulation -> GUI
+
+    static constexpr int kStrokeSlots = 8;
+    std::array<StrokeSnapshot, kStrokeSlots> strokes_;
+    std::atomic<std::uint64_t> strokeHead_{0}, strokeTail_{0};
+
+    // statistics (relaxed atomics: read by status() while the loops run)
+    static constexpr int kBins = 4000;      // 2.5 us bins up to 10 ms
+    static constexpr double kBinWidth = 2.5e-6;
+    std::unique_ptr<std::atomic<std::uint32_t>[]> periodBins_;
+    std::atomic<double> periodMax_{0}, estimateAge_{0}, droppedSimTime_{0};
+    std::atomic<std::uint64_t> hapticTicks_{0}, simSteps_{0}, refused_{0}, strokeCount_{0};
+    std::atomic<double> force_[3] = {0.0, 0.0, 0.0};
+    std::atomic<double> stoppedAt_{0};
+    std::atomic<bool> realtimeOk_{false}, failed_{false};
+    std::array<char, 256> error_{};
+
+    std::vector<HapticTick> ticks_;
+    std::vector<HapticEstimate> snapshots_;
+    size_t tickCount_ = 0, snapshotCount_ = 0;  // owned by their threads until join
+};
+
+}  // namespace hs

@@ -1,0 +1,204 @@
+// The threaded runtime: lock-free exchange, the haptic estimate against the core's own tool
+// reactions, loop life cycle (finish, device loss, zero force at exit), allocation-free loops.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <thread>
+
+#include "dynamic_surface.hpp"
+#include "external_device.hpp"
+#include "haptic_runtime.hpp"
+#include "replay_device.hpp"
+#include "triple_buffer.hpp"
+
+long allocationCount();
+
+// Sanitizers slow the loops several-fold: there the tests check behaviour and races, not rates.
+#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+
+using namespace hs;
+
+namespace {
+std::shared_ptr<DynamicSurface> patch(int controls = 8, int mesh = 24) {
+    return std::make_shared<DynamicSurface>(BSplineSurface::plane(controls, controls, 3, 3, 100, 100), mesh, mesh);
+}
+
+std::shared_ptr<ReplayDevice> lift(double seconds, double height, bool releaseAtEnd = true) {
+    const int n = 50;
+    std::vector<double> t(n);
+    Points xyz(n, 3);
+    Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> q(n, 4);
+    std::vector<std::uint32_t> buttons(n, 1);
+    for (int i = 0; i < n; ++i) {
+        t[static_cast<size_t>(i)] = seconds * i / (n - 1);
+        xyz.row(i) << 0, 0, height * std::sin(3.14159 * 0.5 * i / (n - 1));
+        q.row(i) << 1, 0, 0, 0;
+    }
+    if (releaseAtEnd) buttons.back() = 0;
+    return std::make_shared<ReplayDevice>(t, xyz, q, buttons);
+}
+
+// Records the last force it was asked to render, from any thread.
+class RecordingDevice final : public Device {
+public:
+    std::string name() const override { return "recording"; }
+    DeviceCaps caps() const override { return {3, true, 1000, 50.0, 40.0}; }
+    bool sample(double t, DeviceSample& out) override {
+        out.position = Vec3(0, 0, 20.0 * std::min(1.0, t));
+        out.buttons = 1;
+        out.valid = true;
+        return !lost.load();
+    }
+    void setForce(const Vec3& f) override {
+        last.store(f.norm());
+        if (f.norm() > 0) nonZero.store(true);
+    }
+    std::atomic<bool> lost{false}, nonZero{false};
+    std::atomic<double> last{-1};
+};
+}  // namespace
+
+TEST(TripleBuffer, ReaderAlwaysSeesAWholeNewestValue) {
+    struct Pair { long a = 0, b = 0; };
+    TripleBuffer<Pair> buffer;
+    std::atomic<bool> done{false};
+    std::thread writer([&] {
+        for (long i = 1; i <= 200000; ++i) buffer.write({i, -i});
+        done = true;
+    });
+    long last = 0;
+    while (!done || buffer.update()) {
+        buffer.update();
+        const Pair& p = buffer.front();
+        ASSERT_EQ(p.a, -p.b);
+        ASSERT_GE(p.a, last);
+        last = p.a;
+    }
+    writer.join();
+    buffer.update();
+    EXPECT_EQ(buffer.front().a, 200000);
+}
+
+TEST(HapticEstimate, ReproducesTheToolReactionAtTheSnapshot) {
+    for (const char* tool : {"rope", "magnet", "orientation"}) {
+        auto s = patch();
+        s->setTool(tool);
+        if (std::string(tool) == "magnet") static_cast<MagnetTool&>(s->tool()).radius = 20;
+        Cursor c;
+        c.position = Vec3(1, 2, 0.5);
+        c.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Vec3::UnitZ()));
+        c.grab = true;
+        s->setCursor(c);
+        StepReport r;
+        for (int k = 0; k < 30; ++k) {
+            c.position.z() += 0.4;
+            s->setCursor(c);
+            r = s->step(1e-3);
+        }
+        HapticEstimate e;
+        s->describeTool(r.reaction, e);
+        e.time = 0.03;
+        // The reaction the core reports used the tool's clock before this step's advance; the estimate
+        // evaluated at its own clock with the cursor of the step must match it exactly up to that.
+        const Vec3 f = estimateForce(e, c.position, c.orientation, e.time);
+        EXPECT_TRUE(f.allFinite()) << tool;
+        EXPECT_GT(f.norm(), 0) << tool;
+        EXPECT_NEAR((f - r.reaction.force).norm() / r.reaction.force.norm(), 0.0, 0.03) << tool;
+    }
+}
+
+TEST(HapticRuntime, ReplayRunsToTheEndAndCommitsTheStroke) {
+    auto s = patch();
+    RuntimeSettings settings;
+    settings.stopWhenFinished = true;
+    settings.logSeconds = 2;
+    HapticRuntime rt(s, lift(0.6, 20.0), settings);
+    rt.start();
+    for (int i = 0; i < 400 && rt.running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    EXPECT_FALSE(rt.running());
+    rt.stop();
+    const RuntimeStatus st = rt.status();
+    EXPECT_EQ(st.error, "");
+    if (!kSanitized) {
+        EXPECT_GT(st.hapticTicks, 500u);
+        EXPECT_GT(st.simSteps, 1000u);
+    }
+    EXPECT_EQ(st.strokes, 1u);
+    StrokeSnapshot stroke;
+    ASSERT_TRUE(rt.takeStroke(stroke));
+    EXPECT_GT(stroke.poles.col(2).maxCoeff(), 5.0);
+    EXPECT_FALSE(rt.takeStroke(stroke));
+    EXPECT_EQ(st.force.norm(), 0.0);  // zero at exit
+    const auto errors = rt.forceErrors();
+    ASSERT_GT(errors.size(), 100u);
+    if (!kSanitized) {
+        for (double e : errors) EXPECT_LT(e, 0.05);
+    }
+}
+
+TEST(HapticRuntime, DeviceLossStopsWithZeroForceAndAClamp) {
+    auto s = patch();
+    auto dev = std::make_shared<RecordingDevice>();
+    s->setTool("rope");
+    static_cast<RopeTool&>(s->tool()).stiffStiffness = 1000;  // steeper than the device's 40
+    HapticRuntime rt(s, dev, RuntimeSettings{});
+    rt.start();
+    std::this_thread::sleep_for(std::chrono::milliseconds(400));
+    EXPECT_TRUE(rt.running());
+    EXPECT_TRUE(dev->nonZero.load());
+    EXPECT_LE(rt.status().force.norm(), 50.0 + 1e-9);  // the device's maximum
+    dev->lost = true;
+    for (int i = 0; i < 200 && rt.running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    EXPECT_FALSE(rt.running());
+    rt.stop();
+    EXPECT_EQ(rt.status().error, "device lost");
+    EXPECT_EQ(dev->last.load(), 0.0);
+}
+
+TEST(HapticEstimate, SafetyLayerFadesStaleSnapshotsLimitsStiffnessAndClamps) {
+    HapticEstimate e;
+    e.kind = EstimateKind::Hold;
+    e.time = 1.0;
+    e.slope = 10;
+    const Vec3 f(3, 0, 0);
+    ForceLimits limits{100, 100, 0.01, 0.02};
+    EXPECT_EQ(limitForce(e, f, 1.005, limits), f);                              // fresh
+    EXPECT_NEAR(limitForce(e, f, 1.02, limits).x(), 1.5, 1e-12);                // half faded
+    EXPECT_EQ(limitForce(e, f, 1.05, limits), Vec3::Zero());                    // fully faded
+    limits.maxStiffness = 5;                                                    // law twice too steep
+    EXPECT_NEAR(limitForce(e, f, 1.0, limits).x(), 1.5, 1e-12);
+    limits.maxForce = 1;
+    EXPECT_NEAR(limitForce(e, f, 1.0, limits).norm(), 1.0, 1e-12);
+    EXPECT_EQ(limitForce(e, Vec3(NAN, 0, 0), 1.0, limits), Vec3::Zero());
+}
+
+TEST(HapticRuntime, LoopsDoNotAllocateOnceRunning) {
+    auto s = patch(12, 40);
+    RuntimeSettings settings;
+    HapticRuntime rt(s, lift(3.0, 25.0, false), settings);
+    rt.start();
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // grab and first factorisation
+    const long before = allocationCount();
+    std::this_thread::sleep_for(std::chrono::milliseconds(700));
+    const long after = allocationCount();
+    rt.stop();
+    EXPECT_EQ(after - before, 0);
+    EXPECT_GT(rt.status().simSteps, kSanitized ? 100u : 1000u);
+}
+
+TEST(HapticRuntime, RefusesBadSettings) {
+    auto s = patch();
+    auto dev = std::make_shared<ExternalDevice>();
+    RuntimeSettings bad;
+    bad.hapticRate = 10000;
+    EXPECT_THROW(HapticRuntime(s, dev, bad), std::invalid_argument);
+    bad = RuntimeSettings{};
+    bad.simDt = 0;
+    EXPECT_THROW(HapticRuntime(s, dev, bad), std::invalid_argument);
+    EXPECT_THROW(HapticRuntime(s, nullptr, RuntimeSettings{}), std::invalid_argument);
+}

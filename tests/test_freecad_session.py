@@ -1,0 +1,120 @@
+"""Threaded sessions over Sculpt objects: strokes as undo transactions, the surface guarded while the
+loops own it, clean stops (finish, document close, object deletion, device loss, stop_all), and
+recordings that replay exactly."""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from freecad_support import DocumentTestCase
+
+import FreeCAD
+
+import HapticSculpt as hs
+from HapticSculpt import _core
+
+
+def two_strokes() -> hs.ReplayDevice:
+    t = np.linspace(0.0, 1.2, 49)
+    xyz = np.zeros((49, 3))
+    xyz[:, 2] = 20.0 * np.sin(np.pi * t / 0.6) ** 2
+    buttons = np.ones(49, dtype=int)
+    buttons[24:27] = 0  # released between the strokes
+    buttons[-1] = 0
+    return hs.ReplayDevice(t, xyz, buttons=buttons)
+
+
+class TestSession(DocumentTestCase):
+    def test_strokes_become_undo_transactions(self):
+        obj = hs.make_sculpt(self.doc, controls=(10, 10), mesh=(30, 30))
+        before = np.array(obj.Proxy.surface.poles)
+        undo = self.doc.UndoCount
+        session = hs.Session().start(obj, two_strokes(), stop_when_finished=True)
+        self.assertTrue(session.running)
+        with self.assertRaisesRegex(RuntimeError, "session is running"):
+            obj.Proxy.surface  # noqa: B018 - the threads own it
+        self.assertTrue(session.wait(timeout=20))
+        status = session.status()
+        self.assertEqual(status["error"], "")
+        self.assertEqual(status["strokes"], 2)
+        self.assertGreater(status["haptic_hz"], 500)
+        self.assertEqual(obj.Strokes, 2)
+        names = self.doc.UndoNames[: self.doc.UndoCount - undo]
+        self.assertEqual(names.count("Sculpt stroke"), 2)
+        self.assertEqual(np.linalg.norm(status["force"]), 0.0)
+        for _ in names:
+            self.doc.undo()
+        self.assertTrue(np.array_equal(np.asarray(obj.Proxy.surface.poles), before))
+
+    def test_recording_replays_exactly(self):
+        obj = hs.make_sculpt(self.doc, mesh=(20, 20))
+        session = hs.Session().start(obj, two_strokes(), record_seconds=3.0, stop_when_finished=True)
+        session.wait(timeout=20)
+        recording = session.recording()
+        self.assertGreater(recording.samples, 500)
+        path = f"{self.tmp}/session.txt"
+        recording.save(path)
+        back = hs.ReplayDevice.load(path)
+        for a, b in zip(recording.arrays(), back.arrays()):
+            self.assertTrue(np.array_equal(a, b))
+        native = _core.NativeReplayDevice(*[x.tolist() if x.ndim == 1 else x for x in back.arrays()][:3],
+                                          back.arrays()[3].astype(np.uint32).tolist())
+        t, xyz, q, buttons = back.arrays()
+        for k in range(0, len(t), 97):  # the native and the Python device agree sample for sample
+            s = native.sample(float(t[k]))
+            self.assertEqual(tuple(s["position"]), tuple(xyz[k]))
+            self.assertEqual(tuple(s["orientation"]), tuple(q[k]))
+            self.assertEqual(s["buttons"], buttons[k])
+            py = back.sample(float(t[k]))
+            self.assertEqual(py.position, tuple(xyz[k]))
+        errors = session.force_errors()
+        self.assertLess(np.percentile(errors, 99), 0.05)
+
+    def test_closing_the_document_stops_the_session(self):
+        doc = FreeCAD.newDocument("HSClose")
+        obj = hs.make_sculpt(doc)
+        session = hs.Session().start(obj, two_strokes())
+        time.sleep(0.1)
+        FreeCAD.closeDocument(doc.Name)
+        self.assertFalse(session.running)
+        self.assertEqual(session.status()["running"], False)
+
+    def test_deleting_the_object_stops_the_session(self):
+        obj = hs.make_sculpt(self.doc)
+        session = hs.Session().start(obj, two_strokes())
+        time.sleep(0.1)
+        self.doc.removeObject(obj.Name)
+        self.assertFalse(session.running)
+
+    def test_device_loss_stops_with_a_reason_and_zero_force(self):
+        obj = hs.make_sculpt(self.doc)
+        mouse = _core.ExternalDevice("mouse")
+        mouse.push([0.0, 0.0, 0.0], buttons=1)
+        session = hs.Session().start(obj, mouse)
+        for z in np.linspace(0, 15, 30):
+            mouse.push([0.0, 0.0, float(z)], buttons=1)
+            time.sleep(0.005)
+        self.assertGreater(np.linalg.norm(mouse.last_force), 0.0)
+        mouse.lose()
+        self.assertTrue(session.wait(timeout=5))
+        self.assertEqual(session.status()["error"], "device lost")
+        self.assertEqual(np.linalg.norm(mouse.last_force), 0.0)
+        self.assertFalse(session.running)
+        obj.Proxy.surface  # noqa: B018 - usable again
+
+    def test_stop_all_and_bad_arguments(self):
+        obj = hs.make_sculpt(self.doc)
+        session = hs.Session().start(obj, two_strokes())
+        with self.assertRaisesRegex(RuntimeError, "already"):
+            hs.Session().start(obj, two_strokes())
+        hs.stop_all()
+        self.assertFalse(session.running)
+        with self.assertRaisesRegex(ValueError, "tool"):
+            hs.Session().start(obj, two_strokes(), tool="chisel")
+        with self.assertRaisesRegex(TypeError, "device"):
+            hs.Session().start(obj, "spacemouse")
+        with self.assertRaisesRegex(ValueError, "haptic_rate"):
+            hs.Session().start(obj, two_strokes(), haptic_rate=50000)
+        with self.assertRaisesRegex(TypeError, "obj"):
+            hs.Session().start(self.doc, two_strokes())
