@@ -86,6 +86,7 @@ uninstall:
 
 bench: build
 	$(PY) bench/table1.py
+	$(PY) bench/loops.py
 
 clean:
 	rm -rf $(BUILD) HapticSculpt/_core*.so

@@ -1,0 +1,131 @@
+#!/usr/bin/env python3
+"""The threaded loops (paper section 5): a replay device drives a rope stroke on a scene for a set
+time while the haptic loop renders the force from the simulation's local estimate.
+
+Prints a table and writes bench/results/loops.json: for the 12x12/40x40 scene at the top level
+(haptic_hz, haptic_period_p50/p99/max_ms, sim_hz, force_error_rel = 99th percentile of the estimated
+force's error against the force from the exact surface, relative to the force, cpu_percent of one
+core) and every scene under "scenes"; plus bench/results/loops.png (period histogram, force error).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import sys
+import time
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+from HapticSculpt import _core, core  # noqa: E402
+from HapticSculpt.replay_device import ReplayDevice  # noqa: E402
+
+SCENES = [((12, 12), (40, 40), 5e-4), ((32, 32), (128, 128), 1e-3)]
+
+
+def trajectory(seconds: float) -> ReplayDevice:
+    """A long rope stroke: lift, circle and wiggle, with a release and re-grab every 2.5 s."""
+    t = np.linspace(0.0, seconds, int(seconds * 50) + 1)
+    xyz = np.column_stack([12 * np.sin(1.3 * t), 9 * np.sin(0.7 * t + 1), 18 + 10 * np.sin(2.1 * t) ** 2])
+    xyz[t < 0.3] *= (t[t < 0.3] / 0.3)[:, None]
+    buttons = np.where((t % 2.5) < 2.4, 1, 0)
+    buttons[-1] = 0
+    return ReplayDevice(t, xyz, buttons=buttons)
+
+
+def cpu_seconds() -> float:
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
+
+
+def run_scene(controls, mesh, sim_dt, seconds, rate):
+    surface = core.patch(controls, (3, 3), mesh, (100.0, 100.0))
+    surface.damping_map.set_uniform(5.0)
+    dev = trajectory(seconds)
+    t, xyz, q, b = dev.arrays()
+    native = _core.NativeReplayDevice(t.tolist(), xyz, q, b.astype(np.uint32).tolist())
+    runtime = _core.HapticRuntime(surface, native, haptic_rate=rate, sim_dt=sim_dt, log_seconds=seconds + 1,
+                                  stop_when_finished=True)
+    cpu0, wall0 = cpu_seconds(), time.perf_counter()
+    runtime.start()
+    while runtime.running:
+        time.sleep(0.05)
+    runtime.stop()
+    cpu, wall = cpu_seconds() - cpu0, time.perf_counter() - wall0
+    status = runtime.status()
+    errors = np.asarray(runtime.force_errors(0.05))
+    ticks = runtime.ticks()
+    periods = np.diff(ticks["t"]) * 1e3
+    return {
+        "scene": f"{controls[0]}x{controls[1]}/{mesh[0]}x{mesh[1]}",
+        "seconds": status["elapsed"],
+        "haptic_hz": status["haptic_hz"],
+        "haptic_period_p50_ms": status["haptic_period_p50_ms"],
+        "haptic_period_p99_ms": status["haptic_period_p99_ms"],
+        "haptic_period_max_ms": status["haptic_period_max_ms"],
+        "sim_hz": status["sim_hz"],
+        "sim_dt": sim_dt,
+        "dropped_sim_time": status["dropped_sim_time"],
+        "force_error_rel": float(np.percentile(errors, 99)) if errors.size else None,
+        "force_error_rel_median": float(np.median(errors)) if errors.size else None,
+        "force_rms": float(np.sqrt(np.mean(np.sum(ticks["rendered_force"] ** 2, axis=1)))),
+        "cpu_percent": 100.0 * cpu / wall,
+        "strokes": status["strokes"],
+        "error": status["error"],
+    }, periods, errors
+
+
+def plot(results, data, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    for r, (periods, errors) in zip(results, data):
+        axes[0].hist(periods, bins=np.linspace(0.5, 2.0, 151), histtype="step", label=r["scene"])
+        if errors.size:
+            s = np.sort(errors)
+            axes[1].plot(s, np.linspace(0, 1, s.size), label=r["scene"])
+    axes[0].set_yscale("log")
+    axes[0].set_xlabel("haptic period (ms)")
+    axes[0].set_ylabel("ticks")
+    axes[0].legend()
+    axes[1].set_xscale("log")
+    axes[1].set_xlabel("estimated force error / force")
+    axes[1].set_ylabel("fraction of ticks")
+    axes[1].axvline(0.05, color="r", lw=0.8, ls="--")
+    axes[1].legend()
+    fig.suptitle("HapticSculpt loops: haptic period and force-estimate error (replay rope stroke)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--seconds", type=float, default=10.0)
+    ap.add_argument("--rate", type=float, default=1000.0, help="haptic rate (Hz)")
+    args = ap.parse_args()
+    os.makedirs(os.path.join(ROOT, "bench", "results"), exist_ok=True)
+    results, data = [], []
+    for controls, mesh, sim_dt in SCENES:
+        r, periods, errors = run_scene(controls, mesh, sim_dt, args.seconds, args.rate)
+        results.append(r)
+        data.append((periods, errors))
+    print(f"{'scene':<14}{'haptic Hz':>10}{'p50 ms':>8}{'p99 ms':>8}{'max ms':>8}{'sim Hz':>9}"
+          f"{'err p99':>9}{'cpu %':>7}")
+    for r in results:
+        print(f"{r['scene']:<14}{r['haptic_hz']:>10.1f}{r['haptic_period_p50_ms']:>8.3f}{r['haptic_period_p99_ms']:>8.3f}"
+              f"{r['haptic_period_max_ms']:>8.2f}{r['sim_hz']:>9.0f}{r['force_error_rel']:>9.2e}{r['cpu_percent']:>7.1f}")
+    main_scene = dict(results[0])
+    main_scene["scenes"] = results
+    main_scene["machine"] = f"{os.cpu_count()} cores"
+    with open(os.path.join(ROOT, "bench", "results", "loops.json"), "w") as f:
+        json.dump(main_scene, f, indent=2)
+    plot(results, data, os.path.join(ROOT, "bench", "results", "loops.png"))
+    print("wrote bench/results/loops.json, bench/results/loops.png")
+
+
+if __name__ == "__main__":
+    main()
