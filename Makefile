@@ -8,7 +8,7 @@ APT_PACKAGES := build-essential cmake ninja-build pkg-config libeigen3-dev pybin
 SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
-.PHONY: all deps build build-asan $(PHONY_TSAN) test test-cpp test-asan test-python test-freecad ocp-venv demo bench install uninstall clean
+.PHONY: all deps build build-asan $(PHONY_TSAN) test test-cpp test-asan test-python test-freecad ocp-venv demo bench install install-udev uninstall clean
 # A private FreeCAD user folder whose Mod/HapticSculpt links this checkout (tests, demo render).
 FC_HOME     := $(BUILD)/freecad-home
 # cadquery (with its own OCCT, OCP) in its own virtual environment: its numpy must not shadow Debian's.
@@ -80,6 +80,11 @@ install: build
 	mkdir -p $(FREECAD_MOD)
 	ln -sfn $(CURDIR) $(FREECAD_MOD)/HapticSculpt
 	@echo "linked $(FREECAD_MOD)/HapticSculpt -> $(CURDIR); restart FreeCAD and pick the HapticSculpt workbench"
+
+# SpaceMouse access for the logged-in user (uaccess; nothing broader).
+install-udev:
+	$(SUDO) install -m 644 udev/70-hapticsculpt.rules /etc/udev/rules.d/70-hapticsculpt.rules
+	$(SUDO) udevadm control --reload-rules && $(SUDO) udevadm trigger --subsystem-match=hidraw || true
 
 uninstall:
 	rm -f $(FREECAD_MOD)/HapticSculpt

@@ -44,6 +44,15 @@ try:
     for _ in range(5):
         Gui.updateGui()
     view.saveImage({png!r}, 800, 600, "White")
+    from HapticSculpt.devices import MouseDevice
+    mouse = MouseDevice()
+    mouse.attach(view)
+    size = view.getSize()
+    out["mouse_centre"] = list(mouse.move_to(view, (size[0] // 2, size[1] // 2)))
+    out["mouse_corner"] = list(mouse.move_to(view, (2, 2)))
+    mouse.press(True)
+    out["mouse_sample"] = mouse.native.sample(0.0)["buttons"]
+    mouse.detach()
 except Exception:
     out["error"] = traceback.format_exc()
 json.dump(out, open({answer!r}, "w"))
@@ -74,6 +83,9 @@ def test_workbench_loads_and_commands_run(tmp_path):
     assert set(out["commands"]) >= {"HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Thicken",
                                     "HapticSculpt_ExportStep"}
     assert {"Sculpt", "Sculpt_Solid"} <= set(out["objects"])
+    assert np.all(np.isfinite(out["mouse_centre"])) and np.all(np.isfinite(out["mouse_corner"]))
+    assert abs(out["mouse_centre"][2]) < 60.0  # on the sculpt (a bump up to ~35 mm), not the far plane
+    assert out["mouse_sample"] == 1
     assert out["icon"].endswith("HapticSculpt.svg") and os.path.exists(out["icon"])
     import matplotlib.image as mpimg
     img = mpimg.imread(png)[..., :3]
