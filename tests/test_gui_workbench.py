@@ -53,6 +53,28 @@ try:
     mouse.press(True)
     out["mouse_sample"] = mouse.native.sample(0.0)["buttons"]
     mouse.detach()
+    # A threaded session in the GUI: a Coin timer redraws the shape at graphics rate and commits strokes.
+    import time
+    sculpt2 = hs.make_sculpt(doc, name="Live", size=(50.0, 50.0))
+    sculpt2.Placement.Base = FreeCAD.Vector(120, 0, 0)
+    session = hs.Session().start(sculpt2, hs.ReplayDevice.stroke((0, 0, 0), (0, 0, 20.0), seconds=0.8, hold=0.2),
+                                 stop_when_finished=True)
+    heights, t0 = [], time.monotonic()
+    while session.running and time.monotonic() - t0 < 10:
+        Gui.updateGui()
+        heights.append(sculpt2.Shape.BoundBox.ZLength)
+        time.sleep(0.01)
+    Gui.updateGui()
+    out["live_heights"] = sorted(set(round(h, 3) for h in heights))
+    out["live_strokes"] = sculpt2.Strokes
+    out["live_undo"] = doc.UndoNames[:2]
+    # Leaving the workbench stops every session (force first, then the threads join).
+    session2 = hs.Session().start(sculpt2, hs.ReplayDevice.stroke((0, 0, 0), (0, 0, 5.0), seconds=5.0))
+    time.sleep(0.2)
+    running_before = session2.running
+    Gui.activateWorkbench("PartWorkbench")
+    Gui.updateGui()
+    out["workbench_stop"] = [running_before, session2.running]
 except Exception:
     out["error"] = traceback.format_exc()
 json.dump(out, open({answer!r}, "w"))
@@ -86,6 +108,9 @@ def test_workbench_loads_and_commands_run(tmp_path):
     assert np.all(np.isfinite(out["mouse_centre"])) and np.all(np.isfinite(out["mouse_corner"]))
     assert abs(out["mouse_centre"][2]) < 60.0  # on the sculpt (a bump up to ~35 mm), not the far plane
     assert out["mouse_sample"] == 1
+    assert len(out["live_heights"]) > 5, out["live_heights"]  # the shape moved while the threads ran
+    assert out["live_strokes"] == 1 and "Sculpt stroke" in out["live_undo"]
+    assert out["workbench_stop"] == [True, False]
     assert out["icon"].endswith("HapticSculpt.svg") and os.path.exists(out["icon"])
     import matplotlib.image as mpimg
     img = mpimg.imread(png)[..., :3]
