@@ -182,16 +182,34 @@ void ConstraintSet::terms(const Points& d, std::vector<ConstraintTerm>& out) con
                 break;
             }
             case ConstraintKind::Curvature: {
+                // The three points around p along u (and along v) are projected onto the nearest
+                // circle arc of the target curvature that keeps their mean half-chord s and the
+                // side they bend to: the outer chord is the exact chord curvatureChord(k, s, s) and
+                // p sits at the arc's sagitta. Neighbour-to-centre targets make it rotation and
+                // translation free (zero net force), and give p the transverse pull a chord spring
+                // alone cannot (from a flat start, a chord spring only compresses the row).
                 const int step[2] = {h_, 1};
                 const double kappa[2] = {c.curvatureU, c.curvatureV};
                 for (int k = 0; k < 2; ++k) {
                     const int a = p + step[k], b = p - step[k];
-                    const Vec3 span = d.row(a) - d.row(b);
+                    const Vec3 xa = d.row(a), xb = d.row(b);
+                    const Vec3 span = xa - xb;
                     const double l = span.norm();
                     if (!(l > 0)) continue;
-                    const double chord = curvatureChord(kappa[k], (d.row(a) - x.transpose()).norm(),
-                                                        (x.transpose() - d.row(b)).norm());
-                    out.push_back({a, b, c.stiffness, span * (chord / l)});
+                    const Vec3 e = span / l;
+                    Vec3 w = x - 0.5 * (xa + xb);
+                    w -= w.dot(e) * e;
+                    if (!(w.norm() > 1e-9 * l)) {  // flat: bend toward the surface normal
+                        w = meshNormal(d, p);
+                        w -= w.dot(e) * e;
+                    }
+                    if (!(w.norm() > 0)) continue;
+                    w.normalize();
+                    const double half = 0.5 * ((xa - x).norm() + (x - xb).norm());
+                    const double halfChord = 0.5 * curvatureChord(kappa[k], half, half);
+                    const double sagitta = std::sqrt(std::max(0.0, half * half - halfChord * halfChord));
+                    out.push_back({a, p, c.stiffness, halfChord * e - sagitta * w});
+                    out.push_back({b, p, c.stiffness, -halfChord * e - sagitta * w});
                 }
                 break;
             }
@@ -236,7 +254,7 @@ void ConstraintSet::addLaplacian(std::vector<Eigen::Triplet<double>>& trip) cons
                 pair(p + h_, p); pair(p - h_, p); pair(p + 1, p); pair(p - 1, p);
                 break;
             case ConstraintKind::Curvature:
-                pair(p + h_, p - h_); pair(p + 1, p - 1);
+                pair(p + h_, p); pair(p - h_, p); pair(p + 1, p); pair(p - 1, p);
                 break;
         }
     }
@@ -257,7 +275,7 @@ void ConstraintSet::addStiffness(const Points& y, Points& out) const {
                 pair(p + h_, p); pair(p - h_, p); pair(p + 1, p); pair(p - 1, p);
                 break;
             case ConstraintKind::Curvature:
-                pair(p + h_, p - h_); pair(p + 1, p - 1);
+                pair(p + h_, p); pair(p - h_, p); pair(p + 1, p); pair(p - 1, p);
                 break;
         }
     }

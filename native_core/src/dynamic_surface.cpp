@@ -231,13 +231,10 @@ StepReport DynamicSurface::step(double dt) {
         return r;
     }
     if (tracksWork) {
-        // Work of the applied forces over the step (forces held over the step).
-        for (Eigen::Index i = 0; i < d_.rows(); ++i) {
-            Vec3 f = Vec3::Zero();
-            if (hasExternal_) f += fext_.row(i).transpose();
-            if (toolForces_) f += ftool_.row(i).transpose();
-            work_ += f.dot((d_.row(i) - dPrev_.row(i)).transpose());
-        }
+        // Work of the applied forces over the step (forces held over the step), as whole-array
+        // products so the loop vectorises.
+        if (hasExternal_) work_ += fext_.cwiseProduct(d_ - dPrev_).sum();
+        if (toolForces_) work_ += ftool_.cwiseProduct(d_ - dPrev_).sum();
     }
     if (springs_.plasticity.enabled) springs_.applyPlasticity(d_, dt);
     time_ += dt;

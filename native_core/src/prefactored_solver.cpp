@@ -23,10 +23,30 @@ void PrefactoredSolver::factor(const Eigen::SparseMatrix<double>& m, const char*
     perm_ = ldlt_.permutationP().indices();
     n_ = static_cast<int>(m.rows());
     work_.resize(n_, 3);
+    inverse_.resize(0, 0);
+    if (n_ <= kDenseLimit) {
+        inverse_ = ldlt_.solve(Eigen::MatrixXd::Identity(n_, n_));
+        inverse_ = 0.5 * (inverse_ + inverse_.transpose()).eval();  // exactly symmetric
+        bx_.resize(n_);
+        by_.resize(n_);
+        bz_.resize(n_);
+    }
     ready_ = true;
 }
 
 void PrefactoredSolver::solve(const Points& b, Points& x) const {
+    if (dense()) {
+        bx_ = b.col(0);
+        by_ = b.col(1);
+        bz_ = b.col(2);
+        for (int i = 0; i < n_; ++i) {
+            const auto row = inverse_.row(i);
+            x(i, 0) = row.dot(bx_);
+            x(i, 1) = row.dot(by_);
+            x(i, 2) = row.dot(bz_);
+        }
+        return;
+    }
     double* w = work_.data();
     for (int i = 0; i < n_; ++i) {
         const int t = perm_[i];

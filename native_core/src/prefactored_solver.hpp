@@ -1,4 +1,6 @@
-// Sparse LDL^T factorisation done once, with a three-column solve that never allocates.
+// Sparse LDL^T factorisation done once, with a three-column solve that never allocates. Small systems
+// (up to kDenseLimit unknowns, e.g. 12x12 controls) keep the explicit inverse instead: one pass of
+// contiguous, vectorised dot products beats a sparse triangular solve's dependent, indexed updates.
 #pragma once
 #include <Eigen/SparseCholesky>
 
@@ -15,12 +17,17 @@ public:
     /// x = M^-1 b for the three columns at once; x and b may not alias.
     void solve(const Points& b, Points& x) const;
 
+    static constexpr int kDenseLimit = 600;
+    bool dense() const { return inverse_.size() != 0; }
+
 private:
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
     Eigen::SparseMatrix<double> L_;  // unit lower factor, CSC (strictly lower part stored)
     Eigen::VectorXd invD_;
     Eigen::VectorXi perm_;           // (P b)[perm_[i]] = b[i]
     mutable Points work_;
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> inverse_;  // dense path only
+    mutable Eigen::VectorXd bx_, by_, bz_;
     int n_ = 0;
     bool ready_ = false;
 };

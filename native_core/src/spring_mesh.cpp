@@ -24,20 +24,49 @@ auto withLaw(const ResponseLaw& law, Body&& body) {
     }
     return body(FixedLaw<LawKind::Linear>{law.scale});
 }
+// c_j (x_a - x_b) for one run; branch-free so that it vectorises (Uniform: one stiffness for all).
+template <bool Uniform, class Law>
+void projectRun(Law lw, int n, const double* __restrict xa, const double* __restrict ya, const double* __restrict za,
+                const double* __restrict xb, const double* __restrict yb, const double* __restrict zb,
+                const double* __restrict rest, const double* __restrict k, double kUniform, double maxExtra,
+                double minL, double* __restrict cx, double* __restrict cy, double* __restrict cz) {
+    for (int j = 0; j < n; ++j) {
+        const double kj = Uniform ? kUniform : k[j];
+        const double dx = xa[j] - xb[j], dy = ya[j] - yb[j], dz = za[j] - zb[j];
+        const double l = std::sqrt(dx * dx + dy * dy + dz * dz);
+        const double e = l - rest[j];
+        const double cap = maxExtra * std::abs(e);
+        const double force = std::min(std::max(lw.value(kj * e), kj * e - cap), kj * e + cap);
+        // c = k * target / l with target = l - force / k; a zero-length spring has no direction
+        const double live = l > minL ? 1.0 : 0.0;  // a select of constants keeps the loop branch-free
+        const double c = live * ((kj * l - force) / std::max(l, minL));
+        cx[j] = c * dx;
+        cy[j] = c * dy;
+        cz[j] = c * dz;
+    }
+}
 }  // namespace
 
 SpringMesh::SpringMesh(int g, int h, const Points& d) : g_(g), h_(h) {
-    auto add = [&](int a, int b) { a_.push_back(a); b_.push_back(b); };
-    for (int i = 0; i < g; ++i)
-        for (int j = 0; j < h; ++j) {
-            const int p = i * h + j;
-            if (j + 1 < h) add(p, p + 1);                  // along v
-            if (i + 1 < g) add(p, p + h);                  // along u
-            if (i + 1 < g && j + 1 < h) add(p, p + h + 1); // diagonal
-            if (i + 1 < g && j > 0) add(p, p + h - 1);     // anti-diagonal
+    auto family = [&](int offset, int rows, int j0, int j1) {
+        for (int i = 0; i < rows; ++i) {
+            if (j1 <= j0) continue;
+            runs_.push_back({static_cast<int>(a_.size()), i * h + j0, offset, j1 - j0});
+            for (int j = j0; j < j1; ++j) {
+                a_.push_back(i * h + j);
+                b_.push_back(i * h + j + offset);
+            }
         }
+    };
+    family(1, g, 0, h - 1);          // along v
+    family(h, g - 1, 0, h);          // along u
+    family(h + 1, g - 1, 0, h - 1);  // diagonal
+    family(h - 1, g - 1, 1, h);      // anti-diagonal
     const size_t n = a_.size();
     dirx_.assign(n, 0); diry_.assign(n, 0); dirz_.assign(n, 0); axial_.assign(n, 0); lateral_.assign(n, 0);
+    const Eigen::Index points = static_cast<Eigen::Index>(g) * h;
+    for (Eigen::VectorXd* v : {&x_, &y_, &z_, &fx_, &fy_, &fz_}) v->setZero(points);
+    for (Eigen::VectorXd* v : {&cx_, &cy_, &cz_}) v->setZero(std::max(g, h) + 1);
     resetRest(d);
     rest0_ = rest_;
 }
@@ -116,27 +145,53 @@ void SpringMesh::addTangentStiffness(const Points& y, Points& out) const {
 void SpringMesh::addProjections(const Points& d, Points& out, double maxExtraStiffness) const {
     // Each spring's energy 1/2 k |x_a - x_b - t|^2 is minimised over |t| = target length;
     // a non-linear law changes the target length so that k (l - |t|) = g(k (l - r)).
+    // Runs of one family in one row have contiguous endpoints a and a + offset: in structure-of-
+    // arrays form every loop below is a plain vectorisable stream.
+    const Eigen::Index n = d.rows();
+    x_ = d.col(0);
+    y_ = d.col(1);
+    z_ = d.col(2);
+    fx_.setZero();
+    fy_.setZero();
+    fz_.setZero();
+    const double* X = x_.data();
+    const double* Y = y_.data();
+    const double* Z = z_.data();
+    double* cx = cx_.data();
+    double* cy = cy_.data();
+    double* cz = cz_.data();
+    const double* rest = rest_.data();
+    const bool uniform = k_.empty();
+    const double* kv = uniform ? nullptr : k_.data();
+    const double kU = kUniform_, minL = minLength;
     withLaw(law, [&](auto lw) {
-        for (size_t s = 0; s < a_.size(); ++s) {
-            const double* pa = d.data() + 3 * a_[s];
-            const double* pb = d.data() + 3 * b_[s];
-            const double dx = pa[0] - pb[0], dy = pa[1] - pb[1], dz = pa[2] - pb[2];
-            const double l = std::sqrt(dx * dx + dy * dy + dz * dz);
-            if (!(l > minLength)) continue;
-            const double k = stiffness(static_cast<int>(s));
-            const double e = l - rest_[s];
-            double force = lw.value(k * e);
-            const double cap = maxExtraStiffness * std::abs(e);
-            force = std::clamp(force, k * e - cap, k * e + cap);
-            const double target = l - force / k;
-            const double c = k * target / l;
-            double* oa = out.data() + 3 * a_[s];
-            double* ob = out.data() + 3 * b_[s];
-            oa[0] += c * dx; oa[1] += c * dy; oa[2] += c * dz;
-            ob[0] -= c * dx; ob[1] -= c * dy; ob[2] -= c * dz;
+        for (const Run& run : runs_) {
+            const double* xa = X + run.a0;
+            const double* ya = Y + run.a0;
+            const double* za = Z + run.a0;
+            const double* xb = xa + run.offset;
+            const double* yb = ya + run.offset;
+            const double* zb = za + run.offset;
+            const double* r = rest + run.first;
+            const double* kr = uniform ? nullptr : kv + run.first;
+            if (uniform) projectRun<true>(lw, run.length, xa, ya, za, xb, yb, zb, r, nullptr, kU, maxExtraStiffness, minL, cx, cy, cz);
+            else projectRun<false>(lw, run.length, xa, ya, za, xb, yb, zb, r, kr, kU, maxExtraStiffness, minL, cx, cy, cz);
+            double* fxa = fx_.data() + run.a0;
+            double* fya = fy_.data() + run.a0;
+            double* fza = fz_.data() + run.a0;
+            for (int j = 0; j < run.length; ++j) { fxa[j] += cx[j]; fya[j] += cy[j]; fza[j] += cz[j]; }
+            double* fxb = fxa + run.offset;
+            double* fyb = fya + run.offset;
+            double* fzb = fza + run.offset;
+            for (int j = 0; j < run.length; ++j) { fxb[j] -= cx[j]; fyb[j] -= cy[j]; fzb[j] -= cz[j]; }
         }
         return 0;
     });
+    for (Eigen::Index i = 0; i < n; ++i) {
+        out(i, 0) += fx_[i];
+        out(i, 1) += fy_[i];
+        out(i, 2) += fz_[i];
+    }
 }
 
 void SpringMesh::applyPlasticity(const Points& d, double dt) {

@@ -64,6 +64,17 @@ private:
     double kUniform_ = 1.0;
     // Per-spring state of the last force evaluation, reused by the implicit solver.
     std::vector<double> dirx_, diry_, dirz_, axial_, lateral_;
+    /// Springs are stored family by family (v, u, diagonal, anti-diagonal), row by row, so each
+    /// family's springs in a mesh row are a contiguous run with a constant index offset.
+    struct Run {
+        int first;   ///< index of the first spring of the run
+        int a0;      ///< mesh index of its first point a (b = a + offset)
+        int offset;
+        int length;
+    };
+    std::vector<Run> runs_;
+    // Structure-of-arrays scratch for the vectorised local step.
+    mutable Eigen::VectorXd x_, y_, z_, fx_, fy_, fz_, cx_, cy_, cz_;
 };
 
 }  // namespace hs

@@ -184,11 +184,13 @@ TEST(HapticRuntime, LoopsDoNotAllocateOnceRunning) {
     rt.start();
     std::this_thread::sleep_for(std::chrono::milliseconds(300));  // grab and first factorisation
     const long before = allocationCount();
+    const std::uint64_t stepsBefore = rt.status().simSteps;
     std::this_thread::sleep_for(std::chrono::milliseconds(700));
     const long after = allocationCount();
+    const std::uint64_t steps = rt.status().simSteps - stepsBefore;
     rt.stop();
     EXPECT_EQ(after - before, 0);
-    EXPECT_GT(rt.status().simSteps, kSanitized ? 100u : 1000u);
+    EXPECT_GT(steps, kSanitized ? 5u : 500u);  // the window really covered stepping (sanitizers are slow)
 }
 
 TEST(HapticRuntime, RefusesBadSettings) {
