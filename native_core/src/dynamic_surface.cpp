@@ -9,7 +9,7 @@ DynamicSurface::DynamicSurface(BSplineSurface surface, int g, int h)
     : surface_(std::move(surface)), A_(surface_, g, h), mass_(1.0, "mass"), damping_(1.0, "damping"),
       stiffness_(100.0, "stiffness") {
     const Eigen::Index S = static_cast<Eigen::Index>(g) * h, N = surface_.poles().rows();
-    for (Points* m : {&d_, &dd_, &fext_, &ftool_, &force_, &meshTmp_, &meshTmp2_, &base_, &dPrev_}) m->setZero(S, 3);
+    for (Points* m : {&d_, &dd_, &fext_, &ftool_, &force_, &meshTmp_, &meshTmp2_, &base_, &dPrev_, &av_, &dOld_}) m->setZero(S, 3);
     for (Points* m : {&v_, &fp_, &p0_, &v0_, &a0_, &pStep_, &vStep_, &acc_, &cgR_, &cgZ_, &cgP_, &cgQ_, &x_}) m->setZero(N, 3);
     m_.setZero(S);
     gamma_.setZero(S);
@@ -52,6 +52,7 @@ void DynamicSurface::setPoles(const Points& poles) {
     if (!poles.allFinite()) throw std::invalid_argument("poles: contain NaN or Inf");
     surface_.mutablePoles() = poles;
     v_.setZero();
+    avValid_ = false;
     A_.apply(surface_.poles(), d_);
     touch();
 }
@@ -60,6 +61,7 @@ void DynamicSurface::setVelocities(const Points& v) {
     if (v.rows() != v_.rows()) throw std::invalid_argument("velocities: wrong number of rows");
     if (!v.allFinite()) throw std::invalid_argument("velocities: contain NaN or Inf");
     v_ = v;
+    avValid_ = false;
     touch();
 }
 
@@ -216,6 +218,7 @@ StepReport DynamicSurface::step(double dt) {
     vStep_ = v_;
     const bool tracksWork = hasExternal_ || tool_->grabbed();
     if (tracksWork) dPrev_ = d_;
+    if (solver.kind != IntegratorKind::LocalGlobal) avValid_ = false;
     switch (solver.kind) {
         case IntegratorKind::Explicit: r = stepExplicit(dt); break;
         case IntegratorKind::ImplicitCG: r = stepImplicitCG(dt); break;
@@ -224,6 +227,7 @@ StepReport DynamicSurface::step(double dt) {
     if (!surface_.poles().allFinite() || !v_.allFinite()) {
         surface_.mutablePoles() = pStep_;
         v_ = vStep_;
+        avValid_ = false;
         A_.apply(surface_.poles(), d_);
         accelerationValid_ = false;
         r.refused = true;
@@ -255,6 +259,7 @@ void DynamicSurface::checkSleep(double dt) {
     if (fp_.cwiseAbs().maxCoeff() < sleep.tolerance * stiffness_.mean() * size_) {
         asleep_ = true;
         v_.setZero();
+        avValid_ = false;
     } else {
         quietSteps_ = 0;
     }

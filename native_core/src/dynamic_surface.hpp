@@ -153,6 +153,7 @@ private:
     SamplingOperator A_;
     Points d_, dd_, v_, fext_, ftool_, force_, meshTmp_, meshTmp2_, base_;
     Points fp_, p0_, v0_, a0_, pStep_, vStep_, acc_, cgR_, cgZ_, cgP_, cgQ_, x_, dPrev_;
+    Points av_, dOld_;  // local/global: A v kept from the last step (saves one A product a step)
     Eigen::VectorXd m_, gamma_, cgInvDiag_;
     MaterialMap mass_, damping_, stiffness_;
     SpringMesh springs_;
@@ -169,6 +170,7 @@ private:
     double time_ = 0, work_ = 0;
     bool hasExternal_ = false, toolForces_ = false, asleep_ = false, accelerationValid_ = false;
     bool systemFactored_ = false;
+    bool avValid_ = false;  ///< av_ == A v_ (set by a local/global step, cleared by anything else touching v)
     int quietSteps_ = 0;
     std::uint64_t steps_ = 0;
 };
