@@ -167,18 +167,19 @@ void ConstraintSet::terms(const Points& d, std::vector<ConstraintTerm>& out) con
                 break;
             }
             case ConstraintKind::Normal: {
-                // Paper 4.4, alternate method: desired tangents from the actual ones and the desired
-                // normal, mirrored to four desired points at the actual distances; pairing each
-                // neighbour with the centre puts the negated sum on the centre (zero net force).
-                const Vec3 ua = d.row(p + h_) - d.row(p - h_), va = d.row(p + 1) - d.row(p - 1);
-                Vec3 vd = c.target.cross(ua), ud = va.cross(c.target);
-                if (!(vd.norm() > 0) || !(ud.norm() > 0)) break;
-                vd.normalize();
-                ud.normalize();
+                // Paper 4.4, alternate method, as a projection: each neighbour edge e_k = x_k - x_p is
+                // moved to the nearest edge of the same length in the plane normal to the target,
+                // |e_k| (e_k - (e_k . n) n) / |e_k - (e_k . n) n|. Pairing each neighbour with the
+                // centre keeps the net force zero; rotation about n stays free. Being a true nearest-
+                // point projection keeps the local/global iteration stable at any penalty stiffness.
                 const int nb[4] = {p + h_, p - h_, p + 1, p - 1};
-                const Vec3 dir[4] = {ud, -ud, vd, -vd};
-                for (int k = 0; k < 4; ++k)
-                    out.push_back({nb[k], p, c.stiffness, dir[k] * (d.row(nb[k]) - x.transpose()).norm()});
+                for (int k = 0; k < 4; ++k) {
+                    const Vec3 e = Vec3(d.row(nb[k])) - x;
+                    const Vec3 inPlane = e - e.dot(c.target) * c.target;
+                    const double len = inPlane.norm();
+                    if (!(len > 1e-12 * e.norm())) continue;
+                    out.push_back({nb[k], p, c.stiffness, inPlane * (e.norm() / len)});
+                }
                 break;
             }
             case ConstraintKind::Curvature: {
