@@ -41,7 +41,7 @@ def test_fixtures_drive_a_session(fixture):
                              paced=True)
     status = run_runtime(core.patch((8, 8), (3, 3), (20, 20)), dev, 0.4)
     assert status["error"] == ""
-    assert status["haptic_ticks"] > 200
+    assert status["haptic_ticks"] > 20  # nothing grabbed on a resting surface: the idle polling rate
     state = dev.state
     assert state["reports"] > 0 and state["malformed"] == 0
 
@@ -96,3 +96,21 @@ def test_external_device_rejects_non_finite_input():
 
 def test_list_devices_works_without_hardware():
     assert isinstance(devices.list_devices(), list)  # this machine has no HID devices attached
+
+
+def test_idle_polling_and_full_rate_on_grab():
+    """At rest with nothing grabbed the device is polled at idle_rate; a grab restores full rate."""
+    mouse = _core.ExternalDevice()
+    mouse.push([0.0, 0.0, 30.0])
+    rt = _core.HapticRuntime(core.patch((8, 8), (3, 3), (20, 20)), mouse, idle_rate=100.0)
+    rt.start()
+    time.sleep(0.6)
+    idle_ticks = rt.status()["haptic_ticks"]
+    mouse.push([0.0, 0.0, 0.0], buttons=1)
+    time.sleep(0.05)
+    t0 = rt.status()["haptic_ticks"]
+    time.sleep(0.5)
+    grabbed_ticks = rt.status()["haptic_ticks"] - t0
+    rt.stop()
+    assert idle_ticks < 200          # ~100 Hz (plus the first moments before the surface slept)
+    assert grabbed_ticks > 400       # ~1 kHz while grabbing

@@ -242,7 +242,8 @@ void bindRuntime(py::module_& m) {
         "The simulation and haptic threads of one session over a surface and a device.")
         .def(py::init([](std::shared_ptr<DynamicSurface> surface, std::shared_ptr<Device> device, double hapticRate,
                          double simDt, double graphicsRate, double maxForce, double maxStiffness, double staleLimit,
-                         double fadeTime, double maxLag, double logSeconds, bool stopWhenFinished, bool realtime) {
+                         double fadeTime, double maxLag, double logSeconds, bool stopWhenFinished, bool realtime,
+                         double idleRate) {
                  RuntimeSettings s;
                  s.hapticRate = hapticRate;
                  s.simDt = simDt;
@@ -255,11 +256,13 @@ void bindRuntime(py::module_& m) {
                  s.logSeconds = logSeconds;
                  s.stopWhenFinished = stopWhenFinished;
                  s.realtime = realtime;
+                 s.idleRate = idleRate;
                  return std::make_shared<HapticRuntime>(std::move(surface), std::move(device), s);
              }), py::arg("surface"), py::arg("device"), py::arg("haptic_rate") = 1000.0, py::arg("sim_dt") = 5e-4,
              py::arg("graphics_rate") = 60.0, py::arg("max_force") = 0.0, py::arg("max_stiffness") = 0.0,
              py::arg("stale_limit") = 0.02, py::arg("fade_time") = 0.05, py::arg("max_lag") = 0.005,
-             py::arg("log_seconds") = 0.0, py::arg("stop_when_finished") = false, py::arg("realtime") = false)
+             py::arg("log_seconds") = 0.0, py::arg("stop_when_finished") = false, py::arg("realtime") = false,
+             py::arg("idle_rate") = 100.0)
         .def("start", &HapticRuntime::start)
         .def("stop", &HapticRuntime::stop, py::call_guard<py::gil_scoped_release>(),
              "Zero the force, join both threads (GIL released while waiting).")

@@ -39,7 +39,7 @@ HapticRuntime::HapticRuntime(std::shared_ptr<DynamicSurface> surface, std::share
     positive(settings_.staleLimit, "stale_limit");
     positive(settings_.fadeTime, "fade_time");
     positive(settings_.maxLag, "max_lag");
-    for (double v : {settings_.graphicsRate, settings_.maxForce, settings_.maxStiffness, settings_.logSeconds})
+    for (double v : {settings_.graphicsRate, settings_.maxForce, settings_.maxStiffness, settings_.logSeconds, settings_.idleRate})
         if (!(v >= 0) || !std::isfinite(v)) throw std::invalid_argument("settings: rates, limits and log length must be finite and >= 0");
     for (int i = 0; i <= kBins; ++i) periodBins_[i].store(0, std::memory_order_relaxed);
     caps_ = device_->caps();
@@ -100,23 +100,29 @@ void HapticRuntime::hapticLoop() {
         realtimeOk_.store(pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0, std::memory_order_relaxed);
     }
     const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / settings_.hapticRate));
+    const auto idlePeriod = settings_.idleRate > 0
+        ? std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / settings_.idleRate)) : period;
     auto next = t0_;
     auto last = t0_;
     bool first = true;
     DeviceSample sample;
-    const HapticEstimate idle;  // before the first snapshot: no force
+    const HapticEstimate none;  // before the first snapshot: no force
     try {
+        bool idle = false, wasIdle = false;
         while (!stopRequested_.load(std::memory_order_acquire)) {
-            next += period;
+            // Idle (surface at rest, nothing grabbed): poll the device at idleRate only; a grab is
+            // seen within 1/idleRate and the next tick is back at full rate.
+            next += idle ? idlePeriod : period;
             std::this_thread::sleep_until(next);
             const auto tick = Clock::now();
-            if (!first) {
+            if (!first && !idle && !wasIdle) {
                 const double p = std::chrono::duration<double>(tick - last).count();
                 const int bin = std::min(kBins, static_cast<int>(p / kBinWidth));
                 periodBins_[bin].fetch_add(1, std::memory_order_relaxed);
                 atomicMax(periodMax_, p);
             }
             first = false;
+            wasIdle = idle;
             last = tick;
             if (tick - next > 20 * period) next = tick;  // after a long stall, do not burst to catch up
             const double t = std::chrono::duration<double>(tick - t0_).count();
@@ -125,8 +131,9 @@ void HapticRuntime::hapticLoop() {
                 break;
             }
             if (finiteSample(sample)) cursor_.write(sample);
+            idle = settings_.idleRate > 0 && simIdle_.load(std::memory_order_relaxed) && !(sample.buttons & 1u);
             estimate_.update();
-            const HapticEstimate& e = estimate_.front().sequence ? estimate_.front() : idle;
+            const HapticEstimate& e = estimate_.front().sequence ? estimate_.front() : none;
             const Vec3 estimated = finiteSample(sample) ? estimateForce(e, sample.position, sample.orientation, t) : Vec3::Zero();
             const Vec3 rendered = e.sequence ? limitForce(e, estimated, t, limits_) : Vec3::Zero();
             device_->setForce(rendered);
@@ -169,7 +176,17 @@ void HapticRuntime::simLoop() {
                 droppedSimTime_.store(droppedSimTime_.load(std::memory_order_relaxed) + drop, std::memory_order_relaxed);
                 simTime += drop;
             }
-            if (cursor_.update()) {
+            const bool fresh = cursor_.update();
+            if (surface_->asleep() && !surface_->tool().grabbed() && !(fresh && (cursor_.front().buttons & 1u))) {
+                // At rest and nobody grabbing: nothing can move, so idle (the haptic loop keeps
+                // reading the device) and look again in 5 ms; simulated time follows the clock.
+                simIdle_.store(true, std::memory_order_relaxed);
+                std::this_thread::sleep_for(std::chrono::milliseconds(5));
+                simTime = std::max(simTime, now() - dt);
+                continue;
+            }
+            simIdle_.store(false, std::memory_order_relaxed);
+            if (fresh) {
                 const DeviceSample& s = cursor_.front();
                 Cursor c;
                 c.position = s.position;

@@ -30,6 +30,7 @@ struct RuntimeSettings {
     double logSeconds = 0;      ///< > 0: keep every haptic tick and simulation snapshot for analysis
     bool stopWhenFinished = false;  ///< stop when a finite (replay) device has played out
     bool realtime = false;      ///< try SCHED_FIFO for the haptic thread (needs privileges)
+    double idleRate = 100;      ///< Hz: device polling while the surface rests and nothing is grabbed (0: never idle)
 };
 
 struct RuntimeStatus {
@@ -118,7 +119,7 @@ private:
     std::atomic<std::uint64_t> hapticTicks_{0}, simSteps_{0}, refused_{0}, strokeCount_{0};
     std::atomic<double> force_[3] = {0.0, 0.0, 0.0};
     std::atomic<double> stoppedAt_{0};
-    std::atomic<bool> realtimeOk_{false}, failed_{false};
+    std::atomic<bool> realtimeOk_{false}, failed_{false}, simIdle_{false};
     std::array<char, 256> error_{};
 
     std::vector<HapticTick> ticks_;
