@@ -92,6 +92,7 @@ uninstall:
 bench: build
 	$(PY) bench/table1.py
 	$(PY) bench/loops.py
+	$(PY) bench/skip.py
 
 clean:
 	rm -rf $(BUILD) HapticSculpt/_core*.so
