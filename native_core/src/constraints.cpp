@@ -231,11 +231,11 @@ double ConstraintSet::addForces(const Points& d, Points& f, std::vector<Constrai
     return energy;
 }
 
-void ConstraintSet::addProjections(const Points& d, Points& out, std::vector<ConstraintTerm>& scratch) const {
+void ConstraintSet::addProjections(const Points& d, Points& out, std::vector<ConstraintTerm>& scratch, double scale) const {
     terms(d, scratch);
     for (const auto& t : scratch) {
-        out.row(t.a) += t.k * t.t.transpose();
-        if (t.b >= 0) out.row(t.b) -= t.k * t.t.transpose();
+        out.row(t.a) += (scale * t.k) * t.t.transpose();
+        if (t.b >= 0) out.row(t.b) -= (scale * t.k) * t.t.transpose();
     }
 }
 

@@ -60,8 +60,8 @@ public:
     void terms(const Points& d, std::vector<ConstraintTerm>& out) const;
     /// Adds penalty forces to f; returns the penalty energy.
     double addForces(const Points& d, Points& f, std::vector<ConstraintTerm>& scratch) const;
-    /// out += J t for the local/global solver.
-    void addProjections(const Points& d, Points& out, std::vector<ConstraintTerm>& scratch) const;
+    /// out += scale J t for the local/global solver.
+    void addProjections(const Points& d, Points& out, std::vector<ConstraintTerm>& scratch, double scale = 1.0) const;
     void addLaplacian(std::vector<Eigen::Triplet<double>>& t) const;
     /// out += K y with K the penalty springs' stiffness (targets held fixed).
     void addStiffness(const Points& y, Points& out) const;

@@ -35,10 +35,9 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     double change = 0;
     for (int it = 0; it < solver.iterations; ++it) {
         if (it > 0) A_.apply(x_, meshTmp_);
-        force_.setZero();
-        springs_.addProjections(meshTmp_, force_, 0.25 * minMass_ / (dt * dt));
-        if (!constraints_.empty()) constraints_.addProjections(meshTmp_, force_, terms_);
-        meshTmp2_ = base_ + (dt * dt) * force_;
+        meshTmp2_ = base_;  // + dt^2 J t, added in place by the local steps
+        springs_.addProjections(meshTmp_, meshTmp2_, 0.25 * minMass_ / (dt * dt), dt * dt);
+        if (!constraints_.empty()) constraints_.addProjections(meshTmp_, meshTmp2_, terms_, dt * dt);
         A_.applyTransposed(meshTmp2_, fp_);
         systemSolver_.solve(fp_, acc_);
         change = (acc_ - x_).cwiseAbs().maxCoeff();
@@ -48,7 +47,7 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     r.residual = change / size_;
     v_ = (x_ - p) / dt;
     surface_.mutablePoles() = x_;
-    dOld_ = d_;
+    dOld_ = d_;  // a copy, not a swap: numpy views of d_ must keep pointing at the live mesh
     A_.apply(surface_.poles(), d_);
     av_ = (d_ - dOld_) / dt;  // = A v exactly up to rounding, since A is linear
     avValid_ = true;

@@ -142,7 +142,7 @@ void SpringMesh::addTangentStiffness(const Points& y, Points& out) const {
     }
 }
 
-void SpringMesh::addProjections(const Points& d, Points& out, double maxExtraStiffness) const {
+void SpringMesh::addProjections(const Points& d, Points& out, double maxExtraStiffness, double scale) const {
     // Each spring's energy 1/2 k |x_a - x_b - t|^2 is minimised over |t| = target length;
     // a non-linear law changes the target length so that k (l - |t|) = g(k (l - r)).
     // Runs of one family in one row have contiguous endpoints a and a + offset: in structure-of-
@@ -188,9 +188,9 @@ void SpringMesh::addProjections(const Points& d, Points& out, double maxExtraSti
         return 0;
     });
     for (Eigen::Index i = 0; i < n; ++i) {
-        out(i, 0) += fx_[i];
-        out(i, 1) += fy_[i];
-        out(i, 2) += fz_[i];
+        out(i, 0) += scale * fx_[i];
+        out(i, 1) += scale * fy_[i];
+        out(i, 2) += scale * fz_[i];
     }
 }
 

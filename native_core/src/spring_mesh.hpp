@@ -47,10 +47,10 @@ public:
     double addForces(const Points& d, Points& f);
     /// out += K y with K the tangent stiffness at the last addForces() state (clamped to be PSD).
     void addTangentStiffness(const Points& y, Points& out) const;
-    /// Local step of the local/global solver: out += J t with t the projected spring vectors.
+    /// Local step of the local/global solver: out += scale J t with t the projected spring vectors.
     /// maxExtraStiffness caps |g(k e) - k e| / |e|: the part of a non-linear law the prefactored
     /// matrix does not hold is explicit, and stays stable only below about m / dt^2.
-    void addProjections(const Points& d, Points& out, double maxExtraStiffness) const;
+    void addProjections(const Points& d, Points& out, double maxExtraStiffness, double scale = 1.0) const;
     /// Plastic flow over a step of length dt.
     void applyPlasticity(const Points& d, double dt);
     /// Triplets of the weighted graph Laplacian sum_s k_s (e_a - e_b)(e_a - e_b)^T.
