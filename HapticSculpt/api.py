@@ -18,6 +18,7 @@ from . import core, sculpt_state
 from .replay_device import ReplayDevice
 from .sculpt_feature import SculptFeature, face_of, is_sculpt
 from .source_surface import source_surface
+from .undo import transaction
 
 
 def _int_pair(value: Any, name: str, minimum: int) -> tuple[int, int]:
@@ -95,8 +96,7 @@ def make_sculpt(doc: Any = None, source: Any = None, controls: tuple[int, int] =
     state = sculpt_state.capture(core.DynamicSurface(made.surface, mesh))
     if doc.UndoMode == 0:
         doc.UndoMode = 1
-    doc.openTransaction("Create sculpt")
-    try:
+    with transaction(doc, "Create sculpt"):
         obj = doc.addObject("Part::FeaturePython", name)
         SculptFeature(obj, state, made.method, made.error, made.description)
         import FreeCAD
@@ -105,10 +105,6 @@ def make_sculpt(doc: Any = None, source: Any = None, controls: tuple[int, int] =
             SculptViewProvider(obj.ViewObject)
         obj.Shape = face_of(state)
         obj.purgeTouched()
-    except BaseException:
-        doc.abortTransaction()
-        raise
-    doc.commitTransaction()
     return obj
 
 
@@ -172,17 +168,11 @@ def run(obj: Any, seconds: float, device: ReplayDevice | None = None, tool: str 
 
 
 def _commit(obj: Any, title: str, strokes: int = 0) -> None:
-    doc = obj.Document
-    doc.openTransaction(title)
-    try:
+    with transaction(obj.Document, title):
         obj.Proxy.write_back()
         if strokes:
             obj.Strokes = obj.Strokes + strokes
         obj.purgeTouched()
-    except BaseException:
-        doc.abortTransaction()
-        raise
-    doc.commitTransaction()
 
 
 def add_constraint(obj: Any, kind: str, uv: tuple[float, float] | None = None,

@@ -7,6 +7,7 @@ from typing import Any
 import FreeCAD
 import FreeCADGui as Gui
 
+from .undo import transaction
 from .view_provider import icon
 
 TOOLBAR = ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Thicken", "HapticSculpt_ExportStep"]
@@ -68,10 +69,8 @@ class Thicken:
         import Part
         from .api import thicken
         for obj in _selected_sculpts():
-            doc = obj.Document
-            doc.openTransaction("Thicken")
-            Part.show(thicken(obj, 2.0), obj.Name + "_Solid")
-            doc.commitTransaction()
+            with transaction(obj.Document, "Thicken"):
+                Part.show(thicken(obj, 2.0), obj.Name + "_Solid")
 
 
 class ExportStep:

@@ -1,7 +1,8 @@
 """A device that plays back a recorded or scripted cursor trajectory.
 
 Positions are interpolated linearly between samples, orientations by normalised linear
-interpolation of the quaternions (sign-aligned), buttons are held from the last sample. The text
+interpolation of the quaternions (sign-aligned), buttons are held from the last sample; the
+interpolation is the core's (native_core/src/replay_device.cpp), shared with the threaded loops. The text
 format (one sample per line: ``t x y z qw qx qy qz buttons``, floats written with 17 significant
 digits) round-trips bit for bit, so any session recorded into it replays exactly.
 """
@@ -9,7 +10,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -82,6 +83,7 @@ class ReplayDevice:
             if np.any(b < 0):
                 raise ValueError("buttons: bit masks must be >= 0")
         self._t, self._xyz, self._q, self._buttons = times, pos, q, b
+        self._sampler: Any = None  # native sampler, made on first use
 
     @property
     def duration(self) -> float:
@@ -97,24 +99,20 @@ class ReplayDevice:
         """Copies of (t, xyz, quat, buttons)."""
         return self._t.copy(), self._xyz.copy(), self._q.copy(), self._buttons.copy()
 
+    @property
+    def native(self) -> Any:
+        """A fresh C++ replay of this trajectory (what sessions run; one per session, since it keeps a
+        position hint)."""
+        from . import _core
+        return _core.NativeReplayDevice(self._t.tolist(), self._xyz, self._q, self._buttons.astype(np.uint32).tolist())
+
     def sample(self, time: float) -> CursorSample:
-        """The cursor at ``time`` (clamped to the trajectory's ends)."""
-        t = self._t
-        if time <= t[0] or t.size == 1:
-            k, a = 0, 0.0
-        elif time >= t[-1]:
-            k, a = t.size - 1, 0.0
-        else:
-            k = int(np.searchsorted(t, time, side="right")) - 1
-            a = (time - t[k]) / (t[k + 1] - t[k])
-        if a == 0.0:
-            p, q = self._xyz[k], self._q[k]
-        else:
-            p = self._xyz[k] + a * (self._xyz[k + 1] - self._xyz[k])
-            q1 = self._q[k + 1] if np.dot(self._q[k], self._q[k + 1]) >= 0 else -self._q[k + 1]
-            q = self._q[k] + a * (q1 - self._q[k])
-            q = q / np.linalg.norm(q)
-        return CursorSample(tuple(map(float, p)), tuple(map(float, q)), int(self._buttons[k]))
+        """The cursor at ``time`` (clamped to the trajectory's ends), by the same C++ code the
+        threaded loops run."""
+        if self._sampler is None:
+            self._sampler = self.native
+        s = self._sampler.sample(float(time))
+        return CursorSample(tuple(map(float, s["position"])), tuple(s["orientation"]), int(s["buttons"]))
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write the trajectory in the text format (exact round trip)."""

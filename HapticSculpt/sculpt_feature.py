@@ -139,14 +139,14 @@ class SculptFeature:
         finally:
             self._writing = False
 
-    def show_poles(self, poles: np.ndarray) -> None:
-        """Redraws the Shape from intermediate poles (GUI frame; not stored, not an undo step)."""
+    def show_poles(self, poles: np.ndarray, base: sculpt_state.SculptState) -> None:
+        """Redraws the Shape from intermediate poles on the knots and weights of ``base`` (a GUI
+        frame during a session, which reads the properties once; not stored, not an undo step)."""
         obj = self._object()
-        state = read_state(obj)
-        state.arrays["Poles"] = np.asarray(poles, dtype=float).ravel()
+        frame = sculpt_state.SculptState({**base.arrays, "Poles": np.asarray(poles, dtype=float).ravel()}, base.settings)
         self._writing = True
         try:
-            obj.Shape = face_of(state)
+            obj.Shape = face_of(frame)
         finally:
             self._writing = False
 

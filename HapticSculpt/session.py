@@ -14,9 +14,10 @@ from typing import Any
 
 import numpy as np
 
-from . import _core, core
+from . import _core, core, sculpt_state
 from .replay_device import ReplayDevice
-from .sculpt_feature import is_sculpt
+from .sculpt_feature import is_sculpt, read_state
+from .undo import transaction
 
 #: Sessions that may still run, so a document close or a workbench change can stop them all.
 _ACTIVE: "weakref.WeakSet[Session]" = weakref.WeakSet()
@@ -26,9 +27,6 @@ def native_device(device: Any) -> Any:
     """The C++ device for a Python-side device description."""
     if isinstance(device, _core.Device):
         return device
-    if isinstance(device, ReplayDevice):
-        t, xyz, q, buttons = device.arrays()
-        return _core.NativeReplayDevice(t.tolist(), xyz, q, buttons.astype(np.uint32).tolist())
     native = getattr(device, "native", None)
     if isinstance(native, _core.Device):
         return native
@@ -43,8 +41,8 @@ class Session:
         self._obj: Any = None
         self._device: Any = None
         self._error = ""
-        self._committed_strokes = 0
         self._timer: Any = None
+        self._frame_base: Any = None  # knots, weights, degrees for GUI frames (they do not change)
 
     # --- life cycle -------------------------------------------------------------------------------
     def start(self, obj: Any, device: Any, tool: str = "rope", haptic_rate: float = 1000.0,
@@ -75,6 +73,7 @@ class Session:
         _ACTIVE.add(self)
         _Observer.ensure()
         if _gui_up():
+            self._frame_base = read_state(obj)
             self._start_timer()
         return self
 
@@ -167,38 +166,22 @@ class Session:
     def _commit_strokes(self, runtime: Any, obj: Any) -> int:
         n = 0
         while (stroke := runtime.take_stroke()) is not None:
-            doc = obj.Document
-            doc.openTransaction("Sculpt stroke")
-            try:
+            with transaction(obj.Document, "Sculpt stroke"):
                 obj.Proxy.write_arrays(stroke["poles"], stroke["velocities"], stroke["rest_lengths"])
                 obj.Strokes = obj.Strokes + 1
                 obj.purgeTouched()
-            except BaseException:
-                doc.abortTransaction()
-                raise
-            doc.commitTransaction()
             n += 1
-        self._committed_strokes += n
         return n
 
     def _commit_final(self, obj: Any) -> None:
         """The state after the last stroke (the surface kept moving) as its own transaction."""
-        from .sculpt_feature import read_state
-        from . import sculpt_state
         current = sculpt_state.capture(obj.Proxy.surface)
         stored = read_state(obj)
         if all(np.array_equal(current.arrays[k], stored.arrays[k]) for k in current.arrays) and \
                 current.settings_json() == obj.SculptSettings:
             return
-        doc = obj.Document
-        doc.openTransaction("Sculpt session end")
-        try:
-            obj.Proxy.write_back()
-            obj.purgeTouched()
-        except BaseException:
-            doc.abortTransaction()
-            raise
-        doc.commitTransaction()
+        from .api import _commit
+        _commit(obj, "Sculpt session end")
 
     # --- GUI: shape at graphics rate, strokes as they end ----------------------------------------
     def _start_timer(self) -> None:
@@ -218,7 +201,7 @@ class Session:
             return
         poles = runtime.take_poles()
         if poles is not None and _alive(obj):
-            obj.Proxy.show_poles(poles)
+            obj.Proxy.show_poles(poles, self._frame_base)
         self.poll()
 
 

@@ -58,33 +58,25 @@ def _exact_bspline(geom: Any) -> Any | None:
     import Part
     if isinstance(geom, Part.BSplineSurface):
         bs = geom.copy()
+        u0, u1, v0, v1 = bs.bounds()
     else:
         face = geom
-        if isinstance(face.Surface, Part.BSplineSurface):
-            bs = face.Surface.copy()
-            u0, u1, v0, v1 = face.ParameterRange
-        else:
+        if not isinstance(face.Surface, Part.BSplineSurface):
             try:
                 face = face.toNurbs().Faces[0]
             except Exception:  # no exact B-spline form
                 return None
             if not isinstance(face.Surface, Part.BSplineSurface):
                 return None
-            bs = face.Surface.copy()
-            u0, u1, v0, v1 = face.ParameterRange
-        if bs.isUPeriodic():
-            bs.setUNotPeriodic()
-        if bs.isVPeriodic():
-            bs.setVNotPeriodic()
-        b = bs.bounds()
-        # segment() both trims to the face's range and clamps the ends (an unperiodised surface is not)
-        bs.segment(max(u0, b[0]), min(u1, b[1]), max(v0, b[2]), min(v1, b[3]))
-    if bs.isUPeriodic() or bs.isVPeriodic():
-        if bs.isUPeriodic():
-            bs.setUNotPeriodic()
-        if bs.isVPeriodic():
-            bs.setVNotPeriodic()
-        bs.segment(*bs.bounds())
+        bs = face.Surface.copy()
+        u0, u1, v0, v1 = face.ParameterRange
+    if bs.isUPeriodic():
+        bs.setUNotPeriodic()
+    if bs.isVPeriodic():
+        bs.setVNotPeriodic()
+    b = bs.bounds()
+    # segment() both trims to the face's range and clamps the ends (an unperiodised surface is not)
+    bs.segment(max(u0, b[0]), min(u1, b[1]), max(v0, b[2]), min(v1, b[3]))
     return bs
 
 

@@ -44,9 +44,7 @@ def cpu_seconds() -> float:
 def run_scene(controls, mesh, sim_dt, seconds, rate):
     surface = core.patch(controls, (3, 3), mesh, (100.0, 100.0))
     surface.damping_map.set_uniform(5.0)
-    dev = trajectory(seconds)
-    t, xyz, q, b = dev.arrays()
-    native = _core.NativeReplayDevice(t.tolist(), xyz, q, b.astype(np.uint32).tolist())
+    native = trajectory(seconds).native
     runtime = _core.HapticRuntime(surface, native, haptic_rate=rate, sim_dt=sim_dt, log_seconds=seconds + 1,
                                   stop_when_finished=True)
     cpu0, wall0 = cpu_seconds(), time.perf_counter()

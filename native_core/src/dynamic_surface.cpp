@@ -9,7 +9,7 @@ DynamicSurface::DynamicSurface(BSplineSurface surface, int g, int h)
     : surface_(std::move(surface)), A_(surface_, g, h), mass_(1.0, "mass"), damping_(1.0, "damping"),
       stiffness_(100.0, "stiffness") {
     const Eigen::Index S = static_cast<Eigen::Index>(g) * h, N = surface_.poles().rows();
-    for (Points* m : {&d_, &dd_, &fext_, &ftool_, &force_, &meshTmp_, &meshTmp2_, &base_, &dPrev_, &av_, &dOld_}) m->setZero(S, 3);
+    for (Points* m : {&d_, &dd_, &fext_, &ftool_, &force_, &meshTmp_, &meshTmp2_, &base_, &dPrev_, &av_}) m->setZero(S, 3);
     for (Points* m : {&v_, &fp_, &p0_, &v0_, &a0_, &pStep_, &vStep_, &acc_, &cgR_, &cgZ_, &cgP_, &cgQ_, &x_}) m->setZero(N, 3);
     m_.setZero(S);
     gamma_.setZero(S);
@@ -217,7 +217,8 @@ StepReport DynamicSurface::step(double dt) {
     pStep_ = surface_.poles();
     vStep_ = v_;
     const bool tracksWork = hasExternal_ || tool_->grabbed();
-    if (tracksWork) dPrev_ = d_;
+    // The mesh before the step: for the work of the applied forces, and for local/global's A v.
+    if (tracksWork || solver.kind == IntegratorKind::LocalGlobal) dPrev_ = d_;
     if (solver.kind != IntegratorKind::LocalGlobal) avValid_ = false;
     switch (solver.kind) {
         case IntegratorKind::Explicit: r = stepExplicit(dt); break;

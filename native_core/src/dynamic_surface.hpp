@@ -152,8 +152,9 @@ private:
     BSplineSurface surface_;
     SamplingOperator A_;
     Points d_, dd_, v_, fext_, ftool_, force_, meshTmp_, meshTmp2_, base_;
-    Points fp_, p0_, v0_, a0_, pStep_, vStep_, acc_, cgR_, cgZ_, cgP_, cgQ_, x_, dPrev_;
-    Points av_, dOld_;  // local/global: A v kept from the last step (saves one A product a step)
+    Points fp_, p0_, v0_, a0_, pStep_, vStep_, acc_, cgR_, cgZ_, cgP_, cgQ_, x_;
+    Points dPrev_;  // the mesh before the current step (set by step())
+    Points av_;  // local/global: A v kept from the last step (saves one A product a step)
     Eigen::VectorXd m_, gamma_, cgInvDiag_;
     MaterialMap mass_, damping_, stiffness_;
     SpringMesh springs_;

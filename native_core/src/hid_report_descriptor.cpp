@@ -34,6 +34,21 @@ const HidField* HidReportLayout::find(ReportType type, std::uint32_t u, std::uin
     return nullptr;
 }
 
+FieldSlot locateField(const HidReportLayout& l, ReportType type, std::uint8_t id, std::uint32_t u,
+                      std::uint32_t collection) {
+    for (const auto& f : l.fields) {
+        if (f.type != type || f.reportId != id || (collection && !f.inCollection(collection))) continue;
+        if (f.variable) {
+            for (std::uint32_t k = 0; k < f.count; ++k)
+                if (f.usage(k) == u) return {&f, f.bitOffset + k * f.size, false, 0};
+        } else {
+            const auto it = std::find(f.usages.begin(), f.usages.end(), u);
+            if (it != f.usages.end()) return {&f, f.bitOffset, true, f.logicalMin + static_cast<std::int64_t>(it - f.usages.begin())};
+        }
+    }
+    return {};
+}
+
 namespace {
 struct Globals {
     std::uint16_t usagePage = 0;

@@ -36,6 +36,17 @@ struct HidReportLayout {
     const HidField* find(ReportType type, std::uint32_t fullUsage, std::uint32_t collection = 0) const;
 };
 
+/// Where usage `u` lives in report (type, id): a variable field's own bits, or an array field whose
+/// value `choice` selects it. field == nullptr when the report has no such usage.
+struct FieldSlot {
+    const HidField* field = nullptr;
+    std::uint32_t bit = 0;     ///< bit offset after the ID byte
+    bool array = false;
+    std::int64_t choice = 0;   ///< array fields: the value that selects the usage
+};
+FieldSlot locateField(const HidReportLayout& layout, ReportType type, std::uint8_t id, std::uint32_t u,
+                      std::uint32_t collection = 0);
+
 /// Parses a descriptor; throws std::invalid_argument on malformed input (truncated items,
 /// unbalanced collections, absurd sizes).
 HidReportLayout parseReportDescriptor(const std::vector<std::uint8_t>& descriptor);

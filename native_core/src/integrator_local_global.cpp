@@ -47,9 +47,8 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     r.residual = change / size_;
     v_ = (x_ - p) / dt;
     surface_.mutablePoles() = x_;
-    dOld_ = d_;  // a copy, not a swap: numpy views of d_ must keep pointing at the live mesh
     A_.apply(surface_.poles(), d_);
-    av_ = (d_ - dOld_) / dt;  // = A v exactly up to rounding, since A is linear
+    av_ = (d_ - dPrev_) / dt;  // = A v up to rounding, since A is linear (dPrev_: step()'s copy of the old mesh)
     avValid_ = true;
     accelerationValid_ = false;
     return r;

@@ -53,26 +53,14 @@ std::vector<std::uint8_t> emulatorDescriptor() {
     };
 }
 
+// The value of usage u in a received report: a variable field's value, or 1/0 for whether an
+// array field selects it.
 std::int64_t field(const HidReportLayout& l, ReportType type, std::uint8_t id, std::uint32_t u, const std::uint8_t* r,
-                   std::size_t n, std::uint32_t collection, bool* found = nullptr) {
-    for (const auto& f : l.fields) {
-        if (f.type != type || f.reportId != id || (collection && !f.inCollection(collection))) continue;
-        if (f.variable) {
-            for (std::uint32_t k = 0; k < f.count; ++k)
-                if (f.usage(k) == u) {
-                    if (found) *found = true;
-                    return readField(r + 1, n - 1, f.bitOffset + k * f.size, f.size, f.logicalMin < 0);
-                }
-        } else {
-            for (std::size_t k = 0; k < f.usages.size(); ++k)
-                if (f.usages[k] == u) {
-                    if (found) *found = true;
-                    return readField(r + 1, n - 1, f.bitOffset, f.size, false) == f.logicalMin + static_cast<std::int64_t>(k);
-                }
-        }
-    }
-    if (found) *found = false;
-    return 0;
+                   std::size_t n, std::uint32_t collection) {
+    const FieldSlot slot = locateField(l, type, id, u, collection);
+    if (!slot.field) return 0;
+    const std::int64_t v = readField(r + 1, n - 1, slot.bit, slot.field->size, !slot.array && slot.field->logicalMin < 0);
+    return slot.array ? v == slot.choice : v;
 }
 }  // namespace
 

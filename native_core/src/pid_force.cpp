@@ -36,25 +36,11 @@ PidLayout PidLayout::fromDescriptor(const std::vector<std::uint8_t>& descriptor)
 
 bool setPidField(const HidReportLayout& l, ReportType type, std::uint8_t id, std::uint32_t u, std::int64_t value,
                  std::vector<std::uint8_t>& report, std::uint32_t collection) {
+    const FieldSlot slot = locateField(l, type, id, u, collection);
+    if (!slot.field) return false;
     const std::size_t off = l.usesReportIds ? 1 : 0;
-    for (const auto& f : l.fields) {
-        if (f.type != type || f.reportId != id || (collection && !f.inCollection(collection))) continue;
-        if (f.variable) {
-            for (std::uint32_t k = 0; k < f.count; ++k)
-                if (f.usage(k) == u) {
-                    writeField(report.data() + off, report.size() - off, f.bitOffset + k * f.size, f.size, value);
-                    return true;
-                }
-        } else {  // array: the value selects one of the listed usages
-            const auto it = std::find(f.usages.begin(), f.usages.end(), u);
-            if (it != f.usages.end()) {
-                writeField(report.data() + off, report.size() - off, f.bitOffset, f.size,
-                           f.logicalMin + static_cast<std::int64_t>(it - f.usages.begin()));
-                return true;
-            }
-        }
-    }
-    return false;
+    writeField(report.data() + off, report.size() - off, slot.bit, slot.field->size, slot.array ? slot.choice : value);
+    return true;
 }
 
 PidForceDriver::PidForceDriver(std::shared_ptr<HidTransport> transport, PidSettings settings)
@@ -95,9 +81,9 @@ void PidForceDriver::start() {
         setPidField(l, ReportType::Feature, layout_.createId, pid::EtConstant, 1, create);
         if (transport_->sendFeature(create.data(), create.size()) < 0) throw std::runtime_error("HID PID: Create New Effect failed");
         std::vector<std::uint8_t> load(std::max<std::size_t>(l.reportBytes(ReportType::Feature, layout_.blockLoadId), 3), 0);
-        const HidField* idx = l.find(ReportType::Feature, pid::EffectBlockIndex, pid::BlockLoad);
-        const HidField* status = l.find(ReportType::Feature, pid::BlockLoadSuccess, pid::BlockLoad);
-        if (!idx || !status) throw std::invalid_argument("descriptor: Block Load lacks its index or status field");
+        const FieldSlot idx = locateField(l, ReportType::Feature, layout_.blockLoadId, pid::EffectBlockIndex, pid::BlockLoad);
+        const FieldSlot status = locateField(l, ReportType::Feature, layout_.blockLoadId, pid::BlockLoadSuccess, pid::BlockLoad);
+        if (!idx.field || !status.field) throw std::invalid_argument("descriptor: Block Load lacks its index or status field");
         bool loaded = false;
         std::int64_t block = 0;
         for (int attempt = 0; attempt < 60 && !loaded; ++attempt) {  // as hid-pidff: poll until success
@@ -106,10 +92,8 @@ void PidForceDriver::start() {
             const int n = transport_->getFeature(load.data(), load.size());
             if (n < 0) throw std::runtime_error("HID PID: Block Load read failed");
             const std::size_t off = l.usesReportIds ? 1 : 0;
-            const std::int64_t s = readField(load.data() + off, load.size() - off, status->bitOffset, status->size, false);
-            const auto it = std::find(status->usages.begin(), status->usages.end(), pid::BlockLoadSuccess);
-            loaded = s == status->logicalMin + (it - status->usages.begin());
-            block = readField(load.data() + off, load.size() - off, idx->bitOffset, idx->size, false);
+            loaded = readField(load.data() + off, load.size() - off, status.bit, status.field->size, false) == status.choice;
+            block = readField(load.data() + off, load.size() - off, idx.bit, idx.field->size, false);
             if (!loaded) std::this_thread::sleep_for(std::chrono::milliseconds(1));
         }
         if (!loaded || block <= 0) throw std::runtime_error("HID PID: the device did not load the effect (pool full?)");
