@@ -8,7 +8,8 @@ APT_PACKAGES := build-essential cmake ninja-build pkg-config libeigen3-dev pybin
 SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
-.PHONY: all deps build build-asan $(PHONY_TSAN) test test-cpp test-asan test-python test-freecad ocp-venv demo bench install install-udev uninstall clean
+PHONY_LONG := stress
+.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-cpp test-asan test-python test-freecad ocp-venv demo bench install install-udev uninstall clean
 # A private FreeCAD user folder whose Mod/HapticSculpt links this checkout (tests, demo render).
 FC_HOME     := $(BUILD)/freecad-home
 # cadquery (with its own OCCT, OCP) in its own virtual environment: its numpy must not shadow Debian's.
@@ -72,6 +73,11 @@ test-freecad: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
 	  freecadcmd -t TestHapticSculpt
 
 test: test-cpp test-asan test-tsan test-python test-freecad
+
+# The long stability campaign (make test runs seeds 0..9999; this goes on from there). Resumable.
+STRESS_SCENES ?= 100000
+stress: build
+	$(PY) bench/stress_campaign.py --scenes $(STRESS_SCENES)
 
 demo: build
 	$(PY) demo.py --out out

@@ -256,6 +256,7 @@ PYBIND11_MODULE(_core, m) {
         .def_readonly("residual", &StepReport::residual)
         .def_readonly("slept", &StepReport::slept)
         .def_readonly("refused", &StepReport::refused)
+        .def_readonly("energy_limited", &StepReport::energyLimited, "the energy guard scaled velocities or refused the step")
         .def_property_readonly("reason", [](const StepReport& r) { return std::string(r.reason); })
         .def_property_readonly("force", [](const StepReport& r) { return Vec3(r.reaction.force); }, "reaction force on the cursor")
         .def_property_readonly("torque", [](const StepReport& r) { return Vec3(r.reaction.torque); }, "reaction torque on the cursor")
@@ -452,6 +453,14 @@ PYBIND11_MODULE(_core, m) {
                       [](DynamicSurface& s, bool e) { s.sleep.enabled = e; s.wake(); })
         .def_property("sleep_tolerance", [](const DynamicSurface& s) { return s.sleep.tolerance; },
                       [](DynamicSurface& s, double t) { checkParam(t, "sleep_tolerance"); s.sleep.tolerance = t; })
+        .def_property("energy_guard", [](const DynamicSurface& s) { return s.energyGuard.enabled; },
+                      [](DynamicSurface& s, bool e) { s.energyGuard.enabled = e; s.wake(); },
+                      "keep kinetic + potential energy within (1 + energy_slack) x (energy at the last change + work "
+                      "put in); runs for explicit, implicit, non-linear laws and constraints")
+        .def_property("energy_slack", [](const DynamicSurface& s) { return s.energyGuard.slack; },
+                      [](DynamicSurface& s, double x) { checkParam(x, "energy_slack", true); s.energyGuard.slack = x; })
+        .def_property_readonly("energy_ceiling", &DynamicSurface::energyCeiling,
+                               "the energy guard's ceiling (0 when the guard is not running for this scene)")
         .def_property_readonly("asleep", &DynamicSurface::asleep)
         .def("wake", &DynamicSurface::wake)
         .def("step", [](DynamicSurface& s, double dt, int steps) {
@@ -467,6 +476,7 @@ PYBIND11_MODULE(_core, m) {
                     total.residual = r.residual;
                     total.slept = r.slept;
                     total.reaction = r.reaction;
+                    if (r.energyLimited) { total.energyLimited = true; total.reason = r.reason; }
                     if (r.refused) { total.refused = true; total.reason = r.reason; break; }
                 }
             }

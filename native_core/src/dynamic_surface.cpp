@@ -1,5 +1,6 @@
 #include "dynamic_surface.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -55,6 +56,7 @@ void DynamicSurface::setPoles(const Points& poles) {
     avValid_ = false;
     A_.apply(surface_.poles(), d_);
     touch();
+    resetEnergyCeiling();
 }
 
 void DynamicSurface::setVelocities(const Points& v) {
@@ -63,6 +65,7 @@ void DynamicSurface::setVelocities(const Points& v) {
     v_ = v;
     avValid_ = false;
     touch();
+    resetEnergyCeiling();
 }
 
 int DynamicSurface::meshIndexAt(double u, double v) const {
@@ -206,12 +209,18 @@ StepReport DynamicSurface::step(double dt) {
     refreshMaterials();
     const std::uint64_t key[4] = {mass_.version(), damping_.version(), stiffness_.version(), constraints_.version()};
     for (int i = 0; i < 4; ++i)
-        if (key[i] != wakeKey_[i]) { touch(); wakeKey_[i] = key[i]; }
+        if (key[i] != wakeKey_[i]) { touch(); resetEnergyCeiling(); wakeKey_[i] = key[i]; }
     if (tool_->grabbed()) touch();
     StepReport r;
     if (asleep_) {
         r.slept = true;
         return r;
+    }
+    const bool guard = guardsEnergy();
+    if (!guard) ceilingValid_ = false;
+    else if (!ceilingValid_) {
+        ceiling_ = kineticEnergy() + potentialEnergy();
+        ceilingValid_ = true;
     }
     // Backup for a refused step (separate from the explicit integrator's substep buffers).
     pStep_ = surface_.poles();
@@ -235,17 +244,55 @@ StepReport DynamicSurface::step(double dt) {
         r.reason = "the step would produce NaN or Inf; state kept (reduce dt or stiffness)";
         return r;
     }
+    double work = 0;
     if (tracksWork) {
         // Work of the applied forces over the step (forces held over the step), as whole-array
         // products so the loop vectorises.
-        if (hasExternal_) work_ += fext_.cwiseProduct(d_ - dPrev_).sum();
-        if (toolForces_) work_ += ftool_.cwiseProduct(d_ - dPrev_).sum();
+        if (hasExternal_) work += fext_.cwiseProduct(d_ - dPrev_).sum();
+        if (toolForces_) work += ftool_.cwiseProduct(d_ - dPrev_).sum();
     }
+    if (guard && !limitEnergy(work, r)) return r;
+    work_ += work;
     if (springs_.plasticity.enabled) springs_.applyPlasticity(d_, dt);
     time_ += dt;
     ++steps_;
     checkSleep(dt);
     return r;
+}
+
+bool DynamicSurface::guardsEnergy() const {
+    if (!energyGuard.enabled) return false;
+    return solver.kind != IntegratorKind::LocalGlobal || springs_.law.kind != LawKind::Linear || !constraints_.empty();
+}
+
+bool DynamicSurface::limitEnergy(double work, StepReport& r) {
+    // Work done during a step that is refused was never done: the ceiling grows only on acceptance.
+    const double ceiling = ceiling_ + std::max(0.0, work);
+    // Below this floor energy is rounding noise: 1e-12 of a surface-sized stretch at the mean stiffness.
+    const double floor = 1e-12 * stiffness_.mean() * size_ * size_;
+    const double ke = kineticEnergy(), pe = potentialEnergy();
+    if (ke + pe <= (1 + energyGuard.slack) * ceiling + floor) {
+        ceiling_ = ceiling;
+        return true;
+    }
+    r.energyLimited = true;
+    if (pe <= ceiling && ke > 0) {
+        const double s = std::sqrt((ceiling - pe) / ke);
+        v_ *= s;
+        av_ *= s;
+        accelerationValid_ = false;
+        ceiling_ = ceiling;
+        r.reason = "the step would have created energy; velocities scaled back to the energy ceiling (reduce dt or stiffness)";
+        return true;
+    }
+    surface_.mutablePoles() = pStep_;
+    v_.setZero();
+    avValid_ = false;
+    A_.apply(surface_.poles(), d_);
+    accelerationValid_ = false;
+    r.refused = true;
+    r.reason = "the step would have created energy: positions kept, motion stopped (reduce dt or stiffness, or use local_global)";
+    return false;
 }
 
 void DynamicSurface::checkSleep(double dt) {

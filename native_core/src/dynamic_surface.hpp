@@ -28,13 +28,27 @@ struct SolverSettings {
     int iterations = 1;              ///< local/global iterations per step
     int cgIterations = 5;            ///< implicit: CG iterations per step
     /// explicit: halve the step while any control-point acceleration exceeds this;
-    /// 0 = automatic, 0.1 * size / dt^2 (no point may be flung a tenth of the surface in one step)
+    /// 0 = automatic, 0.1 * size / h^2 for a substep h (no point may be flung a tenth of the surface in one substep)
     double accelerationLimit = 0;
     int maxHalvings = 10;            ///< explicit: deepest recursion (at most 2^10 substeps a step)
+    /// explicit: also halve while a substep gains more than this fraction of its energy beyond the work put in
+    double energyTolerance = 0.01;
 };
 
 /// Sleeping: with no tool active, after `steps` consecutive steps whose largest control-point
 /// speed is below tolerance * size per second and whose net force is below tolerance * stiffness * size.
+/// Energy guard: kinetic plus potential energy may not exceed (1 + slack) times the ceiling, which
+/// starts at the energy when the configuration last changed and grows by the positive work of the
+/// applied forces and tools. A step past it has its velocities scaled back to the ceiling; one whose
+/// potential energy alone is past it is refused (positions kept, motion stopped). Local/global on
+/// linear springs is a descent method on backward Euler's incremental potential and needs no guard,
+/// so it runs only where that does not hold: the explicit and linearised implicit schemes, non-linear
+/// spring laws and constraints.
+struct EnergyGuardSettings {
+    bool enabled = true;
+    double slack = 0.25;
+};
+
 struct SleepSettings {
     bool enabled = true;
     double tolerance = 1e-6;
@@ -47,7 +61,8 @@ struct StepReport {
     int iterations = 0;   ///< local/global or CG iterations in total
     double residual = 0;  ///< CG: relative residual; local/global: last update / size; explicit: 0
     bool slept = false;   ///< the surface was at rest and was not stepped
-    bool refused = false; ///< the step would have produced NaN/Inf; the state was kept
+    bool refused = false; ///< the step would have produced NaN/Inf or created energy; the state was kept
+    bool energyLimited = false;  ///< the energy guard stepped in (velocities scaled down or step refused)
     const char* reason = "";
     Reaction reaction;  ///< on the cursor
 };
@@ -88,7 +103,7 @@ public:
     const MaterialMap& massMap() const { return mass_; }
     const MaterialMap& dampingMap() const { return damping_; }
     const MaterialMap& stiffnessMap() const { return stiffness_; }
-    SpringMesh& springs() { touch(); return springs_; }
+    SpringMesh& springs() { touch(); resetEnergyCeiling(); return springs_; }
     const SpringMesh& springs() const { return springs_; }
     ResponseLaw dampingLaw;  ///< non-linear damping: multiplier g(F)/F of each point's spring-force magnitude F
     const Eigen::VectorXd& pointMasses() { refreshMaterials(); return m_; }
@@ -118,13 +133,16 @@ public:
     // --- stepping -----------------------------------------------------------------------------
     SolverSettings solver;
     SleepSettings sleep;
+    EnergyGuardSettings energyGuard;
     /// Advances by dt seconds; never allocates after the first step with a given configuration.
     StepReport step(double dt);
     bool asleep() const { return asleep_; }
-    void wake() { touch(); }
+    void wake() { touch(); resetEnergyCeiling(); }
     std::uint64_t stepCount() const { return steps_; }
     double time() const { return time_; }
     double workDone() const { return work_; }  ///< work of external and tool forces so far
+    /// The energy guard's current ceiling (0 while the guard is not running for this scene).
+    double energyCeiling() const { return ceilingValid_ ? ceiling_ : 0.0; }
 
     // --- measures -----------------------------------------------------------------------------
     double kineticEnergy();
@@ -134,6 +152,11 @@ public:
 
 private:
     void touch() { asleep_ = false; quietSteps_ = 0; accelerationValid_ = false; }
+    /// Something outside a step changed the energy (shape, velocities, springs, materials, constraints).
+    void resetEnergyCeiling() { ceilingValid_ = false; }
+    bool guardsEnergy() const;
+    /// Applies the energy guard after a finite step that did `work`; returns false if it refused the step.
+    bool limitEnergy(double work, StepReport& r);
     void refreshMaterials();
     void ensureMassFactor();
     void ensureSystem(double dt, bool factor);
@@ -166,9 +189,11 @@ private:
     std::uint64_t massVersion_ = ~0ull, materialKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
     std::uint64_t systemKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
     std::uint64_t wakeKey_[4] = {0, 0, 0, 0};
-    double systemDt_ = -1, stepDt_ = 1;
+    double systemDt_ = -1;
     double minMass_ = 0, size_ = 1, spacingU_ = 1, spacingV_ = 1;
-    double time_ = 0, work_ = 0;
+    double time_ = 0, work_ = 0, ceiling_ = 0;
+    double accEnergy_ = 0;  // explicit: kinetic + elastic energy where acc_ was computed
+    bool ceilingValid_ = false;
     bool hasExternal_ = false, toolForces_ = false, asleep_ = false, accelerationValid_ = false;
     bool systemFactored_ = false;
     bool avValid_ = false;  ///< av_ == A v_ (set by a local/global step, cleared by anything else touching v)

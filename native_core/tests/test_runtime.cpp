@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <limits>
 #include <thread>
 
 #include "dynamic_surface.hpp"
@@ -61,6 +62,33 @@ public:
     }
     std::atomic<bool> lost{false}, nonZero{false};
     std::atomic<double> last{-1};
+};
+
+// A broken device: every other sample holds NaN, Inf or a zero quaternion, the rest grab and lift.
+class GarbageDevice final : public Device {
+public:
+    std::string name() const override { return "garbage"; }
+    DeviceCaps caps() const override { return {6, true, 1000, 50.0, 40.0}; }
+    bool sample(double t, DeviceSample& out) override {
+        const long n = count++;
+        out.position = Vec3(0, 0, 20.0 * std::min(1.0, t));
+        out.orientation = Eigen::Quaterniond::Identity();
+        switch (n % 8) {
+            case 1: out.position.x() = std::numeric_limits<double>::quiet_NaN(); break;
+            case 3: out.position.z() = std::numeric_limits<double>::infinity(); break;
+            case 5: out.orientation = Eigen::Quaterniond(0, 0, 0, 0); break;
+            case 7: out.orientation.w() = std::numeric_limits<double>::quiet_NaN(); break;
+            default: break;
+        }
+        out.buttons = 1;
+        out.valid = true;
+        return true;
+    }
+    void setForce(const Vec3& f) override {
+        if (!f.allFinite()) nonFinite = true;
+    }
+    std::atomic<long> count{0};
+    std::atomic<bool> nonFinite{false};
 };
 }  // namespace
 
@@ -167,6 +195,22 @@ TEST(HapticRuntime, DeviceLossStopsWithZeroForceAndAClamp) {
     rt.stop();
     EXPECT_EQ(rt.status().error, "device lost");
     EXPECT_EQ(dev->last.load(), 0.0);
+}
+
+TEST(HapticRuntime, NonFiniteDeviceInputNeverReachesTheSurfaceOrTheForce) {
+    auto s = patch();
+    auto dev = std::make_shared<GarbageDevice>();
+    HapticRuntime rt(s, dev, RuntimeSettings{});
+    rt.start();
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    const RuntimeStatus st = rt.status();
+    rt.stop();
+    EXPECT_GT(dev->count.load(), kSanitized ? 10 : 100);
+    EXPECT_FALSE(dev->nonFinite.load());
+    EXPECT_TRUE(st.force.allFinite());
+    EXPECT_TRUE(s->poles().allFinite());
+    EXPECT_TRUE(s->velocities().allFinite());
+    EXPECT_GT(s->poles().col(2).maxCoeff(), 1.0);  // the valid samples still lifted the surface
 }
 
 TEST(HapticEstimate, SafetyLayerFadesStaleSnapshotsLimitsStiffnessAndClamps) {

@@ -1,0 +1,91 @@
+#!/usr/bin/env python3
+"""The long stability campaign behind `make stress`: many more seeded random extreme scenes than
+`make test` runs (tests/stress_scenes.py says what a scene is and what it must show).
+
+Each finished scene is appended to a JSON-lines file at once, so Ctrl-C loses nothing and a rerun
+resumes where it stopped. The summary (per integrator: scenes, steps, steps the energy guard or the
+NaN guard refused, failures with their seeds) is printed and written to
+bench/results/stress_campaign.json. Exit status 1 if any scene failed.
+
+    python3 bench/stress_campaign.py --scenes 100000 [--first 10000] [--log build/stress/campaign.jsonl]
+"""
+from __future__ import annotations
+
+import argparse
+import collections
+import dataclasses
+import json
+import os
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path[:0] = [ROOT, os.path.join(ROOT, "tests"), os.path.dirname(os.path.abspath(__file__))]
+from progress import progress  # noqa: E402
+from stress_scenes import run_scene  # noqa: E402
+
+
+def done_seeds(log: str) -> set[int]:
+    if not os.path.exists(log):
+        return set()
+    with open(log) as f:
+        return {json.loads(line)["seed"] for line in f if line.strip()}
+
+
+def summarise(log: str, first: int, scenes: int) -> dict:
+    per: dict[str, collections.Counter] = collections.defaultdict(collections.Counter)
+    failures = []
+    with open(log) as f:
+        for line in f:
+            r = json.loads(line)
+            if not first <= r["seed"] < first + scenes:
+                continue
+            c = per[r["integrator"]]
+            c["scenes"] += 1
+            c["steps"] += r["steps"]
+            c["refused_steps"] += r["refused_steps"]
+            c["energy_limited_steps"] += r["energy_limited_steps"]
+            c["invalid_inputs_refused"] += r["invalid_inputs_refused"]
+            if r["failure"]:
+                c["failures"] += 1
+                failures.append({"seed": r["seed"], "integrator": r["integrator"], "failure": r["failure"]})
+    return {"first_seed": first, "scenes": scenes, "per_integrator": {k: dict(v) for k, v in sorted(per.items())},
+            "failures": failures}
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--scenes", type=int, default=100_000)
+    ap.add_argument("--first", type=int, default=10_000, help="first seed (make test covers 0..9999)")
+    ap.add_argument("--log", default=os.path.join(ROOT, "build", "stress", "campaign.jsonl"))
+    ap.add_argument("--out", default=os.path.join(ROOT, "bench", "results", "stress_campaign.json"))
+    a = ap.parse_args()
+    os.makedirs(os.path.dirname(a.log), exist_ok=True)
+    todo = [s for s in range(a.first, a.first + a.scenes) if s not in done_seeds(a.log)]
+    interrupted = False
+    try:
+        with open(a.log, "a") as log:
+            for seed in progress(todo, "stress", total=len(todo)):
+                r = run_scene(seed)
+                log.write(json.dumps(dataclasses.asdict(r)) + "\n")
+                log.flush()
+                if not r.ok:
+                    print(f"\nFAILED seed {seed}: {r.failure}", file=sys.stderr)
+    except KeyboardInterrupt:
+        interrupted = True
+        print("\ninterrupted: finished scenes are kept in the log; rerun to resume", file=sys.stderr)
+    summary = summarise(a.log, a.first, a.scenes)
+    summary["complete"] = not interrupted and sum(c["scenes"] for c in summary["per_integrator"].values()) == a.scenes
+    print(f"{'integrator':<14}{'scenes':>9}{'steps':>10}{'refused':>10}{'energy guard':>14}{'invalid refused':>17}"
+          f"{'failures':>10}")
+    for k, c in summary["per_integrator"].items():
+        print(f"{k:<14}{c['scenes']:>9}{c['steps']:>10}{c['refused_steps']:>10}{c['energy_limited_steps']:>14}"
+              f"{c['invalid_inputs_refused']:>17}{c.get('failures', 0):>10}")
+    for f in summary["failures"][:20]:
+        print(f"seed {f['seed']} ({f['integrator']}): {f['failure']}")
+    with open(a.out, "w") as f:
+        json.dump(summary, f, indent=1)
+    return 1 if summary["failures"] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
