@@ -1,14 +1,15 @@
 # HapticSculpt: `make demo` and `make test` set up a fresh Debian 12 machine, build and run.
+SHELL       := /bin/bash
 PY          := /usr/bin/python3
 BUILD       := build
 JOBS        ?= 2
 APT_PACKAGES := build-essential cmake ninja-build pkg-config libeigen3-dev pybind11-dev libgtest-dev \
-                python3-dev python3-numpy python3-scipy python3-pytest python3-matplotlib \
+                python3-dev python3-numpy python3-scipy python3-pytest python3-hypothesis python3-matplotlib \
                 python3-venv freecad-python3 freecad libhidapi-dev xvfb xauth
 SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
-PHONY_LONG := stress
+PHONY_LONG := stress fuzz
 .PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-cpp test-asan test-python test-freecad ocp-venv demo bench install install-udev uninstall clean
 # A private FreeCAD user folder whose Mod/HapticSculpt links this checkout (tests, demo render).
 FC_HOME     := $(BUILD)/freecad-home
@@ -73,6 +74,25 @@ test-freecad: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
 	  freecadcmd -t TestHapticSculpt
 
 test: test-cpp test-asan test-tsan test-python test-freecad
+
+# libFuzzer on the HID parsers (clang; FUZZ_SECONDS per harness), seeded with the recorded
+# fixtures' descriptors and reports. A crash or sanitizer report fails the target and leaves the
+# input in $(BUILD)/fuzz/crashes.
+FUZZ_SECONDS ?= 60
+FUZZ_HARNESSES := fuzz_report_descriptor fuzz_spacemouse_report fuzz_hid_recording
+fuzz: deps
+	@dpkg-query -W -f='$${Status}' clang libclang-rt-14-dev 2>/dev/null | grep -c "ok installed" | grep -q 2 || \
+	  (DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends clang libclang-rt-14-dev)
+	CC=clang CXX=clang++ cmake -S native_core -B $(BUILD)/fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHS_FUZZ=ON -DHS_PYTHON=OFF
+	cmake --build $(BUILD)/fuzz -j $(JOBS) --target $(FUZZ_HARNESSES)
+	$(PY) native_core/fuzz/seed_corpus.py tests/fixtures/hid $(BUILD)/fuzz/corpus
+	mkdir -p $(BUILD)/fuzz/crashes
+	set -e; for h in $(FUZZ_HARNESSES); do \
+	  echo "== $$h ($(FUZZ_SECONDS) s)"; \
+	  ASAN_OPTIONS=detect_leaks=1 $(BUILD)/fuzz/$$h -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 \
+	    -artifact_prefix=$(BUILD)/fuzz/crashes/$$h- $(BUILD)/fuzz/corpus/$$h 2>&1 | grep -E "^#[0-9]+ +DONE|stat::number_of_executed_units|ERROR|SUMMARY" ; \
+	  test $${PIPESTATUS[0]} -eq 0; \
+	done
 
 # The long stability campaign (make test runs seeds 0..9999; this goes on from there). Resumable.
 STRESS_SCENES ?= 100000

@@ -9,12 +9,21 @@ digits) round-trips bit for bit, so any session recorded into it replays exactly
 from __future__ import annotations
 
 import os
+import warnings
 from dataclasses import dataclass
 from typing import Any, Sequence
 
 import numpy as np
 
 HEADER = "# HapticSculpt trajectory v1: t x y z qw qx qy qz buttons"
+
+
+def _numbers(name: str, value: Any, dtype: Any = float) -> np.ndarray:
+    """`value` as an array, or a ValueError naming the argument (ragged or non-numeric input)."""
+    try:
+        return np.array(value, dtype=dtype)
+    except (ValueError, TypeError, OverflowError) as exc:
+        raise ValueError(f"{name}: expected numbers in a regular array ({exc})") from exc
 
 
 @dataclass(frozen=True)
@@ -43,7 +52,7 @@ class ReplayDevice:
 
     def __init__(self, t: Sequence[float], xyz: Sequence[Sequence[float]],
                  quat: Sequence[Sequence[float]] | None = None, buttons: Sequence[int] | None = None) -> None:
-        times = np.array(t, dtype=float)
+        times = _numbers("t", t)
         if times.ndim != 1 or times.size < 1:
             raise ValueError("t: expected a non-empty 1-D sequence of timestamps")
         if not np.all(np.isfinite(times)):
@@ -51,7 +60,7 @@ class ReplayDevice:
         if times.size > 1 and not np.all(np.diff(times) > 0):
             raise ValueError("t: timestamps must be strictly increasing")
         n = times.size
-        pos = np.array(xyz, dtype=float)
+        pos = _numbers("xyz", xyz)
         if pos.shape != (n, 3):
             raise ValueError(f"xyz: expected shape ({n}, 3), got {pos.shape}")
         if not np.all(np.isfinite(pos)):
@@ -59,7 +68,7 @@ class ReplayDevice:
         if quat is None:
             q = np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
         else:
-            q = np.array(quat, dtype=float)
+            q = _numbers("quat", quat)
             if q.shape != (n, 4):
                 raise ValueError(f"quat: expected shape ({n}, 4), got {q.shape}")
             if not np.all(np.isfinite(q)):
@@ -73,15 +82,15 @@ class ReplayDevice:
             b = np.ones(n, dtype=np.int64)
             b[-1] = 0
         else:
-            b = np.array(buttons)
+            b = _numbers("buttons", buttons, None)
             if b.shape != (n,):
                 raise ValueError(f"buttons: expected {n} button masks, got shape {b.shape}")
             if not np.issubdtype(b.dtype, np.integer) and not np.issubdtype(b.dtype, np.bool_):
                 if not np.all(np.isfinite(b.astype(float))) or not np.all(b == np.round(b)):
                     raise ValueError("buttons: expected integer bit masks")
             b = b.astype(np.int64)
-            if np.any(b < 0):
-                raise ValueError("buttons: bit masks must be >= 0")
+            if np.any(b < 0) or np.any(b > 0xFFFFFFFF):
+                raise ValueError("buttons: bit masks must be in 0..2**32-1")
         self._t, self._xyz, self._q, self._buttons = times, pos, q, b
         self._sampler: Any = None  # native sampler, made on first use
 
@@ -123,7 +132,9 @@ class ReplayDevice:
     def load(cls, path: str | os.PathLike[str]) -> "ReplayDevice":
         """Read a trajectory written by :meth:`save` (or by a recorded session)."""
         try:
-            data = np.loadtxt(path, ndmin=2, dtype=float)
+            with warnings.catch_warnings():  # an empty file: refused below with the column check
+                warnings.simplefilter("ignore", UserWarning)
+                data = np.loadtxt(path, ndmin=2, dtype=float)
         except ValueError as exc:
             raise ValueError(f"path: {os.fspath(path)!r} is not a trajectory file ({exc})") from exc
         if data.ndim != 2 or data.shape[1] != 9:

@@ -32,14 +32,14 @@ Points pointsFrom(const py::array_t<double, py::array::c_style | py::array::forc
         throw std::invalid_argument(std::string(name) + ": expected " + std::to_string(rows) + " points of 3 coordinates");
     Points p(rows, 3);
     std::copy(a.data(), a.data() + rows * 3, p.data());
-    if (!p.allFinite()) throw std::invalid_argument(std::string(name) + ": contains NaN or Inf");
+    if (!withinRange(p)) throw std::invalid_argument(std::string(name) + ": must be finite and within +-1e9");
     return p;
 }
 
 Vec3 vec3(const std::vector<double>& v, const char* name) {
     if (v.size() != 3) throw std::invalid_argument(std::string(name) + ": expected 3 numbers");
     Vec3 r(v[0], v[1], v[2]);
-    if (!r.allFinite()) throw std::invalid_argument(std::string(name) + ": must be finite");
+    if (!withinRange(r)) throw std::invalid_argument(std::string(name) + ": must be finite and within +-1e9");
     return r;
 }
 
@@ -70,7 +70,7 @@ std::string lawName(LawKind k) {
     return k == LawKind::Linear ? "linear" : k == LawKind::CubicHardening ? "cubic" : "saturating";
 }
 ResponseLaw makeLaw(const std::string& kind, double scale) {
-    if (!(scale > 0) || !std::isfinite(scale)) throw std::invalid_argument("scale: must be finite and > 0");
+    if (!(scale >= 1e-12 && scale <= 1e12)) throw std::invalid_argument("scale: must be in [1e-12, 1e12]");
     return {lawFrom(kind), scale};
 }
 
@@ -465,7 +465,7 @@ PYBIND11_MODULE(_core, m) {
         .def("wake", &DynamicSurface::wake)
         .def("step", [](DynamicSurface& s, double dt, int steps) {
             if (steps < 1) throw std::invalid_argument("steps: must be >= 1");
-            if (!(dt > 0) || !std::isfinite(dt)) throw std::invalid_argument("dt: must be finite and > 0");
+            if (!(dt >= kMinDt) || !std::isfinite(dt)) throw std::invalid_argument("dt: must be finite and >= 1e-9 s");
             StepReport total;
             {
                 py::gil_scoped_release release;

@@ -12,7 +12,7 @@ BSplineSurface::BSplineSurface(int nu, int nv, int degreeU, int degreeV, std::ve
     if (poles_.rows() != static_cast<Eigen::Index>(nu) * nv)
         throw std::invalid_argument("poles: expected " + std::to_string(nu * nv) + " rows (nu*nv), got " +
                                     std::to_string(poles_.rows()));
-    if (!poles_.allFinite()) throw std::invalid_argument("poles: contain NaN or Inf");
+    if (poles_.size() && !withinRange(poles_)) throw std::invalid_argument("poles: must be finite and within +-1e9");
     if (weights_.size() != 0) {
         if (weights_.size() != poles_.rows())
             throw std::invalid_argument("weights: expected " + std::to_string(poles_.rows()) + " values, got " +

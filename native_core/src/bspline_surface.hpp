@@ -10,6 +10,15 @@ namespace hs {
 using Points = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;  ///< one 3D point per row
 using Vec3 = Eigen::Vector3d;
 
+/// Largest coordinate accepted anywhere (poles, cursor, targets): 1e9 (1000 km in mm). Beyond it
+/// squared lengths times stiffness leave the double range; nothing real is that large.
+constexpr double kMaxCoordinate = 1e9;
+/// Largest material value (mass, damping, stiffness per unit area) and smallest non-zero one.
+constexpr double kMaxMaterial = 1e12, kMinMaterial = 1e-12;
+inline bool withinRange(const Eigen::Ref<const Eigen::MatrixXd>& x) {
+    return x.allFinite() && x.cwiseAbs().maxCoeff() <= kMaxCoordinate;
+}
+
 /// Position and partial derivatives of a surface at one (u, v).
 struct SurfaceDerivatives {
     Vec3 s, su, sv, suu, suv, svv;

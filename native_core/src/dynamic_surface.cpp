@@ -50,7 +50,7 @@ const Points& DynamicSurface::meshVelocities() {
 
 void DynamicSurface::setPoles(const Points& poles) {
     if (poles.rows() != surface_.poles().rows()) throw std::invalid_argument("poles: wrong number of rows");
-    if (!poles.allFinite()) throw std::invalid_argument("poles: contain NaN or Inf");
+    if (!withinRange(poles)) throw std::invalid_argument("poles: must be finite and within +-1e9");
     surface_.mutablePoles() = poles;
     v_.setZero();
     avValid_ = false;
@@ -99,6 +99,7 @@ void DynamicSurface::refreshMaterials() {
         }
     springs_.setStiffness(stiffness_, A_.us(), A_.vs());
     minMass_ = m_.minCoeff();
+    maxStiffness_ = stiffness_.values().maxCoeff();
     for (int i = 0; i < 3; ++i) materialKey_[i] = key[i];
     accelerationValid_ = false;
 }
@@ -130,7 +131,17 @@ void DynamicSurface::ensureSystem(double dt, bool factor) {
     const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
     const Eigen::SparseMatrix<double> sys = A.transpose() * Sm * A;
     cgInvDiag_ = sys.diagonal().cwiseInverse();  // Jacobi preconditioner
-    if (factor) systemSolver_.factor(sys, "system matrix A^T (M + dt D + dt^2 L) A");
+    if (factor) {
+        ensureMassFactor();  // throws first if the mesh does not see every control point
+        try {
+            systemSolver_.factor(sys, "system matrix A^T (M + dt D + dt^2 L) A");
+        } catch (const std::runtime_error&) {
+            // The mass matrix factors, so only dt^2 L (singular: free translations) can swamp it.
+            systemDt_ = -1;
+            throw std::invalid_argument("dt: too long for this mass and stiffness (dt^2 x stiffness / mass swamps the "
+                                        "mass matrix and the system is numerically singular); use a shorter step");
+        }
+    }
     systemFactored_ = factor;
     systemDt_ = dt;
     for (int i = 0; i < 4; ++i) systemKey_[i] = key[i];
@@ -205,7 +216,7 @@ double DynamicSurface::meshForces(const Points& d, const Points& dd, double) {
 }
 
 StepReport DynamicSurface::step(double dt) {
-    if (!(dt > 0) || !std::isfinite(dt)) throw std::invalid_argument("dt: must be finite and > 0");
+    if (!(dt >= kMinDt) || !std::isfinite(dt)) throw std::invalid_argument("dt: must be finite and >= 1e-9 s");
     refreshMaterials();
     const std::uint64_t key[4] = {mass_.version(), damping_.version(), stiffness_.version(), constraints_.version()};
     for (int i = 0; i < 4; ++i)
@@ -216,7 +227,7 @@ StepReport DynamicSurface::step(double dt) {
         r.slept = true;
         return r;
     }
-    const bool guard = guardsEnergy();
+    const bool guard = guardsEnergy(dt);
     if (!guard) ceilingValid_ = false;
     else if (!ceilingValid_) {
         ceiling_ = kineticEnergy() + potentialEnergy();
@@ -260,9 +271,14 @@ StepReport DynamicSurface::step(double dt) {
     return r;
 }
 
-bool DynamicSurface::guardsEnergy() const {
+bool DynamicSurface::guardsEnergy(double dt) const {
     if (!energyGuard.enabled) return false;
-    return solver.kind != IntegratorKind::LocalGlobal || springs_.law.kind != LawKind::Linear || !constraints_.empty();
+    if (solver.kind != IntegratorKind::LocalGlobal || springs_.law.kind != LawKind::Linear || !constraints_.empty())
+        return true;
+    // Local/global's descent guarantee is exact arithmetic's: the solve's rounding grows with the
+    // system's stiffness-to-mass ratio (~ dt^2 8 k_max / m_min, Gershgorin), and past 1e8 it can
+    // put measurable energy into a resting mesh (seen: 4.5e4 from rest at a ratio of 1e13).
+    return dt * dt * 8 * maxStiffness_ > 1e8 * minMass_;
 }
 
 bool DynamicSurface::limitEnergy(double work, StepReport& r) {

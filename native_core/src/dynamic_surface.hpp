@@ -17,6 +17,10 @@
 
 namespace hs {
 
+/// Shortest step: below it rounding in the positions (1e-16 of the size) turns into velocities
+/// above 1e-7 of the size per second, and backward Euler's velocity (x' - x) / dt into noise.
+constexpr double kMinDt = 1e-9;
+
 enum class IntegratorKind {
     Explicit,     ///< paper eq. 8-9 with recursive step halving
     ImplicitCG,   ///< linearised backward Euler, a fixed number of conjugate-gradient iterations
@@ -43,7 +47,8 @@ struct SolverSettings {
 /// potential energy alone is past it is refused (positions kept, motion stopped). Local/global on
 /// linear springs is a descent method on backward Euler's incremental potential and needs no guard,
 /// so it runs only where that does not hold: the explicit and linearised implicit schemes, non-linear
-/// spring laws and constraints.
+/// spring laws, constraints, and steps so long for the stiffness and mass that rounding in the
+/// solve is no longer negligible.
 struct EnergyGuardSettings {
     bool enabled = true;
     double slack = 0.25;
@@ -154,7 +159,7 @@ private:
     void touch() { asleep_ = false; quietSteps_ = 0; accelerationValid_ = false; }
     /// Something outside a step changed the energy (shape, velocities, springs, materials, constraints).
     void resetEnergyCeiling() { ceilingValid_ = false; }
-    bool guardsEnergy() const;
+    bool guardsEnergy(double dt) const;
     /// Applies the energy guard after a finite step that did `work`; returns false if it refused the step.
     bool limitEnergy(double work, StepReport& r);
     void refreshMaterials();
@@ -190,7 +195,7 @@ private:
     std::uint64_t systemKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
     std::uint64_t wakeKey_[4] = {0, 0, 0, 0};
     double systemDt_ = -1;
-    double minMass_ = 0, size_ = 1, spacingU_ = 1, spacingV_ = 1;
+    double minMass_ = 0, maxStiffness_ = 0, size_ = 1, spacingU_ = 1, spacingV_ = 1;
     double time_ = 0, work_ = 0, ceiling_ = 0;
     double accEnergy_ = 0;  // explicit: kinetic + elastic energy where acc_ was computed
     bool ceilingValid_ = false;

@@ -1,5 +1,7 @@
 #include "material_map.hpp"
 
+#include "bspline_surface.hpp"  // kMaxMaterial
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -12,9 +14,9 @@ MaterialMap::MaterialMap(double value, const char* name)
 }
 
 void MaterialMap::checkValue(double value, const char* what) const {
-    if (!std::isfinite(value) || value < 0 || (value == 0 && !allowZero_))
-        throw std::invalid_argument(std::string(name_) + " " + what + ": must be finite and " +
-                                    (allowZero_ ? ">= 0" : "> 0") + ", got " + std::to_string(value));
+    if (!std::isfinite(value) || value > kMaxMaterial || (value < kMinMaterial && !(value == 0 && allowZero_)))
+        throw std::invalid_argument(std::string(name_) + " " + what + ": must be " + (allowZero_ ? "0 or " : "") +
+                                    "in [1e-12, 1e12], got " + std::to_string(value));
 }
 
 double MaterialMap::at(double u, double v) const {
