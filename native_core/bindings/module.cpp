@@ -443,6 +443,9 @@ PYBIND11_MODULE(_core, m) {
                       "explicit (paper eq. 8-9, adaptive halving), implicit (backward Euler, CG) or local_global (default)")
         .def_property("iterations", [](const DynamicSurface& s) { return s.solver.iterations; },
                       [](DynamicSurface& s, int n) { if (n < 1 || n > 1000) throw std::invalid_argument("iterations: 1..1000"); s.solver.iterations = n; })
+        .def_property("time_order", [](const DynamicSurface& s) { return s.solver.timeOrder; },
+                      [](DynamicSurface& s, int n) { if (n != 1 && n != 2) throw std::invalid_argument("time_order: 1 (backward Euler) or 2 (BDF2)"); s.solver.timeOrder = n; s.wake(); },
+                      "local_global's time discretisation: 2 = BDF2 (default, second order), 1 = backward Euler")
         .def_property("cg_iterations", [](const DynamicSurface& s) { return s.solver.cgIterations; },
                       [](DynamicSurface& s, int n) { if (n < 1 || n > 10000) throw std::invalid_argument("cg_iterations: 1..10000"); s.solver.cgIterations = n; })
         .def_property("acceleration_limit", [](const DynamicSurface& s) { return s.solver.accelerationLimit; },

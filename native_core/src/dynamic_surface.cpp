@@ -10,8 +10,10 @@ DynamicSurface::DynamicSurface(BSplineSurface surface, int g, int h)
     : surface_(std::move(surface)), A_(surface_, g, h), mass_(1.0, "mass"), damping_(1.0, "damping"),
       stiffness_(100.0, "stiffness") {
     const Eigen::Index S = static_cast<Eigen::Index>(g) * h, N = surface_.poles().rows();
-    for (Points* m : {&d_, &dd_, &fext_, &ftool_, &force_, &meshTmp_, &meshTmp2_, &base_, &dPrev_, &av_}) m->setZero(S, 3);
-    for (Points* m : {&v_, &fp_, &p0_, &v0_, &a0_, &pStep_, &vStep_, &acc_, &cgR_, &cgZ_, &cgP_, &cgQ_, &x_}) m->setZero(N, 3);
+    for (Points* m : {&d_, &dd_, &fext_, &ftool_, &force_, &meshTmp_, &meshTmp2_, &base_, &dPrev_, &av_, &dHist_, &avHist_, &dHat_})
+        m->setZero(S, 3);
+    for (Points* m : {&v_, &fp_, &p0_, &v0_, &a0_, &pStep_, &vStep_, &acc_, &cgR_, &cgZ_, &cgP_, &cgQ_, &x_, &pHist_, &vHist_, &xHat_})
+        m->setZero(N, 3);
     m_.setZero(S);
     gamma_.setZero(S);
     damping_.allowZero(true);
@@ -53,7 +55,7 @@ void DynamicSurface::setPoles(const Points& poles) {
     if (!withinRange(poles)) throw std::invalid_argument("poles: must be finite and within +-1e9");
     surface_.mutablePoles() = poles;
     v_.setZero();
-    avValid_ = false;
+    avValid_ = histValid_ = false;
     A_.apply(surface_.poles(), d_);
     touch();
     resetEnergyCeiling();
@@ -63,7 +65,7 @@ void DynamicSurface::setVelocities(const Points& v) {
     if (v.rows() != v_.rows()) throw std::invalid_argument("velocities: wrong number of rows");
     if (!v.allFinite()) throw std::invalid_argument("velocities: contain NaN or Inf");
     v_ = v;
-    avValid_ = false;
+    avValid_ = histValid_ = false;
     touch();
     resetEnergyCeiling();
 }
@@ -239,7 +241,7 @@ StepReport DynamicSurface::step(double dt) {
     const bool tracksWork = hasExternal_ || tool_->grabbed();
     // The mesh before the step: for the work of the applied forces, and for local/global's A v.
     if (tracksWork || solver.kind == IntegratorKind::LocalGlobal) dPrev_ = d_;
-    if (solver.kind != IntegratorKind::LocalGlobal) avValid_ = false;
+    if (solver.kind != IntegratorKind::LocalGlobal) avValid_ = histValid_ = false;
     switch (solver.kind) {
         case IntegratorKind::Explicit: r = stepExplicit(dt); break;
         case IntegratorKind::ImplicitCG: r = stepImplicitCG(dt); break;
@@ -248,7 +250,7 @@ StepReport DynamicSurface::step(double dt) {
     if (!surface_.poles().allFinite() || !v_.allFinite()) {
         surface_.mutablePoles() = pStep_;
         v_ = vStep_;
-        avValid_ = false;
+        avValid_ = histValid_ = false;
         A_.apply(surface_.poles(), d_);
         accelerationValid_ = false;
         r.refused = true;
@@ -296,6 +298,7 @@ bool DynamicSurface::limitEnergy(double work, StepReport& r) {
         const double s = std::sqrt((ceiling - pe) / ke);
         v_ *= s;
         av_ *= s;
+        histValid_ = false;
         accelerationValid_ = false;
         ceiling_ = ceiling;
         r.reason = "the step would have created energy; velocities scaled back to the energy ceiling (reduce dt or stiffness)";
@@ -303,7 +306,7 @@ bool DynamicSurface::limitEnergy(double work, StepReport& r) {
     }
     surface_.mutablePoles() = pStep_;
     v_.setZero();
-    avValid_ = false;
+    avValid_ = histValid_ = false;
     A_.apply(surface_.poles(), d_);
     accelerationValid_ = false;
     r.refused = true;
@@ -323,7 +326,7 @@ void DynamicSurface::checkSleep(double dt) {
     if (fp_.cwiseAbs().maxCoeff() < sleep.tolerance * stiffness_.mean() * size_) {
         asleep_ = true;
         v_.setZero();
-        avValid_ = false;
+        avValid_ = histValid_ = false;
     } else {
         quietSteps_ = 0;
     }

@@ -30,6 +30,7 @@ enum class IntegratorKind {
 struct SolverSettings {
     IntegratorKind kind = IntegratorKind::LocalGlobal;
     int iterations = 1;              ///< local/global iterations per step
+    int timeOrder = 2;               ///< local/global: 1 = backward Euler, 2 = BDF2 (same cost, second order)
     int cgIterations = 5;            ///< implicit: CG iterations per step
     /// explicit: halve the step while any control-point acceleration exceeds this;
     /// 0 = automatic, 0.1 * size / h^2 for a substep h (no point may be flung a tenth of the surface in one substep)
@@ -183,6 +184,10 @@ private:
     Points fp_, p0_, v0_, a0_, pStep_, vStep_, acc_, cgR_, cgZ_, cgP_, cgQ_, x_;
     Points dPrev_;  // the mesh before the current step (set by step())
     Points av_;  // local/global: A v kept from the last step (saves one A product a step)
+    // local/global BDF2: the state one step back (poles, velocities, mesh, A v) and x^ = (4 x_n - x_n-1) / 3
+    Points pHist_, vHist_, dHist_, avHist_, xHat_, dHat_;
+    double histDt_ = 0;
+    bool histValid_ = false;  ///< the history is the previous step's at histDt_ (cleared with avValid_)
     Eigen::VectorXd m_, gamma_, cgInvDiag_;
     MaterialMap mass_, damping_, stiffness_;
     SpringMesh springs_;
