@@ -395,3 +395,25 @@ def test_constraints_stay_stable_under_a_rope_pull(integrator):
     assert math.degrees(ds.constraint_error(ids["normal"])) < 0.5
     assert math.degrees(ds.constraint_error(ids["tangent"])) < 0.5
     assert ds.constraint_error(ids["curvature"]) < 0.02
+
+
+@pytest.mark.parametrize("kind", ["none", "point", "tangent", "normal"])
+def test_potential_gradient_matches_finite_differences(kind):
+    """potential_gradient is the exact derivative of potential_energy (the static reference of
+    bench/time_vs_error.py minimises that energy with it). Not for the curvature constraint: its
+    arc targets keep the current half-chord, so its force is the gradient with the targets held."""
+    ds = core.patch((6, 6), (3, 3), (14, 14))
+    rng = np.random.default_rng(3)
+    p = ds.poles + rng.normal(scale=2.0, size=ds.poles.shape)
+    if kind != "none":
+        ds.add_constraint(kind, uv=(0.5, 0.5), target=[0.3, 0.2, 0.9] if kind != "point" else [1.0, 2.0, 5.0])
+    ds.set_poles(p)
+    g = ds.potential_gradient()
+    h = 1e-5
+    for idx in [(2, 3, 2), (0, 0, 0), (3, 3, 1), (5, 2, 2)]:
+        q = p.copy(); q[idx] += h
+        ds.set_poles(q); ep = ds.potential_energy()
+        q[idx] -= 2 * h
+        ds.set_poles(q); em = ds.potential_energy()
+        fd = (ep - em) / (2 * h)
+        assert abs(fd - g[idx]) <= 1e-5 * max(1.0, np.abs(g).max()), (idx, fd, g[idx])

@@ -492,6 +492,13 @@ PYBIND11_MODULE(_core, m) {
         .def_property_readonly("work_done", &DynamicSurface::workDone, "work of external and tool forces so far")
         .def("kinetic_energy", &DynamicSurface::kineticEnergy)
         .def("potential_energy", &DynamicSurface::potentialEnergy, "springs plus penalty terms")
+        .def("potential_gradient", [](DynamicSurface& s) {
+            const Points& g = s.potentialGradient();
+            const auto [nu, nv] = std::make_pair(s.surface().nu(), s.surface().nv());
+            py::array_t<double> out({nu, nv, 3});
+            std::copy(g.data(), g.data() + g.size(), out.mutable_data());
+            return out;
+        }, "Gradient of potential_energy() with respect to the poles (nu, nv, 3): -A^T f(d), springs and constraints")
         .def("point_masses", [](DynamicSurface& s) { return Eigen::VectorXd(s.pointMasses()); })
         .def("curvature_grid", [](const DynamicSurface& s) {
             Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> c;

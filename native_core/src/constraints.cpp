@@ -168,17 +168,16 @@ void ConstraintSet::terms(const Points& d, std::vector<ConstraintTerm>& out) con
             }
             case ConstraintKind::Normal: {
                 // Paper 4.4, alternate method, as a projection: each neighbour edge e_k = x_k - x_p is
-                // moved to the nearest edge of the same length in the plane normal to the target,
-                // |e_k| (e_k - (e_k . n) n) / |e_k - (e_k . n) n|. Pairing each neighbour with the
-                // centre keeps the net force zero; rotation about n stays free. Being a true nearest-
-                // point projection keeps the local/global iteration stable at any penalty stiffness.
+                // moved to its nearest point in the plane normal to the target, e_k - (e_k . n) n, so
+                // the energy is 1/2 k sum (e_k . n)^2 and these forces are its exact gradient.
+                // Pairing each neighbour with the centre keeps the net force zero; rotation about n
+                // and the edges' lengths stay free (the mesh springs hold those). A true nearest-
+                // point projection onto a fixed (convex) set keeps local/global a descent method at
+                // any penalty stiffness.
                 const int nb[4] = {p + h_, p - h_, p + 1, p - 1};
                 for (int k = 0; k < 4; ++k) {
                     const Vec3 e = Vec3(d.row(nb[k])) - x;
-                    const Vec3 inPlane = e - e.dot(c.target) * c.target;
-                    const double len = inPlane.norm();
-                    if (!(len > 1e-12 * e.norm())) continue;
-                    out.push_back({nb[k], p, c.stiffness, inPlane * (e.norm() / len)});
+                    out.push_back({nb[k], p, c.stiffness, e - e.dot(c.target) * c.target});
                 }
                 break;
             }

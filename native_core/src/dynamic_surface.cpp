@@ -347,6 +347,17 @@ double DynamicSurface::potentialEnergy() {
     return e;
 }
 
+const Points& DynamicSurface::potentialGradient() {
+    refreshMaterials();
+    force_.setZero();
+    springs_.addForces(d_, force_);
+    if (!constraints_.empty()) constraints_.addForces(d_, force_, terms_);
+    A_.applyTransposed(force_, fp_);
+    fp_ = -fp_;
+    accelerationValid_ = false;  // fp_ and force_ are the explicit scheme's scratch
+    return fp_;
+}
+
 Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> DynamicSurface::curvatureGrid() const {
     const auto& ops = A_.derivativeOperators(surface_);
     const Eigen::Index S = d_.rows();

@@ -153,6 +153,8 @@ public:
     // --- measures -----------------------------------------------------------------------------
     double kineticEnergy();
     double potentialEnergy();
+    /// Gradient of potentialEnergy() with respect to the poles, -A^T f(d) (springs and constraints).
+    const Points& potentialGradient();
     /// Per mesh point: u and v normal curvature, min and max principal, mean, Gaussian (g*h x 6).
     Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> curvatureGrid() const;
 
