@@ -1,0 +1,285 @@
+#!/usr/bin/env python3
+"""Run time against error: every integrator over a range of time steps and iteration counts on three
+reference scenes, error against a converged reference, and the Pareto front of each solver.
+
+Scenes (8x8 controls, 24x24 mesh, a 100 mm dome-shaped patch relaxed as its rest shape, stiffness
+1e4, mass 1 per unit area; the same for every solver):
+- rope: the rope grabs the centre, the cursor rises 15 mm in 0.15 s (updated every 1 ms of
+  simulated time), lets go, and the patch swings free until 0.3 s; damping 2.
+- equilibrium: four pinned corners, a point constraint raised 5 mm and a normal tilted 10 degrees
+  settle for 1.5 s; damping 40. Reference: the static minimum of the same discrete energy, by scipy
+  (Newton-CG on the core's potential energy and its gradient, exact for springs, point and normal
+  constraints: tests/test_core_dynamics.py). The curvature constraint is left out: its arc targets keep the
+  current half-chord, so its force is not the gradient of a fixed energy and there is no energy
+  to minimise (its accuracy at equilibrium is tested in tests/test_core_dynamics.py).
+- oscillation: a pole pushed 3 mm and let go, undamped, 0.2 s.
+Rope and oscillation references: the explicit scheme at 1 ms / 1024 and 1 ms / 2048, Richardson-
+extrapolated (first order); their difference says how good the reference is (printed).
+
+Error: largest mesh-point distance to the reference at the end, over the patch size (also at the
+release for the rope). Time: wall seconds per simulated second, median of repeats for short runs.
+
+Solvers: explicit (the paper's eq. 8-9 with adaptive halving), implicit (the paper's linearised
+backward Euler, 5 or 20 CG iterations), local_global (the default: BDF2, 1-8 iterations) and
+local_global_be (the same with backward Euler, for comparison).
+
+Writes bench/results/time_vs_error.json (records: scene, solver, dt, iterations,
+seconds_per_sim_second, error) and time_vs_error.png, prints each solver's fastest run at each error
+level 1e-2 .. 1e-6 and the default's speed-up over the paper's schemes. Finished runs are kept if
+interrupted (Ctrl-C writes what is done).
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+from scipy import optimize
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path[:0] = [ROOT, os.path.dirname(os.path.abspath(__file__))]
+from HapticSculpt import core  # noqa: E402
+from progress import progress  # noqa: E402
+
+MS = 1e-3
+DTS = [MS * 2.0 ** -k for k in range(0, 9)] + [2 * MS, 4 * MS, 8 * MS]  # 8 ms .. 3.9 us
+LEVELS = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6]
+# (solver, integrator, settings): solver names the integrator family the Pareto fronts compare;
+# iteration counts are one of the parameters each family is swept over, as the time step is.
+SOLVERS = [
+    ("explicit", "explicit", {}),
+    ("implicit", "implicit", {"cg_iterations": 5}),
+    ("implicit", "implicit", {"cg_iterations": 20}),
+    ("local_global", "local_global", {"iterations": 1}),
+    ("local_global", "local_global", {"iterations": 2}),
+    ("local_global", "local_global", {"iterations": 4}),
+    ("local_global", "local_global", {"iterations": 8}),
+    ("local_global_be", "local_global", {"time_order": 1, "iterations": 1}),
+    ("local_global_be", "local_global", {"time_order": 1, "iterations": 4}),
+]
+FAMILIES = ["explicit", "implicit", "local_global_be", "local_global"]
+DEFAULT = "local_global"  # BDF2, the default integrator and time order
+
+
+def dome(damping: float) -> core.DynamicSurface:
+    s = core.patch((8, 8), (3, 3), (24, 24))
+    p = np.array(s.poles)
+    x, y = p[..., 0] / 50, p[..., 1] / 50
+    p[..., 2] = 15 * (1 - 0.5 * (x ** 2 + y ** 2))
+    s.set_poles(p)
+    s.relax()
+    s.stiffness_map.set_uniform(1e4)
+    s.damping_map.set_uniform(damping)
+    s.sleep_enabled = False
+    return s
+
+
+# --- scenes: build(solver settings) -> surface; play(surface, dt) -> list of mesh snapshots -----------
+def rope_build() -> core.DynamicSurface:
+    s = dome(2.0)
+    s.tool.reel_time = 0.1
+    return s
+
+
+def rope_play(s: core.DynamicSurface, dt: float) -> list[np.ndarray]:
+    per_ms = round(MS / dt)
+    top = np.array(s.mesh[12, 12]) + [0, 0, 2.0]
+    snaps = []
+    for k in range(300):
+        grab = k < 150
+        s.set_cursor(list(top + [0, 0, 15.0 * min(k, 150) / 150]), grab=grab)
+        s.step(dt, per_ms)
+        if k == 149:
+            snaps.append(np.array(s.mesh))
+    snaps.append(np.array(s.mesh))
+    return snaps
+
+
+def equilibrium_build() -> core.DynamicSurface:
+    s = dome(40.0)
+    n = s.mesh.shape[1]
+    for idx in (0, n - 1, n * (n - 1), n * n - 1):
+        s.add_constraint("point", index=idx)
+    s.add_constraint("point", uv=(0.4, 0.4), target=list(np.array(s.mesh[9, 9]) + [0, 0, 5.0]))
+    tilt = math.radians(10)
+    s.add_constraint("normal", uv=(0.7, 0.3), target=[math.sin(tilt), 0.0, math.cos(tilt)])
+    return s
+
+
+def equilibrium_play(s: core.DynamicSurface, dt: float) -> list[np.ndarray]:
+    s.step(dt, round(1.5 / dt))
+    return [np.array(s.mesh)]
+
+
+def oscillation_build() -> core.DynamicSurface:
+    s = dome(0.0)
+    p = np.array(s.poles)
+    p[3, 4, 2] += 3.0
+    s.set_poles(p)
+    return s
+
+
+def oscillation_play(s: core.DynamicSurface, dt: float) -> list[np.ndarray]:
+    s.step(dt, round(0.2 / dt))
+    return [np.array(s.mesh)]
+
+
+# name: (build, play, simulated seconds, (shortest, longest) time step)
+SCENES = {"rope": (rope_build, rope_play, 0.3, (MS / 256, MS)),
+          "equilibrium": (equilibrium_build, equilibrium_play, 1.5, (MS / 16, 8 * MS)),
+          "oscillation": (oscillation_build, oscillation_play, 0.2, (MS / 256, 8 * MS))}
+
+
+def configure(s: core.DynamicSurface, integrator: str, settings: dict) -> core.DynamicSurface:
+    s.integrator = integrator
+    for k, v in settings.items():
+        setattr(s, k, v)
+    return s
+
+
+def richardson_reference(scene: str) -> tuple[list[np.ndarray], float]:
+    """Explicit at 1 ms/1024 and 1 ms/2048, extrapolated; and its own error estimate."""
+    build, play, _, _ = SCENES[scene]
+    runs = []
+    for div in (512, 1024, 2048):
+        s = configure(build(), "explicit", {})
+        runs.append(play(s, MS / div))
+    coarse = [2 * b - a for a, b in zip(runs[0], runs[1])]
+    fine = [2 * b - a for a, b in zip(runs[1], runs[2])]
+    size = build().size
+    return fine, max(float(np.abs(f - c).max()) for f, c in zip(fine, coarse)) / size
+
+
+def static_equilibrium(s: core.DynamicSurface) -> float:
+    """Moves s to the minimum of its discrete potential energy by scipy's Newton-CG (the core's exact
+    gradient; Hessian-vector products by central differences of it); returns the largest
+    remaining gradient entry over the largest initial one."""
+    shape = s.poles.shape
+
+    def energy(x: np.ndarray) -> float:
+        s.set_poles(x.reshape(shape))
+        return s.potential_energy()
+
+    def gradient(x: np.ndarray) -> np.ndarray:
+        s.set_poles(x.reshape(shape))
+        return s.potential_gradient().ravel().copy()
+
+    def hessp(x: np.ndarray, v: np.ndarray) -> np.ndarray:
+        e = 1e-6 / max(1e-300, float(np.abs(v).max()))
+        return (gradient(x + e * v) - gradient(x - e * v)) / (2 * e)
+
+    x0 = np.array(s.poles).ravel()
+    g0 = float(np.abs(gradient(x0)).max())
+    sol = optimize.minimize(energy, x0, jac=gradient, hessp=hessp, method="Newton-CG",
+                            options={"xtol": 1e-14, "maxiter": 5000})
+    return float(np.abs(gradient(sol.x)).max()) / g0
+
+
+def static_reference() -> tuple[list[np.ndarray], float]:
+    s = equilibrium_build()
+    residual = static_equilibrium(s)
+    return [np.array(s.mesh)], residual
+
+
+def timed_run(scene: str, integrator: str, settings: dict, dt: float) -> tuple[float, list[np.ndarray], bool]:
+    build, play, seconds, _ = SCENES[scene]
+    times, snaps, clean = [], None, True
+    for _ in range(3):
+        s = configure(build(), integrator, settings)
+        t0 = time.perf_counter()
+        snaps = play(s, dt)
+        times.append(time.perf_counter() - t0)
+        if times[-1] > 0.5:  # long runs once: noise is small next to them
+            break
+    return float(np.median(times)) / seconds, snaps, clean
+
+
+def pareto_table(records: list[dict]) -> list[dict]:
+    rows = []
+    for scene in SCENES:
+        for label in FAMILIES:
+            row = {"scene": scene, "solver": label}
+            for level in LEVELS:
+                ok = [r["seconds_per_sim_second"] for r in records
+                      if r["scene"] == scene and r["solver"] == label and r["error"] <= level]
+                row[f"{level:g}"] = min(ok) if ok else None
+            rows.append(row)
+    return rows
+
+
+def plot(records: list[dict], path: str) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, len(SCENES), figsize=(6 * len(SCENES), 5))
+    for ax, scene in zip(axes, SCENES):
+        for label in FAMILIES:
+            pts = sorted((r["error"], r["seconds_per_sim_second"]) for r in records
+                         if r["scene"] == scene and r["solver"] == label and r["error"] > 0)
+            if not pts:
+                continue
+            front, best = [], math.inf  # Pareto front: fastest run reaching each error
+            for e, t in pts:
+                if t < best:
+                    front.append((e, t))
+                    best = t
+            ax.loglog(*zip(*pts), ".", alpha=0.35)
+            ax.loglog(*zip(*front), "-o", ms=4, label=label, color=ax.lines[-1].get_color(),
+                      lw=2.5 if label == DEFAULT else 1.2)
+        ax.set_title(scene)
+        ax.set_xlabel("error / patch size")
+        ax.set_ylabel("wall s per simulated s")
+        ax.axvspan(1e-6, 1e-2, color="0.93", zorder=0)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
+def main() -> None:
+    out_dir = os.path.join(ROOT, "bench", "results")
+    os.makedirs(out_dir, exist_ok=True)
+    refs, notes = {}, {}
+    for scene in progress(list(SCENES), "references"):
+        refs[scene], notes[scene] = static_reference() if scene == "equilibrium" else richardson_reference(scene)
+    print("reference quality: " + ", ".join(
+        f"{k}: {'relative gradient left' if k == 'equilibrium' else 'Richardson spread / size'} {v:.1e}" for k, v in notes.items()))
+    jobs = [(scene, label, integ, settings, dt) for scene in SCENES for label, integ, settings in SOLVERS
+            for dt in DTS if SCENES[scene][3][0] <= dt <= SCENES[scene][3][1]]
+    records: list[dict] = []
+    try:
+        for scene, label, integ, settings, dt in progress(jobs, "runs"):
+            sps, snaps, _ = timed_run(scene, integ, settings, dt)
+            size = 100.0 * math.sqrt(2)
+            err = max(float(np.abs(a - b).max()) for a, b in zip(snaps, refs[scene])) / size
+            records.append({"scene": scene, "solver": label, "dt": dt,
+                            "iterations": settings.get("iterations", settings.get("cg_iterations", 1)),
+                            "seconds_per_sim_second": sps, "error": err if math.isfinite(err) else float("inf")})
+    except KeyboardInterrupt:
+        print(f"\ninterrupted after {len(records)} of {len(jobs)} runs; writing those", file=sys.stderr)
+    with open(os.path.join(out_dir, "time_vs_error.json"), "w") as f:
+        json.dump({"references": notes, "records": records}, f, indent=1)
+    rows = pareto_table(records)
+    print(f"\nfastest run (wall s per simulated s) reaching each error level; '-' = never reached")
+    print(f"{'scene':<12}{'solver':<18}" + "".join(f"{level:>10g}" for level in LEVELS))
+    for r in rows:
+        print(f"{r['scene']:<12}{r['solver']:<18}" + "".join(
+            f"{r[f'{lv:g}']:>10.3g}" if r[f"{lv:g}"] is not None else f"{'-':>10}" for lv in LEVELS))
+    print("\ndefault against the paper's schemes (ratio = their fastest / ours at the same error level):")
+    for scene in SCENES:
+        ours = next(r for r in rows if r["scene"] == scene and r["solver"] == DEFAULT)
+        for label in ("explicit", "implicit"):
+            theirs = next(r for r in rows if r["scene"] == scene and r["solver"] == label)
+            cells = []
+            for lv in LEVELS:
+                a, b = ours[f"{lv:g}"], theirs[f"{lv:g}"]
+                cells.append("ours only" if a is not None and b is None else "-" if a is None else f"{b / a:.1f}x")
+            print(f"  {scene:<12}{label:<10}" + "".join(f"{c:>11}" for c in cells))
+    plot(records, os.path.join(out_dir, "time_vs_error.png"))
+
+
+if __name__ == "__main__":
+    main()
