@@ -22,10 +22,13 @@ class HapticSculptWorkbench(Gui.Workbench):
         self.appendMenu("HapticSculpt", commands.TOOLBAR)
 
     def Activated(self):
-        pass
+        from HapticSculpt.gui import controller
+        controller().attach()  # the mouse cursor and the keys P, N, C, M in the active view
 
     def Deactivated(self):
         import HapticSculpt
+        from HapticSculpt.gui import controller
+        controller().shutdown()
         HapticSculpt.stop_all()  # leaving the workbench ends every sculpting session
 
     def GetClassName(self):

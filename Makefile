@@ -9,7 +9,7 @@ APT_PACKAGES := build-essential cmake ninja-build pkg-config libeigen3-dev pybin
 SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
-PHONY_LONG := stress fuzz
+PHONY_LONG := stress fuzz bench-peers
 .PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-cpp test-asan test-python test-freecad ocp-venv demo bench install install-udev uninstall clean
 # A private FreeCAD user folder whose Mod/HapticSculpt links this checkout (tests, demo render).
 FC_HOME     := $(BUILD)/freecad-home
@@ -115,10 +115,24 @@ install-udev:
 uninstall:
 	rm -f $(FREECAD_MOD)/HapticSculpt
 
+# Benchmarks print tables and write bench/results/*.json and *.png (tracked JSON, untracked plots).
 bench: build
 	$(PY) bench/table1.py
 	$(PY) bench/loops.py
 	$(PY) bench/skip.py
+	$(PY) bench/time_vs_error.py
+	$(PY) bench/discretisation.py
+
+# Peers run in their own virtual environment (optional benchmark dependencies, not test ones).
+BENCH_VENV := $(BUILD)/bench-venv
+PEERS      := pypbd==2.2.2 warp-lang==1.19.0 newton==1.8.0 pbatoolkit==0.0.11 numpy scipy matplotlib
+$(BENCH_VENV)/.installed:
+	$(PY) -m venv $(BENCH_VENV)
+	$(BENCH_VENV)/bin/pip install -q --disable-pip-version-check $(PEERS)
+	touch $@
+
+bench-peers: build $(BENCH_VENV)/.installed
+	$(BENCH_VENV)/bin/python bench/peers.py
 
 clean:
 	rm -rf $(BUILD) HapticSculpt/_core*.so

@@ -10,7 +10,13 @@ import FreeCADGui as Gui
 from .undo import transaction
 from .view_provider import icon
 
-TOOLBAR = ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Thicken", "HapticSculpt_ExportStep"]
+TOOLBAR = ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Session", "HapticSculpt_ToolRope",
+           "HapticSculpt_ToolMagnet", "HapticSculpt_MagnetFalloff", "HapticSculpt_ToolOrientation",
+           "HapticSculpt_ToolSmooth", "HapticSculpt_PointConstraint", "HapticSculpt_NormalConstraint",
+           "HapticSculpt_CurvatureConstraint", "HapticSculpt_PaintMass", "HapticSculpt_PaintDamping",
+           "HapticSculpt_PaintStiffness", "HapticSculpt_ShowMap", "HapticSculpt_ShowCurvature",
+           "HapticSculpt_Combs", "HapticSculpt_Zebra", "HapticSculpt_Panel", "HapticSculpt_Thicken",
+           "HapticSculpt_ExportStep"]
 
 
 def _selected_sculpts() -> list[Any]:
@@ -92,8 +98,190 @@ class ExportStep:
         FreeCAD.Console.PrintMessage(f"HapticSculpt: wrote {path}\n")
 
 
+def _ctl() -> Any:
+    from .gui import controller
+    return controller()
+
+
+def _has_sculpt() -> bool:
+    return FreeCAD.ActiveDocument is not None and _ctl().active_sculpt() is not None
+
+
+class _SculptCommand:
+    """A command on the active sculpt (selected, else the document's last): active only with one."""
+
+    icon_name = "HapticSculpt"
+    menu = tip = ""
+
+    def GetResources(self) -> dict[str, str]:
+        return {"Pixmap": icon(self.icon_name), "MenuText": self.menu, "ToolTip": self.tip}
+
+    def IsActive(self) -> bool:
+        return _has_sculpt()
+
+
+class Session(_SculptCommand):
+    icon_name = "Session"
+    menu = "Start/stop sculpting"
+    tip = ("Start a sculpting session on the active sculpt with the attached SpaceMouse (the mouse when none "
+           "is attached: left button grabs); run again to stop")
+
+    def Activated(self) -> None:
+        ctl = _ctl()
+        if ctl.session is not None and ctl.session.running:
+            ctl.stop_session()
+        else:
+            ctl.start_session()
+
+
+class _Tool(_SculptCommand):
+    tool = "rope"
+
+    def Activated(self) -> None:
+        _ctl().set_tool(self.tool)
+
+
+class ToolRope(_Tool):
+    tool, icon_name, menu = "rope", "Rope", "Rope tool"
+    tip = "Rope: grabs the nearest mass point; pulls, cannot push; reels in over 1 s"
+
+
+class ToolMagnet(_Tool):
+    tool, icon_name, menu = "magnet", "Magnet", "Magnet tool"
+    tip = "Magnet: pulls every mass point within its radius, weighted by its falloff"
+
+
+class ToolOrientation(_Tool):
+    tool, icon_name, menu = "orientation", "Orientation", "Orientation tool"
+    tip = "Orientation: five springs turn the surface's u and v directions toward the cursor frame"
+
+
+class ToolSmooth(_Tool):
+    tool, icon_name, menu = "smooth", "Smooth", "Smooth tool"
+    tip = "Smooth: a fairing brush toward lower curvature variation under the cursor"
+
+
+class MagnetFalloff(_SculptCommand):
+    icon_name, menu = "Magnet", "Magnet falloff"
+    tip = "Cycle the magnet's falloff: constant, spherical, cylindrical (about the cursor axis), conical"
+
+    def Activated(self) -> None:
+        from .core import FALLOFFS
+        ctl = _ctl()
+        nxt = FALLOFFS[(FALLOFFS.index(ctl.falloff) + 1) % len(FALLOFFS)]
+        ctl.set_tool("magnet", nxt)
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: magnet falloff {nxt}\n")
+
+
+class _Constraint(_SculptCommand):
+    kind = "point"
+
+    def IsActive(self) -> bool:
+        return _has_sculpt() and _ctl().cursor() is not None
+
+    def Activated(self) -> None:
+        _ctl().toggle_constraint(self.kind)
+
+
+class PointConstraint(_Constraint):
+    kind, icon_name, menu = "point", "PointConstraint", "Point constraint (P)"
+    tip = "Toggle a point constraint at the mass point nearest the cursor (key P)"
+
+
+class NormalConstraint(_Constraint):
+    kind, icon_name, menu = "normal", "NormalConstraint", "Normal constraint (N)"
+    tip = "Toggle a normal constraint at the mass point nearest the cursor (key N)"
+
+
+class CurvatureConstraint(_Constraint):
+    kind, icon_name, menu = "curvature", "CurvatureConstraint", "Curvature constraint (C)"
+    tip = "Toggle a curvature constraint at the mass point nearest the cursor (key C)"
+
+
+class _Paint(_Constraint):
+    which = "mass"
+
+    def Activated(self) -> None:
+        _ctl().paint(self.which)
+
+
+class PaintMass(_Paint):
+    which, icon_name, menu = "mass", "PaintMass", "Paint mass"
+    tip = "Airbrush: raise the mass map around the point nearest the cursor"
+
+
+class PaintDamping(_Paint):
+    which, icon_name, menu = "damping", "PaintDamping", "Paint damping"
+    tip = "Airbrush: raise the damping map around the point nearest the cursor"
+
+
+class PaintStiffness(_Paint):
+    which, icon_name, menu = "stiffness", "PaintStiffness", "Paint stiffness"
+    tip = "Airbrush: raise the stiffness map around the point nearest the cursor"
+
+
+class ShowMap(_SculptCommand):
+    icon_name, menu = "ShowMap", "Show map (M)"
+    tip = "Cycle the material map display in pseudo-colour: mass, damping, stiffness, off (key M toggles)"
+
+    def Activated(self) -> None:
+        from .gui import MAP_CYCLE
+        _ctl().cycle(MAP_CYCLE)
+
+
+class ShowCurvature(_SculptCommand):
+    icon_name, menu = "ShowCurvature", "Show curvature"
+    tip = "Cycle curvature displays: u green / v blue (as in the paper), mean, Gaussian, off"
+
+    def Activated(self) -> None:
+        from .gui import CURVATURE_CYCLE
+        _ctl().cycle(CURVATURE_CYCLE)
+
+
+class Combs(_SculptCommand):
+    icon_name, menu = "Combs", "Curvature combs"
+    tip = "Toggle curvature combs along the u and v iso-lines"
+
+    def Activated(self) -> None:
+        ov = _ctl().overlay()
+        if ov is not None:
+            ov.combs = not ov.combs
+            ov.refresh()
+
+
+class Zebra(_SculptCommand):
+    icon_name, menu = "Zebra", "Zebra stripes"
+    tip = "Toggle zebra stripes (reflection lines) for class-A continuity inspection"
+
+    def Activated(self) -> None:
+        ov = _ctl().overlay()
+        if ov is not None:
+            _ctl().set_display("shading" if ov.display == "zebra" else "zebra")
+
+
+class Panel(_SculptCommand):
+    icon_name, menu = "Panel", "Slider panel"
+    tip = "Toggle the 3D slider panel (mass, damping, stiffness, curvature targets), operated with the cursor"
+
+    def Activated(self) -> None:
+        ov = _ctl().overlay()
+        if ov is not None:
+            ov.panel_visible = not ov.panel_visible
+            ov.refresh()
+
+
+COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_SculptFace": SculptFace, "HapticSculpt_Session": Session,
+            "HapticSculpt_ToolRope": ToolRope, "HapticSculpt_ToolMagnet": ToolMagnet,
+            "HapticSculpt_MagnetFalloff": MagnetFalloff, "HapticSculpt_ToolOrientation": ToolOrientation,
+            "HapticSculpt_ToolSmooth": ToolSmooth, "HapticSculpt_PointConstraint": PointConstraint,
+            "HapticSculpt_NormalConstraint": NormalConstraint, "HapticSculpt_CurvatureConstraint": CurvatureConstraint,
+            "HapticSculpt_PaintMass": PaintMass, "HapticSculpt_PaintDamping": PaintDamping,
+            "HapticSculpt_PaintStiffness": PaintStiffness, "HapticSculpt_ShowMap": ShowMap,
+            "HapticSculpt_ShowCurvature": ShowCurvature, "HapticSculpt_Combs": Combs, "HapticSculpt_Zebra": Zebra,
+            "HapticSculpt_Panel": Panel, "HapticSculpt_Thicken": Thicken, "HapticSculpt_ExportStep": ExportStep}
+
+
 def register() -> None:
     """Adds every command to FreeCAD (called once from the workbench's Initialize)."""
-    for name, cls in (("HapticSculpt_NewPatch", NewPatch), ("HapticSculpt_SculptFace", SculptFace),
-                      ("HapticSculpt_Thicken", Thicken), ("HapticSculpt_ExportStep", ExportStep)):
+    for name, cls in COMMANDS.items():
         Gui.addCommand(name, cls())

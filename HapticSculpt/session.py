@@ -43,6 +43,9 @@ class Session:
         self._error = ""
         self._timer: Any = None
         self._frame_base: Any = None  # knots, weights, degrees for GUI frames (they do not change)
+        self._start_args: dict[str, Any] = {}
+        #: the newest pole snapshot the GUI received ((nu*nv, 3)), for overlays; None before one
+        self.latest_poles: np.ndarray | None = None
 
     # --- life cycle -------------------------------------------------------------------------------
     def start(self, obj: Any, device: Any, tool: str = "rope", haptic_rate: float = 1000.0,
@@ -68,6 +71,9 @@ class Session:
                                       max_stiffness=max_stiffness, stale_limit=stale_limit, log_seconds=record_seconds,
                                       stop_when_finished=stop_when_finished, realtime=realtime)
         self._runtime, self._obj, self._device, self._error = runtime, obj, native, ""
+        self._start_args = dict(device=device, tool=tool, haptic_rate=haptic_rate, sim_dt=sim_dt, max_force=max_force,
+                                max_stiffness=max_stiffness, stale_limit=stale_limit, record_seconds=record_seconds,
+                                stop_when_finished=stop_when_finished, realtime=realtime)
         proxy.session = self
         runtime.start()
         _ACTIVE.add(self)
@@ -97,6 +103,24 @@ class Session:
                 self._commit_final(obj)
         self._last_runtime = runtime  # logs stay readable (recording, force errors)
         return status
+
+    def edit(self, change: Any, title: str) -> Any:
+        """Applies ``change(surface)`` to the sculpted surface as one undo transaction. The
+        simulation owns the surface while the loops run, so they are stopped (strokes committed,
+        force to zero) for the edit and started again with the same device and settings."""
+        obj = self._obj
+        if obj is None:
+            raise RuntimeError("session: not running")
+        args = dict(self._start_args)
+        self.stop()
+        try:
+            result = change(obj.Proxy.surface)
+            from .api import _commit
+            _commit(obj, title)
+        finally:
+            args["tool"] = obj.Proxy.surface.tool.name
+            self.start(obj, **args)
+        return result
 
     @property
     def running(self) -> bool:
@@ -201,6 +225,7 @@ class Session:
             return
         poles = runtime.take_poles()
         if poles is not None and _alive(obj):
+            self.latest_poles = poles
             obj.Proxy.show_poles(poles, self._frame_base)
         self.poll()
 
@@ -248,3 +273,17 @@ class _Observer:
         for session in list(_ACTIVE):
             if session._obj is obj:
                 session.stop(commit=False)
+
+
+def edit_surface(obj: Any, change: Any, title: str) -> Any:
+    """Applies ``change(surface)`` to a sculpt object's surface as one undo transaction, through its
+    session when one runs (see :meth:`Session.edit`)."""
+    if not is_sculpt(obj):
+        raise TypeError(f"obj: expected a HapticSculpt Sculpt object, got {type(obj).__name__}")
+    session = getattr(obj.Proxy, "session", None)
+    if session is not None and session.running:
+        return session.edit(change, title)
+    result = change(obj.Proxy.surface)
+    from .api import _commit
+    _commit(obj, title)
+    return result

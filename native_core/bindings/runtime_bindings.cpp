@@ -286,6 +286,10 @@ void bindRuntime(py::module_& m) {
             d["estimate_age_ms"] = s.estimateAge * 1e3;
             d["realtime_priority"] = s.realtimePriority;
             d["error"] = s.error;
+            d["cursor"] = Vec3(s.cursor);
+            d["orientation"] = std::vector<double>{s.orientation.w(), s.orientation.x(), s.orientation.y(), s.orientation.z()};
+            d["grab"] = s.grab;
+            d["contact"] = s.contactValid ? py::cast(Vec3(s.contact)) : py::object(py::none());
             return d;
         })
         .def("take_poles", [](HapticRuntime& r) -> py::object {

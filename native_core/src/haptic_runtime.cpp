@@ -140,6 +140,13 @@ void HapticRuntime::hapticLoop() {
             for (int i = 0; i < 3; ++i) force_[i].store(rendered[i], std::memory_order_relaxed);
             estimateAge_.store(t - e.time, std::memory_order_relaxed);
             if (tickCount_ < ticks_.size()) ticks_[tickCount_++] = {t, sample, estimated, rendered};
+            if (finiteSample(sample)) {
+                ShownCursor shown;
+                shown.cursor = sample;
+                shown.contactValid = e.kind != EstimateKind::None && e.points > 0;
+                if (shown.contactValid) shown.contact = e.x[0];
+                shown_.write(shown);
+            }
             hapticTicks_.fetch_add(1, std::memory_order_relaxed);
             if (settings_.stopWhenFinished && device_->finished(t)) {
                 stopRequested_.store(true, std::memory_order_release);
@@ -264,6 +271,13 @@ RuntimeStatus HapticRuntime::status() const {
     s.refusedSteps = refused_.load(std::memory_order_relaxed);
     s.strokes = strokeCount_.load(std::memory_order_relaxed);
     s.droppedSimTime = droppedSimTime_.load(std::memory_order_relaxed);
+    shown_.update();
+    const ShownCursor& shown = shown_.front();
+    s.cursor = shown.cursor.position;
+    s.orientation = shown.cursor.orientation;
+    s.grab = (shown.cursor.buttons & 1u) != 0;
+    s.contactValid = shown.contactValid;
+    s.contact = shown.contact;
     if (s.elapsed > 0) {
         s.hapticHz = static_cast<double>(s.hapticTicks) / s.elapsed;
         s.simHz = static_cast<double>(s.simSteps) / s.elapsed;

@@ -44,6 +44,19 @@ struct RuntimeStatus {
     double estimateAge = 0;         ///< s: age of the snapshot the last tick used
     bool realtimePriority = false;
     std::string error;              ///< why the session stopped by itself ("" if it did not)
+    // for the GUI overlay: the last finite cursor and the tool's contact point (rope: the grabbed
+    // mesh point), as the haptic loop last saw them
+    Vec3 cursor = Vec3::Zero();
+    Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+    bool grab = false, contactValid = false;
+    Vec3 contact = Vec3::Zero();
+};
+
+/// What the haptic loop shows the GUI each tick (one writer, one reader: status()).
+struct ShownCursor {
+    DeviceSample cursor;
+    bool contactValid = false;
+    Vec3 contact = Vec3::Zero();
 };
 
 /// One haptic tick, kept when logging.
@@ -106,6 +119,7 @@ private:
     TripleBuffer<DeviceSample> cursor_;     // haptic -> simulation
     TripleBuffer<HapticEstimate> estimate_; // simulation -> haptic
     TripleBuffer<Points> poles_;            // simulation -> GUI
+    mutable TripleBuffer<ShownCursor> shown_;  // haptic -> GUI (status(): one reader)
 
     static constexpr int kStrokeSlots = 8;
     std::array<StrokeSnapshot, kStrokeSlots> strokes_;

@@ -213,6 +213,22 @@ TEST(HapticRuntime, NonFiniteDeviceInputNeverReachesTheSurfaceOrTheForce) {
     EXPECT_GT(s->poles().col(2).maxCoeff(), 1.0);  // the valid samples still lifted the surface
 }
 
+TEST(HapticRuntime, StatusShowsTheCursorAndTheRopeContactForTheOverlay) {
+    auto s = patch();
+    auto dev = std::make_shared<RecordingDevice>();
+    HapticRuntime rt(s, dev, RuntimeSettings{});
+    rt.start();
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    const RuntimeStatus st = rt.status();
+    rt.stop();
+    EXPECT_TRUE(st.grab);
+    EXPECT_GT(st.cursor.z(), 1.0);  // the device lifts the cursor 20 mm/s
+    EXPECT_NEAR(st.cursor.x(), 0.0, 1e-12);
+    ASSERT_TRUE(st.contactValid);   // the rope holds a mesh point
+    EXPECT_LT(st.contact.z(), st.cursor.z());
+    EXPECT_LT(std::abs(st.contact.x()) + std::abs(st.contact.y()), 10.0);  // the point under the cursor
+}
+
 TEST(HapticEstimate, SafetyLayerFadesStaleSnapshotsLimitsStiffnessAndClamps) {
     HapticEstimate e;
     e.kind = EstimateKind::Hold;

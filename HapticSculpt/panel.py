@@ -1,0 +1,128 @@
+"""The paper's 3D control panel, immediate-mode: sliders for mass, damping, stiffness and the
+curvature targets drawn in the scene beside the surface and operated with the cursor.
+
+Every frame :meth:`SliderPanel.draw` builds the panel from the current values and
+:meth:`SliderPanel.operate` reads the cursor: grabbing within reach of a slider's track takes that
+slider, moving along the track sets its value (shown at once), releasing commits it as one undo
+transaction. Nothing about the panel is retained but which slider is held.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+# name, label, low, high (log scale)
+SLIDERS = (("mass", "mass", 1e-2, 1e2), ("damping", "damping", 1e-2, 1e3), ("stiffness", "stiffness", 1e0, 1e5),
+           ("curvature_u", "curvature u (1/mm)", 1e-4, 1e-1), ("curvature_v", "curvature v (1/mm)", 1e-4, 1e-1))
+
+
+class SliderPanel:
+    """Vertical sliders standing beside the patch on its -x side."""
+
+    def __init__(self) -> None:
+        self.held: str | None = None
+        self.pending: float | None = None  # the held slider's value while dragging
+        self._tracks: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+
+    # --- values -----------------------------------------------------------------------------------
+    @staticmethod
+    def value(obj: Any, name: str) -> float:
+        s = obj.Proxy.surface
+        if name in ("mass", "damping", "stiffness"):
+            return float(np.mean(getattr(s, name + "_map").values))
+        curv = [c for c in s.constraints if c["kind"] == "curvature"]
+        if not curv:
+            return 0.0
+        return float(curv[-1]["curvature"][0 if name == "curvature_u" else 1])
+
+    @staticmethod
+    def apply(obj: Any, name: str, value: float) -> None:
+        from .session import edit_surface
+
+        def change(s: Any) -> None:
+            if name in ("mass", "damping", "stiffness"):
+                getattr(s, name + "_map").set_uniform(value)
+                return
+            curv = [c for c in s.constraints if c["kind"] == "curvature"]
+            if curv:
+                ku, kv = curv[-1]["curvature"]
+                s.set_constraint_curvature(curv[-1]["id"], value if name == "curvature_u" else ku,
+                                           value if name == "curvature_v" else kv)
+        edit_surface(obj, change, f"Set {name.replace('_', ' ')}")
+
+    # --- geometry ---------------------------------------------------------------------------------
+    def layout(self, mesh: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """Track end points of each slider: bottom and top, in a row on the patch's -x side."""
+        flat = mesh.reshape(-1, 3)
+        lo, hi = flat.min(0), flat.max(0)
+        size = float(np.linalg.norm(hi - lo)) or 1.0
+        x = lo[0] - 0.12 * size
+        tracks = {}
+        for k, (name, _, _, _) in enumerate(SLIDERS):
+            y = lo[1] + (k + 0.5) * (hi[1] - lo[1]) / len(SLIDERS)
+            tracks[name] = (np.array([x, y, lo[2]]), np.array([x, y, lo[2] + 0.4 * size]))
+        self._tracks = tracks
+        return tracks
+
+    @staticmethod
+    def fraction(name: str, value: float) -> float:
+        _, _, low, high = next(s for s in SLIDERS if s[0] == name)
+        if value <= 0:
+            return 0.0
+        return float(np.clip((math.log10(value) - math.log10(low)) / (math.log10(high) - math.log10(low)), 0, 1))
+
+    @staticmethod
+    def from_fraction(name: str, f: float) -> float:
+        _, _, low, high = next(s for s in SLIDERS if s[0] == name)
+        return 10 ** (math.log10(low) + float(np.clip(f, 0, 1)) * (math.log10(high) - math.log10(low)))
+
+    # --- immediate mode ---------------------------------------------------------------------------
+    def operate(self, cursor: np.ndarray, grab: bool, obj: Any) -> None:
+        """Reads the cursor: takes, drags or releases a slider."""
+        if not self._tracks:
+            return
+        if grab and self.held is None:
+            reach = 0.06 * max(float(np.linalg.norm(b - a)) for a, b in self._tracks.values())
+            best = min(self._tracks, key=lambda n: _distance_to_segment(cursor, *self._tracks[n]))
+            if _distance_to_segment(cursor, *self._tracks[best]) <= reach:
+                self.held = best
+        if self.held is not None:
+            a, b = self._tracks[self.held]
+            f = float(np.dot(cursor - a, b - a) / max(np.dot(b - a, b - a), 1e-300))
+            self.pending = self.from_fraction(self.held, f)
+            if not grab:
+                name, value = self.held, self.pending
+                self.held, self.pending = None, None
+                self.apply(obj, name, value)
+
+    def draw(self, obj: Any, mesh: np.ndarray) -> Any:
+        from pivy import coin
+
+        from .overlay import _lines, _material, _sphere
+        sep = coin.SoSeparator()
+        tracks = self.layout(mesh)
+        size = float(np.linalg.norm(mesh.reshape(-1, 3).max(0) - mesh.reshape(-1, 3).min(0))) or 1.0
+        for name, label, _, _ in SLIDERS:
+            a, b = tracks[name]
+            value = self.pending if self.held == name and self.pending is not None else self.value(obj, name)
+            knob = a + self.fraction(name, value) * (b - a)
+            sep.addChild(_lines(np.array([[a, b]]), (0.7, 0.7, 0.7), 2.0))
+            sep.addChild(_sphere(knob, 0.015 * size, (1.0, 0.6, 0.0) if self.held == name else (0.3, 0.8, 1.0)))
+            text = coin.SoSeparator()
+            text.addChild(_material((1.0, 1.0, 1.0)))
+            tr = coin.SoTranslation()
+            tr.translation = tuple(float(x) for x in b + [0.0, 0.0, 0.03 * size])
+            text.addChild(tr)
+            t2 = coin.SoText2()
+            t2.string = f"{label} {value:.3g}"
+            text.addChild(t2)
+            sep.addChild(text)
+        return sep
+
+
+def _distance_to_segment(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    ab = b - a
+    t = float(np.clip(np.dot(p - a, ab) / max(np.dot(ab, ab), 1e-300), 0.0, 1.0))
+    return float(np.linalg.norm(p - (a + t * ab)))
