@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from . import core
-from .overlay import Overlay
+from .overlay import Overlay, readable_surface
 
 MAP_CYCLE = ("mass", "damping", "stiffness")
 CURVATURE_CYCLE = ("curvature", "mean", "gauss")
@@ -130,8 +130,8 @@ class Controller:
         obj, at = self.active_sculpt(), self.cursor()
         if obj is None or at is None:
             raise RuntimeError("no sculpt or no cursor: move the mouse over a sculpt first")
-        index = int(obj.Proxy.surface.nearest_mesh_index(list(at)))
-        existing = [c for c in obj.Proxy.surface.constraints if c["kind"] == kind and c["index"] == index]
+        index = int(self._nearest(obj, at))
+        existing = [c for c in readable_surface(obj).constraints if c["kind"] == kind and c["index"] == index]
         if existing:
             edit_surface(obj, lambda s: s.remove_constraint(existing[0]["id"]), f"Remove {kind} constraint")
             result = "removed"
@@ -148,8 +148,8 @@ class Controller:
         obj, at = self.active_sculpt(), self.cursor()
         if obj is None or at is None:
             raise RuntimeError("no sculpt or no cursor: move the mouse over a sculpt first")
-        s = obj.Proxy.surface
-        uv = s.mesh_parameters(int(s.nearest_mesh_index(list(at))))
+        s = readable_surface(obj)
+        uv = s.mesh_parameters(int(self._nearest(obj, at)))
         (u0, u1), (v0, v1) = s.surface.domain
         uvn = ((uv[0] - u0) / (u1 - u0), (uv[1] - v0) / (v1 - v0))
         m = getattr(s, which + "_map")
@@ -158,6 +158,12 @@ class Controller:
                      f"Paint {which}")
         self.last_map = which
         self.refresh(obj)
+
+    def _nearest(self, obj: Any, at: np.ndarray) -> int:
+        """Mass point nearest `at` on the newest shape (the overlay's copy: never the stepped surface)."""
+        ov = self.overlay(obj)
+        surface = ov.scratch() if ov is not None else readable_surface(obj)
+        return int(surface.nearest_mesh_index(list(at)))
 
     def set_display(self, display: str) -> None:
         ov = self.overlay()
@@ -217,7 +223,7 @@ class Controller:
                 if view is not None:
                     device.attach(view)
         self.mouse = device if isinstance(device, MouseDevice) else None
-        self.session = Session().start(obj, device, tool=obj.Proxy.surface.tool.name)
+        self.session = Session().start(obj, device, tool=readable_surface(obj).tool.name)
         self.refresh(obj)
         return self.session
 

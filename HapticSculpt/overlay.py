@@ -11,6 +11,7 @@ off. No Qt: everything is pivy.
 """
 from __future__ import annotations
 
+import functools
 import math
 import time
 from typing import Any
@@ -22,6 +23,17 @@ from .panel import SliderPanel
 
 DISPLAYS = ("shading", "mass", "damping", "stiffness", "curvature", "mean", "gauss", "zebra")
 JACK_COLOURS = {"point": (1.0, 0.0, 0.0), "tangent": (1.0, 0.5, 0.0), "normal": (0.0, 0.3, 1.0), "curvature": (1.0, 1.0, 1.0)}
+
+
+def readable_surface(obj: Any) -> core.DynamicSurface:
+    """The sculpt's core surface for reading what the simulation never writes (the B-spline's knots
+    and degrees, material maps, constraints, tool settings), also while a session steps it. Its
+    poles and mesh move under a session: take those from :meth:`Overlay.scratch`."""
+    proxy = obj.Proxy
+    session = getattr(proxy, "session", None)
+    if session is not None and session.running and getattr(proxy, "_surface", None) is not None:
+        return proxy._surface
+    return proxy.surface
 
 
 class Overlay:
@@ -80,16 +92,18 @@ class Overlay:
             self.stop()
 
     # --- state ------------------------------------------------------------------------------------
-    def _surface(self) -> core.DynamicSurface:
+    def scratch(self) -> core.DynamicSurface:
         """A private analysis surface holding the newest poles (the session's snapshot while one
         runs, else the object's), so the GUI never reads the surface the simulation steps."""
-        live = self.obj.Proxy.surface
+        live = readable_surface(self.obj)
         session = getattr(self.obj.Proxy, "session", None)
-        poles = getattr(session, "latest_poles", None) if session is not None and session.running else None
+        running = session is not None and session.running
+        poles = getattr(session, "latest_poles", None) if running else None
         if self._scratch is None or self._scratch.mesh.shape != live.mesh.shape or \
                 self._scratch.poles.shape != live.poles.shape:
             self._scratch = core.DynamicSurface(live.surface, live.mesh.shape[:2])
-        self._scratch.set_poles(np.asarray(poles if poles is not None else live.poles).reshape(live.poles.shape))
+        if poles is not None or not running:  # (before a session's first snapshot: the shape it started from)
+            self._scratch.set_poles(np.asarray(poles if poles is not None else live.poles).reshape(live.poles.shape))
         return self._scratch
 
     def _update_cursor(self) -> None:
@@ -109,9 +123,9 @@ class Overlay:
             self.stop()
             return
         self._update_cursor()
-        s = self._surface()
+        s = self.scratch()
         mesh = np.array(s.mesh)
-        live = self.obj.Proxy.surface
+        live = readable_surface(self.obj)
         scene = coin.SoSeparator()
         light = coin.SoLightModel()
         light.model = coin.SoLightModel.BASE_COLOR
@@ -158,7 +172,7 @@ class Overlay:
         flat = mesh.reshape(-1, 3)
         size = float(np.linalg.norm(flat.max(0) - flat.min(0))) or 1.0
         r = 0.03 * size
-        normals = analysis.vertex_normals(mesh).reshape(-1, 3)
+        g, h = mesh.shape[:2]
         for c in live.constraints:
             p = flat[c["index"]]
             kind = c["kind"]
@@ -170,8 +184,8 @@ class Overlay:
                 n = np.asarray(c["target"], float)
                 sep.addChild(_lines(np.array([[p, p + 3 * r * n]]), colour, 3.0))
             else:
-                n = normals[c["index"]]
-                sep.addChild(_circle(p, n, r, colour))
+                i, j = divmod(c["index"], h)
+                sep.addChild(_circle(p, _frame(*_tangents(mesh, i, j))[:, 2], r, colour))
         return sep
 
     def _cursor(self, s: core.DynamicSurface, mesh: np.ndarray) -> Any:
@@ -183,11 +197,8 @@ class Overlay:
         sep.addChild(_sphere(pos, 0.02 * size, (1.0, 0.85, 0.0) if grab else (0.9, 0.9, 0.9)))
         sep.addChild(_axes(pos, _rotation(quat), 0.06 * size))
         nearest = int(s.nearest_mesh_index(list(pos)))
-        g, h = mesh.shape[:2]
-        i, j = divmod(nearest, h)
-        du = np.gradient(mesh, axis=0)[i, j]
-        dv = np.gradient(mesh, axis=1)[i, j]
-        frame = _frame(du, dv)
+        i, j = divmod(nearest, mesh.shape[1])
+        frame = _frame(*_tangents(mesh, i, j))
         point = flat[nearest]
         sep.addChild(_sphere(point, 0.012 * size, (0.2, 1.0, 0.2)))
         sep.addChild(_axes(point, frame, 0.05 * size))
@@ -261,6 +272,14 @@ def _rotation(quat: np.ndarray) -> np.ndarray:
                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
+def _tangents(mesh: np.ndarray, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
+    """Mesh tangents along u and v at point (i, j) by differences (one-sided at the border)."""
+    g, h = mesh.shape[:2]
+    du = mesh[min(i + 1, g - 1), j] - mesh[max(i - 1, 0), j]
+    dv = mesh[i, min(j + 1, h - 1)] - mesh[i, max(j - 1, 0)]
+    return du, dv
+
+
 def _frame(du: np.ndarray, dv: np.ndarray) -> np.ndarray:
     u = du / (np.linalg.norm(du) or 1.0)
     n = np.cross(du, dv)
@@ -291,14 +310,19 @@ def _coloured_mesh(mesh: np.ndarray, colours: np.ndarray) -> Any:
     coords = coin.SoCoordinate3()
     coords.point.setValues(0, g * h, mesh.reshape(-1, 3).tolist())
     sep.addChild(coords)
-    i, j = np.meshgrid(np.arange(g - 1), np.arange(h - 1), indexing="ij")
-    a = (i * h + j).ravel()
-    quads = np.stack([a, a + h, a + h + 1, a + 1, np.full_like(a, -1)], axis=1).ravel()
+    quads = _quad_indices(g, h)
     faces = coin.SoIndexedFaceSet()
-    faces.coordIndex.setValues(0, len(quads), quads.tolist())
-    faces.materialIndex.setValues(0, len(quads), quads.tolist())
+    faces.coordIndex.setValues(0, len(quads), quads)  # (materialIndex empty: colours follow coordIndex)
     sep.addChild(faces)
     return sep
+
+
+@functools.lru_cache(maxsize=8)
+def _quad_indices(g: int, h: int) -> list[int]:
+    """Face indices of a g x h grid as quads (-1 separated); the same every frame, so made once."""
+    i, j = np.meshgrid(np.arange(g - 1), np.arange(h - 1), indexing="ij")
+    a = (i * h + j).ravel()
+    return np.stack([a, a + h, a + h + 1, a + 1, np.full_like(a, -1)], axis=1).ravel().tolist()
 
 
 def _legend(mesh: np.ndarray, display: str, rng: tuple[float, float]) -> Any:

@@ -29,7 +29,8 @@ class SliderPanel:
     # --- values -----------------------------------------------------------------------------------
     @staticmethod
     def value(obj: Any, name: str) -> float:
-        s = obj.Proxy.surface
+        from .overlay import readable_surface
+        s = readable_surface(obj)
         if name in ("mass", "damping", "stiffness"):
             return float(np.mean(getattr(s, name + "_map").values))
         curv = [c for c in s.constraints if c["kind"] == "curvature"]

@@ -91,7 +91,7 @@ try:
     out["undo"] = doc.UndoNames[:8]
     # A replay stroke through the session path the mouse and the devices use.
     ov = ctl.overlay(obj)
-    stroke = hs.ReplayDevice.stroke((0, 0, 0), (0, 0, 30.0), seconds=0.8, hold=3.0)
+    stroke = hs.ReplayDevice.stroke((0, 0, 0), (0, 0, 30.0), seconds=0.8, hold=0.8)
     ctl.start_session(stroke)
     pump(1.0)
     out["session_running"] = ctl.session.running
@@ -102,6 +102,7 @@ try:
         ov.frame()
         frames.append(ov.frame_ms)
     out["frame_ms_session"] = float(np.median(frames))
+    pump(1.0)  # the stroke ends (released) and is committed by the session's timer
     ctl.stop_session()
     out["strokes"] = obj.Strokes
     ov.cursor = None
