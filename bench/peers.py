@@ -229,7 +229,7 @@ def main() -> None:
                     continue
                 x, us = ours(n, integ, DT, STEPS, **st)
                 mine.append((error(x, ref), us, f"{integ} {st}", "controls" not in st))
-            print(f"\n{n}x{n} grid, ours: " + ", ".join(f"{lbl}: {us:.0f} us, err {e:.1e}" for e, us, lbl in mine))
+            print(f"\n{n}x{n} grid, ours: " + ", ".join(f"{lbl}: {us:.0f} us, err {e:.1e}" for e, us, lbl, _ in mine))
             for name, run in progress(PEERS, f"peers {n}x{n}"):
                 try:
                     x, us = run(n, masses)

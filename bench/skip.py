@@ -53,7 +53,9 @@ VARIANTS = {
     "painted maps": paint,
     "maps painted then uniform again": lambda s: (paint(s), [m.set_uniform(m.values.mean()) for m in
                                                             (s.mass_map, s.damping_map, s.stiffness_map)]),
-    "4 constraints": constrain,
+    "point, normal, tangent constraints": lambda s: [s.add_constraint(k, uv=uv) for k, uv in
+                                                     (("point", (0.1, 0.1)), ("normal", (0.8, 0.2)), ("tangent", (0.2, 0.8)))],
+    "4 constraints (curvature: energy guard on)": constrain,
     "constraints added then removed": lambda s: [s.remove_constraint(c) for c in constrain(s)],
     "non-linear laws": nonlinear,
     "laws set back to linear": lambda s: (nonlinear(s), s.set_stiffness_law("linear"), s.set_damping_law("linear")),

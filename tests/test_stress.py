@@ -68,5 +68,9 @@ def test_plain_local_global_scene_runs_no_guard():
     s.step(1e-3)
     assert s.energy_ceiling == 0.0  # pay only for what the scene has
     s.add_constraint("point", index=0)
+    s.add_constraint("normal", index=40)
+    s.step(1e-3)
+    assert s.energy_ceiling == 0.0  # convex projections keep local/global's guarantee
+    s.add_constraint("curvature", index=50, curvature=(0.01, 0.01))
     s.step(1e-3)
     assert s.energy_ceiling > 0.0

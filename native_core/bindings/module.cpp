@@ -459,7 +459,7 @@ PYBIND11_MODULE(_core, m) {
         .def_property("energy_guard", [](const DynamicSurface& s) { return s.energyGuard.enabled; },
                       [](DynamicSurface& s, bool e) { s.energyGuard.enabled = e; s.wake(); },
                       "keep kinetic + potential energy within (1 + energy_slack) x (energy at the last change + work "
-                      "put in); runs for explicit, implicit, non-linear laws and constraints")
+                      "put in); runs for explicit, implicit, non-linear laws, curvature constraints and very long steps")
         .def_property("energy_slack", [](const DynamicSurface& s) { return s.energyGuard.slack; },
                       [](DynamicSurface& s, double x) { checkParam(x, "energy_slack", true); s.energyGuard.slack = x; })
         .def_property_readonly("energy_ceiling", &DynamicSurface::energyCeiling,

@@ -35,6 +35,13 @@ public:
     ConstraintSet(int g, int h) : g_(g), h_(h) {}
 
     bool empty() const { return items_.empty(); }
+    /// True if any constraint's projection is onto a non-convex set (curvature: arcs); point,
+    /// tangent and normal project onto points, fixed offsets and planes.
+    bool anyNonConvex() const {
+        for (const Constraint& c : items_)
+            if (c.kind == ConstraintKind::Curvature) return true;
+        return false;
+    }
     int size() const { return static_cast<int>(items_.size()); }
     const std::vector<Constraint>& items() const { return items_; }
     /// Increments when the term structure (which points, which stiffness) changes: the

@@ -275,7 +275,8 @@ StepReport DynamicSurface::step(double dt) {
 
 bool DynamicSurface::guardsEnergy(double dt) const {
     if (!energyGuard.enabled) return false;
-    if (solver.kind != IntegratorKind::LocalGlobal || springs_.law.kind != LawKind::Linear || !constraints_.empty())
+    // Point, tangent and normal constraints project onto convex sets, so they keep the guarantee.
+    if (solver.kind != IntegratorKind::LocalGlobal || springs_.law.kind != LawKind::Linear || constraints_.anyNonConvex())
         return true;
     // Local/global's descent guarantee is exact arithmetic's: the solve's rounding grows with the
     // system's stiffness-to-mass ratio (~ dt^2 8 k_max / m_min, Gershgorin), and past 1e8 it can
@@ -288,7 +289,9 @@ bool DynamicSurface::limitEnergy(double work, StepReport& r) {
     const double ceiling = ceiling_ + std::max(0.0, work);
     // Below this floor energy is rounding noise: 1e-12 of a surface-sized stretch at the mean stiffness.
     const double floor = 1e-12 * stiffness_.mean() * size_ * size_;
-    const double ke = kineticEnergy(), pe = potentialEnergy();
+    // Local/global keeps A v (av_): the kinetic energy without a product by A.
+    const double ke = avValid_ ? 0.5 * (m_.asDiagonal() * av_).cwiseProduct(av_).sum() : kineticEnergy();
+    const double pe = potentialEnergy();
     if (ke + pe <= (1 + energyGuard.slack) * ceiling + floor) {
         ceiling_ = ceiling;
         return true;

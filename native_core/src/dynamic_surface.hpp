@@ -48,8 +48,9 @@ struct SolverSettings {
 /// potential energy alone is past it is refused (positions kept, motion stopped). Local/global on
 /// linear springs is a descent method on backward Euler's incremental potential and needs no guard,
 /// so it runs only where that does not hold: the explicit and linearised implicit schemes, non-linear
-/// spring laws, constraints, and steps so long for the stiffness and mass that rounding in the
-/// solve is no longer negligible.
+/// spring laws, curvature constraints (projections onto arcs, a non-convex set; point, tangent and
+/// normal constraints project onto convex sets), and steps so long for the stiffness and mass that
+/// rounding in the solve is no longer negligible.
 struct EnergyGuardSettings {
     bool enabled = true;
     double slack = 0.25;

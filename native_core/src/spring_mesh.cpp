@@ -215,10 +215,31 @@ void SpringMesh::addLaplacian(std::vector<Eigen::Triplet<double>>& t) const {
 }
 
 double SpringMesh::energy(const Points& d) const {
+    if (law.kind != LawKind::Linear) {
+        double e = 0;
+        for (size_t s = 0; s < a_.size(); ++s)
+            e += law.energy(stiffness(static_cast<int>(s)), (d.row(a_[s]) - d.row(b_[s])).norm() - rest_[s]);
+        return e;
+    }
+    // Linear springs run by run (contiguous endpoints), branch-free, so the loop vectorises: the
+    // energy guard calls this every step of the scenes it watches.
+    const double* D = d.data();
+    const bool uniform = k_.empty();
     double e = 0;
-    for (size_t s = 0; s < a_.size(); ++s)
-        e += law.energy(stiffness(static_cast<int>(s)), (d.row(a_[s]) - d.row(b_[s])).norm() - rest_[s]);
-    return e;
+    for (const Run& run : runs_) {
+        const double* pa = D + 3 * run.a0;
+        const double* pb = pa + 3 * run.offset;
+        const double* r = rest_.data() + run.first;
+        const double* kr = uniform ? nullptr : k_.data() + run.first;
+        double sum = 0;
+        for (int j = 0; j < run.length; ++j) {
+            const double dx = pb[3 * j] - pa[3 * j], dy = pb[3 * j + 1] - pa[3 * j + 1], dz = pb[3 * j + 2] - pa[3 * j + 2];
+            const double x = std::sqrt(dx * dx + dy * dy + dz * dz) - r[j];
+            sum += (uniform ? kUniform_ : kr[j]) * x * x;
+        }
+        e += sum;
+    }
+    return 0.5 * e;
 }
 
 }  // namespace hs
