@@ -106,9 +106,17 @@ try:
     ctl.stop_session()
     out["strokes"] = obj.Strokes
     ov.cursor = None
-    for display, name in (("curvature", "curvature"), ("stiffness", "map"), ("zebra", "zebra"),
-                          ("mean", "mean"), ("gauss", "gauss")):
-        ctl.set_display(display)
+    # the display commands, each pressed as a user would: ShowCurvature cycles curvature, mean,
+    # Gaussian; ShowMap cycles mass, damping, stiffness; Zebra toggles
+    presses = [("HapticSculpt_ShowCurvature", "curvature"), ("HapticSculpt_ShowCurvature", "mean"),
+               ("HapticSculpt_ShowCurvature", "gauss"), ("HapticSculpt_ShowMap", None),
+               ("HapticSculpt_ShowMap", None), ("HapticSculpt_ShowMap", "map"), ("HapticSculpt_Zebra", "zebra")]
+    out["displays"] = []
+    for command, name in presses:
+        Gui.runCommand(command)
+        out["displays"].append(ov.display)
+        if name is None:
+            continue
         frames = []
         for _ in range(20):
             ov.frame()
@@ -175,6 +183,7 @@ def test_overlay_commands_keys_and_pictures(tmp_path):
     assert out["session_running"] and out["cursor"][2] > 10.0
     assert out["strokes"] >= 1
     assert out["panel_stiffness"] > 5e4 and out["undo_after_panel"] == "Set stiffness"
+    assert out["displays"] == ["curvature", "mean", "gauss", "mass", "damping", "stiffness", "zebra"]
     assert out["m_key"] == "stiffness" and out["m_key_back"] == "shading" and not out["timer_after_off"]
     import matplotlib.image as mpimg
 
