@@ -198,26 +198,34 @@ class CurvatureConstraint(_Constraint):
     tip = "Toggle a curvature constraint at the mass point nearest the cursor (key C)"
 
 
-class _Paint(_Constraint):
+class _Paint(_SculptCommand):
+    """Airbrush: without a session, switches spraying this map with the left button on or off;
+    with one, a single dab at the device's cursor."""
+
     which = "mass"
 
     def Activated(self) -> None:
-        _ctl().paint(self.which)
+        ctl = _ctl()
+        if ctl.session is not None and ctl.session.running:
+            ctl.paint(self.which)
+        else:
+            state = ctl.set_painting(self.which)
+            FreeCAD.Console.PrintMessage(f"HapticSculpt: airbrush {'on: ' + state if state else 'off'}\n")
 
 
 class PaintMass(_Paint):
     which, icon_name, menu = "mass", "PaintMass", "Paint mass"
-    tip = "Airbrush: raise the mass map around the point nearest the cursor"
+    tip = "Airbrush on the mass map: hold the left button and move over the surface (during a session: one dab at the cursor)"
 
 
 class PaintDamping(_Paint):
     which, icon_name, menu = "damping", "PaintDamping", "Paint damping"
-    tip = "Airbrush: raise the damping map around the point nearest the cursor"
+    tip = "Airbrush on the damping map: hold the left button and move over the surface (during a session: one dab at the cursor)"
 
 
 class PaintStiffness(_Paint):
     which, icon_name, menu = "stiffness", "PaintStiffness", "Paint stiffness"
-    tip = "Airbrush: raise the stiffness map around the point nearest the cursor"
+    tip = "Airbrush on the stiffness map: hold the left button and move over the surface (during a session: one dab at the cursor)"
 
 
 class ShowMap(_SculptCommand):

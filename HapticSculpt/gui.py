@@ -5,6 +5,11 @@ The cursor: with a session running it is the device's (the haptic loop's last sa
 it follows the mouse over the surface (or the view's focal plane off it), so constraints and paint
 dabs go to the mass point nearest the mouse. Keys as in paper section 5: P, N, C toggle a point,
 normal or curvature constraint at the nearest point; M switches between shading and the map display.
+
+Airbrush: a paint command switches painting of that map on (again: off). Without a session, holding
+the left button sprays dabs along the mouse path, shown live in the map display, and the release
+makes the whole stroke one undo step; with a session, each paint command or key press is one dab
+at the device's cursor (the loops own the surface: see Session.edit).
 """
 from __future__ import annotations
 
@@ -31,6 +36,8 @@ class Controller:
         self._view: Any = None
         self._callbacks: list[tuple[Any, Any]] = []
         self.last_map = "mass"
+        self.painting: str | None = None  # the map the airbrush paints, None when off
+        self._paint_stroke: Any = None  # the sculpt being painted while the button is held
         self.tool = "rope"
         self.falloff = "spherical"
 
@@ -83,7 +90,8 @@ class Controller:
             return
         self.detach()
         self._view = view
-        for event, handler in ((coin.SoLocation2Event, self._on_move), (coin.SoKeyboardEvent, self._on_key)):
+        for event, handler in ((coin.SoLocation2Event, self._on_move), (coin.SoKeyboardEvent, self._on_key),
+                               (coin.SoMouseButtonEvent, self._on_button)):
             self._callbacks.append((event, view.addEventCallbackPivy(event.getClassTypeId(), handler)))
 
     def detach(self) -> None:
@@ -108,7 +116,63 @@ class Controller:
         self.mouse_point = self.point_at(self._view, int(pos[0]), int(pos[1]))
         ov = self.overlay()
         if ov is not None and not (self.session is not None and self.session.running):
-            ov.cursor = (self.mouse_point, np.array([1.0, 0, 0, 0]), False)
+            ov.cursor = (self.mouse_point, np.array([1.0, 0, 0, 0]), self._paint_stroke is not None)
+        if self._paint_stroke is not None:
+            self._dab(self._paint_stroke, self.mouse_point)
+            cb.setHandled()
+
+    def _on_button(self, cb: Any) -> None:
+        from pivy import coin
+        event = cb.getEvent()
+        if self.painting is None or event.getButton() != coin.SoMouseButtonEvent.BUTTON1:
+            return
+        if self.session is not None and self.session.running:
+            return  # the left button belongs to the session's mouse device then
+        if event.getState() == coin.SoButtonEvent.DOWN:
+            pos = event.getPosition()
+            self.mouse_point = self.point_at(self._view, int(pos[0]), int(pos[1]))
+            self.begin_paint_stroke()
+        else:
+            self.end_paint_stroke()
+        cb.setHandled()
+
+    # --- the airbrush ------------------------------------------------------------------------------
+    def set_painting(self, which: str | None) -> str | None:
+        """Switches the airbrush to map `which` (off if it was already on, or for None); shows the map."""
+        if which is not None and which not in MAP_CYCLE:
+            raise ValueError(f"which: one of {', '.join(MAP_CYCLE)}")
+        self.painting = None if which is None or which == self.painting else which
+        if self.painting is not None:
+            self.set_display(self.painting)
+        return self.painting
+
+    def begin_paint_stroke(self) -> None:
+        """Button down with the airbrush on: the first dab at the cursor."""
+        obj = self.active_sculpt()
+        if obj is None or self.painting is None or self.mouse_point is None:
+            return
+        self._paint_stroke = obj
+        self._dab(obj, self.mouse_point)
+
+    def end_paint_stroke(self) -> None:
+        """Button up: the stroke's dabs become one undo step."""
+        obj, self._paint_stroke = self._paint_stroke, None
+        if obj is not None:
+            from .api import _commit
+            _commit(obj, f"Paint {self.painting}")
+            self.refresh(obj)
+
+    def _dab(self, obj: Any, at: np.ndarray, radius: float = 0.08, strength: float = 0.25, factor: float = 3.0) -> None:
+        """One airbrush dab on the painted map around the mass point nearest `at` (no session runs)."""
+        s = obj.Proxy.surface
+        uv = s.mesh_parameters(int(self._nearest(obj, at)))
+        (u0, u1), (v0, v1) = s.surface.domain
+        m = getattr(s, self.painting + "_map")  # (a uniform map gets a paint resolution on its first dab)
+        target = factor * float(np.median(m.values))
+        m.dab(((uv[0] - u0) / (u1 - u0), (uv[1] - v0) / (v1 - v0)), radius, target, "spherical", strength)
+        ov = self.overlay(obj)
+        if ov is not None:
+            ov.frame()
 
     def _on_key(self, cb: Any) -> None:
         from pivy import coin

@@ -78,9 +78,36 @@ try:
     ctl._on_key(FakeCallback(coin.SoKeyboardEvent.P))
     ctl._on_key(FakeCallback(coin.SoKeyboardEvent.P))  # again: removes it
     out["constraints"] = sorted(c["kind"] for c in surface.constraints)
+    # the airbrush: switched on by the command, a left-button stroke across the view, one undo step
+    Gui.runCommand("HapticSculpt_PaintStiffness")
+    out["painting"] = ctl.painting
+    class FakeMouse:
+        def __init__(self, event):
+            self.event = event
+        def getEvent(self):
+            return self.event
+        def setHandled(self):
+            pass
+    def button(state, x, y):
+        e = coin.SoMouseButtonEvent()
+        e.setButton(coin.SoMouseButtonEvent.BUTTON1)
+        e.setState(state)
+        e.setPosition(coin.SbVec2s(x, y))
+        ctl._on_button(FakeMouse(e))
+    def move(x, y):
+        e = coin.SoLocation2Event()
+        e.setPosition(coin.SbVec2s(x, y))
+        ctl._on_move(FakeMouse(e))
+    w, hgt = view.getSize()
+    undo_before = doc.UndoCount
+    button(coin.SoButtonEvent.DOWN, w // 2 - 60, hgt // 2)
+    for k in range(1, 13):
+        move(w // 2 - 60 + 10 * k, hgt // 2)
+    button(coin.SoButtonEvent.UP, w // 2 + 60, hgt // 2)
+    out["paint_undo_steps"] = doc.UndoCount - undo_before
+    Gui.runCommand("HapticSculpt_PaintStiffness")
+    out["painting_after"] = ctl.painting
     ctl.mouse_point = mesh[g // 2, h // 2]
-    Gui.runCommand("HapticSculpt_PaintStiffness")
-    Gui.runCommand("HapticSculpt_PaintStiffness")
     out["stiffness_range"] = [float(np.min(surface.stiffness_map.values)), float(np.max(surface.stiffness_map.values))]
     for name, cls in commands.COMMANDS.items():
         out["active"][name] = bool(cls().IsActive())
@@ -177,6 +204,8 @@ def test_overlay_commands_keys_and_pictures(tmp_path):
     selection_based = {"HapticSculpt_SculptFace", "HapticSculpt_Thicken", "HapticSculpt_ExportStep"}
     assert all(v for k, v in out["active"].items() if k not in selection_based), out["active"]
     assert out["constraints"] == ["curvature", "normal", "point"]
+    assert out["painting"] == "stiffness" and out["painting_after"] is None
+    assert out["paint_undo_steps"] == 1  # a whole airbrush stroke is one undo step
     assert out["stiffness_range"][1] > 2 * out["stiffness_range"][0]
     assert out["magnet"] == ["magnet", "cylindrical"]
     assert {"Add point constraint", "Paint stiffness", "Tool: rope"} <= set(out["undo"]), out["undo"]
