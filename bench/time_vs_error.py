@@ -184,9 +184,10 @@ def static_reference() -> tuple[list[np.ndarray], float]:
     return [np.array(s.mesh)], residual
 
 
-def timed_run(scene: str, integrator: str, settings: dict, dt: float) -> tuple[float, list[np.ndarray], bool]:
+def timed_run(scene: str, integrator: str, settings: dict, dt: float) -> tuple[float, list[np.ndarray]]:
+    """Wall seconds per simulated second (median of 3 for short runs) and the run's snapshots."""
     build, play, seconds, _ = SCENES[scene]
-    times, snaps, clean = [], None, True
+    times, snaps = [], []
     for _ in range(3):
         s = configure(build(), integrator, settings)
         t0 = time.perf_counter()
@@ -194,7 +195,7 @@ def timed_run(scene: str, integrator: str, settings: dict, dt: float) -> tuple[f
         times.append(time.perf_counter() - t0)
         if times[-1] > 0.5:  # long runs once: noise is small next to them
             break
-    return float(np.median(times)) / seconds, snaps, clean
+    return float(np.median(times)) / seconds, snaps
 
 
 def pareto_table(records: list[dict]) -> list[dict]:
@@ -252,7 +253,7 @@ def main() -> None:
     records: list[dict] = []
     try:
         for scene, label, integ, settings, dt in progress(jobs, "runs"):
-            sps, snaps, _ = timed_run(scene, integ, settings, dt)
+            sps, snaps = timed_run(scene, integ, settings, dt)
             size = 100.0 * math.sqrt(2)
             err = max(float(np.abs(a - b).max()) for a, b in zip(snaps, refs[scene])) / size
             records.append({"scene": scene, "solver": label, "dt": dt,
@@ -263,7 +264,7 @@ def main() -> None:
     with open(os.path.join(out_dir, "time_vs_error.json"), "w") as f:
         json.dump({"references": notes, "records": records}, f, indent=1)
     rows = pareto_table(records)
-    print(f"\nfastest run (wall s per simulated s) reaching each error level; '-' = never reached")
+    print("\nfastest run (wall s per simulated s) reaching each error level; '-' = never reached")
     print(f"{'scene':<12}{'solver':<18}" + "".join(f"{level:>10g}" for level in LEVELS))
     for r in rows:
         print(f"{r['scene']:<12}{r['solver']:<18}" + "".join(
