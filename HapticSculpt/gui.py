@@ -164,12 +164,8 @@ class Controller:
 
     def _dab(self, obj: Any, at: np.ndarray, radius: float = 0.08, strength: float = 0.25, factor: float = 3.0) -> None:
         """One airbrush dab on the painted map around the mass point nearest `at` (no session runs)."""
-        s = obj.Proxy.surface
-        uv = s.mesh_parameters(int(self._nearest(obj, at)))
-        (u0, u1), (v0, v1) = s.surface.domain
-        m = getattr(s, self.painting + "_map")  # (a uniform map gets a paint resolution on its first dab)
-        target = factor * float(np.median(m.values))
-        m.dab(((uv[0] - u0) / (u1 - u0), (uv[1] - v0) / (v1 - v0)), radius, target, "spherical", strength)
+        m = getattr(obj.Proxy.surface, self.painting + "_map")  # (a uniform map gets a paint resolution on its first dab)
+        m.dab(self._map_uv(obj, at), radius, factor * float(np.median(m.values)), "spherical", strength)
         ov = self.overlay(obj)
         if ov is not None:
             ov.frame()
@@ -212,16 +208,19 @@ class Controller:
         obj, at = self.active_sculpt(), self.cursor()
         if obj is None or at is None:
             raise RuntimeError("no sculpt or no cursor: move the mouse over a sculpt first")
-        s = readable_surface(obj)
-        uv = s.mesh_parameters(int(self._nearest(obj, at)))
-        (u0, u1), (v0, v1) = s.surface.domain
-        uvn = ((uv[0] - u0) / (u1 - u0), (uv[1] - v0) / (v1 - v0))
-        m = getattr(s, which + "_map")
-        target = factor * float(np.mean(m.values))
+        uvn = self._map_uv(obj, at)
+        target = factor * float(np.mean(getattr(readable_surface(obj), which + "_map").values))
         edit_surface(obj, lambda surf: getattr(surf, which + "_map").dab(uvn, radius, target, "spherical", strength),
                      f"Paint {which}")
         self.last_map = which
         self.refresh(obj)
+
+    def _map_uv(self, obj: Any, at: np.ndarray) -> tuple[float, float]:
+        """Map coordinates (0..1 over the parametric domain) of the mass point nearest `at`."""
+        s = readable_surface(obj)
+        u, v = s.mesh_parameters(self._nearest(obj, at))
+        (u0, u1), (v0, v1) = s.surface.domain
+        return (u - u0) / (u1 - u0), (v - v0) / (v1 - v0)
 
     def _nearest(self, obj: Any, at: np.ndarray) -> int:
         """Mass point nearest `at` on the newest shape (the overlay's copy: never the stepped surface)."""

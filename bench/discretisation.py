@@ -18,7 +18,6 @@ meets each tolerance.
 from __future__ import annotations
 
 import json
-import math
 import os
 import sys
 import time
@@ -29,31 +28,13 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path[:0] = [ROOT, os.path.dirname(os.path.abspath(__file__))]
 from HapticSculpt import core  # noqa: E402
 from progress import progress  # noqa: E402
-from time_vs_error import static_equilibrium  # noqa: E402
+from time_vs_error import equilibrium_build as scene, static_equilibrium  # noqa: E402
 
 # g - 1 a multiple of 10, so the constraints at u, v = 0.3, 0.4, 0.7 sit on mesh points at every
 # resolution (elsewhere they snap to the nearest point, an error of its own: up to half a spacing).
 MESHES = [11, 21, 31, 41, 51, 61, 81, 101, 121]
 TOLERANCES = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4]
 EVAL = 201
-
-
-def scene(mesh: int) -> core.DynamicSurface:
-    s = core.patch((8, 8), (3, 3), (mesh, mesh))
-    p = np.array(s.poles)
-    x, y = p[..., 0] / 50, p[..., 1] / 50
-    p[..., 2] = 15 * (1 - 0.5 * (x ** 2 + y ** 2))
-    s.set_poles(p)
-    s.relax()
-    s.stiffness_map.set_uniform(1e4)
-    n = mesh
-    for idx in (0, n - 1, n * (n - 1), n * n - 1):
-        s.add_constraint("point", index=idx)
-    centre = np.array(s.surface.evaluate(0.4, 0.4)["point"])
-    s.add_constraint("point", uv=(0.4, 0.4), target=list(centre + [0, 0, 5.0]))
-    tilt = math.radians(10)
-    s.add_constraint("normal", uv=(0.7, 0.3), target=[math.sin(tilt), 0.0, math.cos(tilt)])
-    return s
 
 
 def equilibrium(s: core.DynamicSurface) -> np.ndarray:

@@ -61,6 +61,34 @@ def run_freecadcmd(script: str, tmp: str, timeout: float = 300) -> dict:
         return json.load(f)
 
 
+#: The FreeCAD GUI can run here (under Xvfb); GUI tests skip otherwise (make deps installs both).
+GUI_AVAILABLE = shutil.which("xvfb-run") is not None and shutil.which("freecad") is not None
+
+
+def run_freecad_gui(script: str, tmp: str, timeout: float = 300) -> dict:
+    """Runs ``script`` in the real FreeCAD GUI under Xvfb with this checkout installed as an addon;
+    the script's text may use ``{answer}`` (formatted in here with the path, as a repr) to dump its
+    result dict as JSON before ``os._exit(0)``, which this returns."""
+    home = os.path.join(tmp, "guihome")
+    os.makedirs(os.path.join(home, "Mod"), exist_ok=True)
+    link = os.path.join(home, "Mod", "HapticSculpt")
+    if not os.path.lexists(link):
+        os.symlink(ROOT, link)
+    out = os.path.join(tmp, "answer.json")
+    path = os.path.join(tmp, "gui.py")
+    with open(path, "w") as f:
+        f.write(textwrap.dedent(script).replace("{answer}", repr(out)))
+    env = dict(os.environ, QTWEBENGINE_DISABLE_SANDBOX="1", FREECAD_USER_HOME=home)
+    proc = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", "freecad", path],
+                          env=env, capture_output=True, text=True, timeout=timeout)
+    if not os.path.exists(out):
+        raise AssertionError(f"the FreeCAD GUI gave no answer (rc {proc.returncode}):\n{proc.stdout[-2000:]}\n{proc.stderr[-2000:]}")
+    with open(out) as f:
+        result = json.load(f)
+    assert "error" not in result, result["error"]
+    return result
+
+
 def run_ocp(script: str, tmp: str, timeout: float = 300) -> dict:
     """Runs ``script`` with the cadquery/OCP virtual environment's Python; it prints one JSON line."""
     if not os.path.exists(OCP_PYTHON):

@@ -6,14 +6,11 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
-import subprocess
-import textwrap
 
 import numpy as np
 import pytest
 
-from freecad_support import ROOT
+from freecad_support import GUI_AVAILABLE, ROOT, run_freecad_gui
 
 SHOTS = os.path.join(ROOT, "build", "screenshots")
 
@@ -187,7 +184,7 @@ try:
     Gui.activateWorkbench("PartWorkbench")
 except Exception:
     out["error"] = traceback.format_exc()
-json.dump(out, open({answer!r}, "w"))
+json.dump(out, open({answer}, "w"))
 os._exit(0)
 """
 
@@ -196,22 +193,10 @@ def colour_fraction(img: np.ndarray, test) -> float:
     return float(np.mean(test(img[..., 0], img[..., 1], img[..., 2])))
 
 
-@pytest.mark.skipif(shutil.which("xvfb-run") is None or shutil.which("freecad") is None,
-                    reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
 def test_overlay_commands_keys_and_pictures(tmp_path):
-    home = tmp_path / "home"
-    (home / "Mod").mkdir(parents=True)
-    os.symlink(ROOT, home / "Mod" / "HapticSculpt")
     os.makedirs(SHOTS, exist_ok=True)
-    answer = tmp_path / "answer.json"
-    script = tmp_path / "gui.py"
-    script.write_text(textwrap.dedent(GUI_SCRIPT.format(shots=SHOTS, answer=str(answer))))
-    env = dict(os.environ, QTWEBENGINE_DISABLE_SANDBOX="1", FREECAD_USER_HOME=str(home))
-    proc = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", "freecad", str(script)],
-                          env=env, capture_output=True, text=True, timeout=300)
-    assert answer.exists(), proc.stdout[-2000:] + proc.stderr[-2000:]
-    out = json.loads(answer.read_text())
-    assert "error" not in out, out["error"]
+    out = run_freecad_gui(GUI_SCRIPT.format(shots=SHOTS, answer="{answer}"), str(tmp_path))
     with open(os.path.join(SHOTS, "overlay_cost.json"), "w") as f:
         json.dump({k: v for k, v in out.items() if k.startswith(("frame_ms", "sim_hz"))}, f, indent=1)
     # disabled without a document, enabled with a sculpt (constraint and paint need a cursor: they had one)

@@ -3,16 +3,12 @@ sculpt face is drawn. Writes build/screenshots/gui_workbench.png (look at it; do
 the README shows)."""
 from __future__ import annotations
 
-import json
 import os
-import shutil
-import subprocess
-import textwrap
 
 import numpy as np
 import pytest
 
-from freecad_support import ROOT
+from freecad_support import GUI_AVAILABLE, ROOT, run_freecad_gui
 
 GUI_SCRIPT = """
 import json, os, traceback
@@ -77,30 +73,18 @@ try:
     out["workbench_stop"] = [running_before, session2.running]
 except Exception:
     out["error"] = traceback.format_exc()
-json.dump(out, open({answer!r}, "w"))
+json.dump(out, open({answer}, "w"))
 os._exit(0)
 """
 
 
-@pytest.mark.skipif(shutil.which("xvfb-run") is None or shutil.which("freecad") is None,
-                    reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
 def test_workbench_loads_and_commands_run(tmp_path):
-    home = tmp_path / "home"
-    (home / "Mod").mkdir(parents=True)
-    os.symlink(ROOT, home / "Mod" / "HapticSculpt")
     os.makedirs(os.path.join(ROOT, "build", "screenshots"), exist_ok=True)
     png = os.path.join(ROOT, "build", "screenshots", "gui_workbench.png")
     if os.path.exists(png):
         os.remove(png)
-    answer = tmp_path / "answer.json"
-    script = tmp_path / "gui.py"
-    script.write_text(textwrap.dedent(GUI_SCRIPT.format(png=png, answer=str(answer))))
-    env = dict(os.environ, QTWEBENGINE_DISABLE_SANDBOX="1", FREECAD_USER_HOME=str(home))
-    proc = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", "freecad", str(script)],
-                          env=env, capture_output=True, text=True, timeout=300)
-    assert answer.exists(), proc.stdout[-2000:] + proc.stderr[-2000:]
-    out = json.loads(answer.read_text())
-    assert "error" not in out, out["error"]
+    out = run_freecad_gui(GUI_SCRIPT.format(png=png, answer="{answer}"), str(tmp_path))
     assert out["workbench"] == "HapticSculptWorkbench"
     assert set(out["commands"]) >= {"HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Thicken",
                                     "HapticSculpt_ExportStep"}

@@ -248,11 +248,7 @@ StepReport DynamicSurface::step(double dt) {
         case IntegratorKind::LocalGlobal: r = stepLocalGlobal(dt); break;
     }
     if (!surface_.poles().allFinite() || !v_.allFinite()) {
-        surface_.mutablePoles() = pStep_;
-        v_ = vStep_;
-        avValid_ = histValid_ = false;
-        A_.apply(surface_.poles(), d_);
-        accelerationValid_ = false;
+        restoreStepStart(true);
         r.refused = true;
         r.reason = "the step would produce NaN or Inf; state kept (reduce dt or stiffness)";
         return r;
@@ -289,9 +285,7 @@ bool DynamicSurface::limitEnergy(double work, StepReport& r) {
     const double ceiling = ceiling_ + std::max(0.0, work);
     // Below this floor energy is rounding noise: 1e-12 of a surface-sized stretch at the mean stiffness.
     const double floor = 1e-12 * stiffness_.mean() * size_ * size_;
-    // Local/global keeps A v (av_): the kinetic energy without a product by A.
-    const double ke = avValid_ ? 0.5 * (m_.asDiagonal() * av_).cwiseProduct(av_).sum() : kineticEnergy();
-    const double pe = potentialEnergy();
+    const double ke = kineticEnergy(), pe = potentialEnergy();
     if (ke + pe <= (1 + energyGuard.slack) * ceiling + floor) {
         ceiling_ = ceiling;
         return true;
@@ -307,11 +301,7 @@ bool DynamicSurface::limitEnergy(double work, StepReport& r) {
         r.reason = "the step would have created energy; velocities scaled back to the energy ceiling (reduce dt or stiffness)";
         return true;
     }
-    surface_.mutablePoles() = pStep_;
-    v_.setZero();
-    avValid_ = histValid_ = false;
-    A_.apply(surface_.poles(), d_);
-    accelerationValid_ = false;
+    restoreStepStart(false);
     r.refused = true;
     r.reason = "the step would have created energy: positions kept, motion stopped (reduce dt or stiffness, or use local_global)";
     return false;
@@ -337,8 +327,18 @@ void DynamicSurface::checkSleep(double dt) {
 
 double DynamicSurface::kineticEnergy() {
     refreshMaterials();
+    if (avValid_) return 0.5 * (m_.asDiagonal() * av_).cwiseProduct(av_).sum();  // local/global keeps A v
     A_.apply(v_, dd_);
     return 0.5 * (m_.asDiagonal() * dd_).cwiseProduct(dd_).sum();
+}
+
+void DynamicSurface::restoreStepStart(bool keepVelocity) {
+    surface_.mutablePoles() = pStep_;
+    if (keepVelocity) v_ = vStep_;
+    else v_.setZero();
+    avValid_ = histValid_ = false;
+    A_.apply(surface_.poles(), d_);
+    accelerationValid_ = false;
 }
 
 double DynamicSurface::potentialEnergy() {

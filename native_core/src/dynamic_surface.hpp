@@ -164,6 +164,8 @@ private:
     /// Something outside a step changed the energy (shape, velocities, springs, materials, constraints).
     void resetEnergyCeiling() { ceilingValid_ = false; }
     bool guardsEnergy(double dt) const;
+    /// Back to the state step() started from (refused steps); velocities kept or zeroed.
+    void restoreStepStart(bool keepVelocity);
     /// Applies the energy guard after a finite step that did `work`; returns false if it refused the step.
     bool limitEnergy(double work, StepReport& r);
     void refreshMaterials();
