@@ -3,6 +3,7 @@
 // or re-projected from the current shape, so all integrators, including the prefactored
 // local/global one, treat them exactly like springs.
 #pragma once
+#include <algorithm>
 #include <Eigen/Sparse>
 #include <vector>
 
@@ -41,6 +42,14 @@ public:
         for (const Constraint& c : items_)
             if (c.kind == ConstraintKind::Curvature) return true;
         return false;
+    }
+    /// The stiffest constraint whose projection moves with the mesh (all but point constraints,
+    /// whose targets are fixed); 0 if there is none.
+    double maxMovingStiffness() const {
+        double k = 0;
+        for (const Constraint& c : items_)
+            if (c.kind != ConstraintKind::Point) k = std::max(k, c.stiffness);
+        return k;
     }
     int size() const { return static_cast<int>(items_.size()); }
     const std::vector<Constraint>& items() const { return items_; }

@@ -180,6 +180,8 @@ private:
     void explicitSubstep(double dt, int depth, StepReport& r);
     void computeAcceleration();  // acc_ from the current p, v
     void applyToolForces(double dt, StepReport& r);
+    /// Local/global BDF2: weight in [0, 1] of the second-order prediction of the step's end.
+    double predictorWeight(double dt) const;
     void checkSleep(double dt);
     MeshView meshView() const { return {d_, g(), h(), spacingU_, spacingV_}; }
 

@@ -15,6 +15,20 @@
 
 namespace hs {
 
+double DynamicSurface::predictorWeight(double dt) const {
+    // The prediction d_n + dt A v_n + dt^2/2 A a_n (a_n from the BDF2 history) is O(dt^3) off the
+    // step's end, where the inertial prediction y is O(dt^2) off: one iteration from it stays second
+    // order (17x smaller error at 16 us in bench/time_vs_error.py). Extrapolation feeds the stiffest
+    // modes back explicitly and is unstable past rho = dt^2 omega_max^2 ~ 2.7 (omega_max^2 <= 8 k /
+    // m_min, k the stiffest spring or moving penalty term), so its weight falls as 1/rho^2 past
+    // rho = 1. Non-linear laws can stiffen a spring by up to m / (4 h^2): no prediction there.
+    if (springs_.law.kind != LawKind::Linear) return 0.0;
+    const double k = std::max(maxStiffness_, constraints_.maxMovingStiffness());
+    const double rho = dt * dt * 8 * k / minMass_;
+    const double w = rho <= 1 ? 1.0 : 1.0 / (rho * rho);
+    return w > 1e-6 ? w : 0.0;
+}
+
 StepReport DynamicSurface::stepLocalGlobal(double dt) {
     StepReport r;
     const bool bdf2 = solver.timeOrder == 2;
@@ -53,6 +67,9 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
             base_.row(i) -= h * limited * (meshTmp_.row(i) - dBase->row(i));  // h^2 * extra * v^
         }
     }
+    // The first local step projects at the end of the step predicted to O(dt^3) (predictorWeight).
+    const double w = bdf2 ? predictorWeight(dt) : 0.0;
+    if (w > 0) meshTmp_ += w * (d_ + dt * av_ + (0.5 * dt) * (av_ - avHist_) - meshTmp_);
     double change = 0;
     for (int it = 0; it < solver.iterations; ++it) {
         if (it > 0) A_.apply(x_, meshTmp_);
