@@ -199,33 +199,29 @@ class CurvatureConstraint(_Constraint):
 
 
 class _Paint(_SculptCommand):
-    """Airbrush: without a session, switches spraying this map with the left button on or off;
-    with one, a single dab at the device's cursor."""
+    """Airbrush: switches spraying this map on or off; the left button sprays along the mouse path,
+    or during a session the device's button along the device's path (instead of grabbing)."""
 
     which = "mass"
 
     def Activated(self) -> None:
-        ctl = _ctl()
-        if ctl.session is not None and ctl.session.running:
-            ctl.paint(self.which)
-        else:
-            state = ctl.set_painting(self.which)
-            FreeCAD.Console.PrintMessage(f"HapticSculpt: airbrush {'on: ' + state if state else 'off'}\n")
+        state = _ctl().set_painting(self.which)
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: airbrush {'on: ' + state if state else 'off'}\n")
 
 
 class PaintMass(_Paint):
     which, icon_name, menu = "mass", "PaintMass", "Paint mass"
-    tip = "Airbrush on the mass map: hold the left button and move over the surface (during a session: one dab at the cursor)"
+    tip = "Airbrush on the mass map: hold the left button (or the device's button during a session) and move over the surface"
 
 
 class PaintDamping(_Paint):
     which, icon_name, menu = "damping", "PaintDamping", "Paint damping"
-    tip = "Airbrush on the damping map: hold the left button and move over the surface (during a session: one dab at the cursor)"
+    tip = "Airbrush on the damping map: hold the left button (or the device's button during a session) and move over the surface"
 
 
 class PaintStiffness(_Paint):
     which, icon_name, menu = "stiffness", "PaintStiffness", "Paint stiffness"
-    tip = "Airbrush on the stiffness map: hold the left button and move over the surface (during a session: one dab at the cursor)"
+    tip = "Airbrush on the stiffness map: hold the left button (or the device's button during a session) and move over the surface"
 
 
 class ShowMap(_SculptCommand):

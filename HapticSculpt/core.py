@@ -31,6 +31,7 @@ TOOLS = ("rope", "magnet", "orientation", "smooth")
 CONSTRAINTS = ("point", "tangent", "normal", "curvature")
 FALLOFFS = ("constant", "spherical", "cylindrical", "conical")
 LAWS = ("linear", "cubic", "saturating")
+MAPS = ("mass", "damping", "stiffness")
 
 
 def patch(controls: tuple[int, int] = (8, 8), degree: tuple[int, int] = (3, 3),

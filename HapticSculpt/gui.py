@@ -8,8 +8,9 @@ normal or curvature constraint at the nearest point; M switches between shading 
 
 Airbrush: a paint command switches painting of that map on (again: off). Without a session, holding
 the left button sprays dabs along the mouse path, shown live in the map display, and the release
-makes the whole stroke one undo step; with a session, each paint command or key press is one dab
-at the device's cursor (the loops own the surface: see Session.edit).
+makes the whole stroke one undo step. With a session, the device's button sprays instead of
+grabbing: the simulation thread lays the dabs between its steps along the device's path, and each
+spray is one undo step, shown in the map display when it ends (Session.set_airbrush).
 """
 from __future__ import annotations
 
@@ -23,6 +24,7 @@ from .overlay import Overlay, readable_surface
 MAP_CYCLE = ("mass", "damping", "stiffness")
 CURVATURE_CYCLE = ("curvature", "mean", "gauss")
 KEYS = {"p": "point", "n": "normal", "c": "curvature"}
+AIRBRUSH_FACTOR = 3.0  # a stroke moves the map toward this times its mean when the stroke began
 
 
 class Controller:
@@ -38,6 +40,7 @@ class Controller:
         self.last_map = "mass"
         self.painting: str | None = None  # the map the airbrush paints, None when off
         self._paint_stroke: Any = None  # the sculpt being painted while the button is held
+        self._paint_target = 0.0
         self.tool = "rope"
         self.falloff = "spherical"
 
@@ -142,6 +145,8 @@ class Controller:
         if which is not None and which not in MAP_CYCLE:
             raise ValueError(f"which: one of {', '.join(MAP_CYCLE)}")
         self.painting = None if which is None or which == self.painting else which
+        if self.session is not None and self.session.running:
+            self.session.set_airbrush(self.painting, factor=AIRBRUSH_FACTOR)
         if self.painting is not None:
             self.set_display(self.painting)
         return self.painting
@@ -152,6 +157,8 @@ class Controller:
         if obj is None or self.painting is None or self.mouse_point is None:
             return
         self._paint_stroke = obj
+        # One target for the whole stroke (as the session's airbrush), so dabs saturate at it.
+        self._paint_target = AIRBRUSH_FACTOR * float(np.mean(getattr(obj.Proxy.surface, self.painting + "_map").values))
         self._dab(obj, self.mouse_point)
 
     def end_paint_stroke(self) -> None:
@@ -162,10 +169,10 @@ class Controller:
             _commit(obj, f"Paint {self.painting}")
             self.refresh(obj)
 
-    def _dab(self, obj: Any, at: np.ndarray, radius: float = 0.08, strength: float = 0.25, factor: float = 3.0) -> None:
+    def _dab(self, obj: Any, at: np.ndarray, radius: float = 0.08, strength: float = 0.25) -> None:
         """One airbrush dab on the painted map around the mass point nearest `at` (no session runs)."""
         m = getattr(obj.Proxy.surface, self.painting + "_map")  # (a uniform map gets a paint resolution on its first dab)
-        m.dab(self._map_uv(obj, at), radius, factor * float(np.median(m.values)), "spherical", strength)
+        m.dab(self._map_uv(obj, at), radius, self._paint_target, "spherical", strength)
         ov = self.overlay(obj)
         if ov is not None:
             ov.frame()
@@ -200,20 +207,6 @@ class Controller:
             result = "added"
         self.refresh(obj)
         return result
-
-    def paint(self, which: str, factor: float = 3.0, radius: float = 0.15, strength: float = 0.5) -> None:
-        """One airbrush dab on the `which` map at the point nearest the cursor: the map moves toward
-        `factor` times its value there."""
-        from .session import edit_surface
-        obj, at = self.active_sculpt(), self.cursor()
-        if obj is None or at is None:
-            raise RuntimeError("no sculpt or no cursor: move the mouse over a sculpt first")
-        uvn = self._map_uv(obj, at)
-        target = factor * float(np.mean(getattr(readable_surface(obj), which + "_map").values))
-        edit_surface(obj, lambda surf: getattr(surf, which + "_map").dab(uvn, radius, target, "spherical", strength),
-                     f"Paint {which}")
-        self.last_map = which
-        self.refresh(obj)
 
     def _map_uv(self, obj: Any, at: np.ndarray) -> tuple[float, float]:
         """Map coordinates (0..1 over the parametric domain) of the mass point nearest `at`."""
@@ -287,6 +280,8 @@ class Controller:
                     device.attach(view)
         self.mouse = device if isinstance(device, MouseDevice) else None
         self.session = Session().start(obj, device, tool=readable_surface(obj).tool.name)
+        if self.painting is not None:
+            self.session.set_airbrush(self.painting, factor=AIRBRUSH_FACTOR)
         self.refresh(obj)
         return self.session
 

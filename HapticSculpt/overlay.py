@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from . import analysis, core
+from . import analysis, core, sculpt_state
 from .panel import SliderPanel
 
 DISPLAYS = ("shading", "mass", "damping", "stiffness", "curvature", "mean", "gauss", "zebra")
@@ -27,13 +27,26 @@ JACK_COLOURS = {"point": (1.0, 0.0, 0.0), "tangent": (1.0, 0.5, 0.0), "normal": 
 
 def readable_surface(obj: Any) -> core.DynamicSurface:
     """The sculpt's core surface for reading what the simulation never writes (the B-spline's knots
-    and degrees, material maps, constraints, tool settings), also while a session steps it. Its
-    poles and mesh move under a session: take those from :meth:`Overlay.scratch`."""
+    and degrees, constraints, tool settings), also while a session steps it. Its poles and mesh
+    move under a session: take those from :meth:`Overlay.scratch`; the airbrush paints its maps:
+    take those from :func:`material_values`."""
     proxy = obj.Proxy
     session = getattr(proxy, "session", None)
     if session is not None and session.running and getattr(proxy, "_surface", None) is not None:
         return proxy._surface
     return proxy.surface
+
+
+def material_values(obj: Any, name: str) -> np.ndarray:
+    """Material map ``name`` ("mass", "damping", "stiffness") as a (rows, cols) array. While a
+    session runs its simulation thread may be spraying the live map, so this reads the stored one:
+    each spray is stored (one undo step) when it ends."""
+    session = getattr(obj.Proxy, "session", None)
+    if session is not None and session.running:
+        prop = sculpt_state.map_property(name)
+        rows, cols = sculpt_state.parse_settings(obj.SculptSettings)["maps"][prop]
+        return np.asarray(getattr(obj, prop), dtype=float).reshape(int(rows), int(cols))
+    return np.array(getattr(obj.Proxy.surface, name + "_map").values)
 
 
 class Overlay:
@@ -155,7 +168,7 @@ class Overlay:
     def _colours(self, s: core.DynamicSurface, mesh: np.ndarray, live: core.DynamicSurface) -> tuple[np.ndarray, tuple[float, float]]:
         g, h = mesh.shape[:2]
         if self.display in ("mass", "damping", "stiffness"):
-            return analysis.map_colours(np.array(getattr(live, self.display + "_map").values), (g, h))
+            return analysis.map_colours(material_values(self.obj, self.display), (g, h))
         if self.display == "zebra":
             d = self.view.getViewDirection()
             return analysis.zebra_colours(mesh, np.array([d[0], d[1], d[2]]))

@@ -29,10 +29,10 @@ class SliderPanel:
     # --- values -----------------------------------------------------------------------------------
     @staticmethod
     def value(obj: Any, name: str) -> float:
-        from .overlay import readable_surface
-        s = readable_surface(obj)
+        from .overlay import material_values, readable_surface
         if name in ("mass", "damping", "stiffness"):
-            return float(np.mean(getattr(s, name + "_map").values))
+            return float(np.mean(material_values(obj, name)))
+        s = readable_surface(obj)
         curv = [c for c in s.constraints if c["kind"] == "curvature"]
         if not curv:
             return 0.0

@@ -125,13 +125,20 @@ class SculptFeature:
         finally:
             self._writing = False
 
-    def write_arrays(self, poles: np.ndarray, velocities: np.ndarray, rest_lengths: Any) -> None:
-        """Stores a stroke's end state (from a session's snapshot) and rebuilds the Shape."""
+    def write_arrays(self, poles: np.ndarray, velocities: np.ndarray, rest_lengths: Any,
+                     painted: tuple[str, tuple[int, int], np.ndarray] | None = None) -> None:
+        """Stores a stroke's end state (from a session's snapshot) and rebuilds the Shape;
+        ``painted`` = (map name, shape, values) also stores a map an airbrush spray changed."""
         obj = self._object()
         state = read_state(obj)
         state.arrays["Poles"] = np.asarray(poles, dtype=float).ravel()
         state.arrays["Velocities"] = np.asarray(velocities, dtype=float).ravel()
         state.arrays["RestLengths"] = np.asarray(rest_lengths, dtype=float).ravel()
+        if painted is not None:
+            name, shape, values = painted
+            prop = sculpt_state.map_property(name)
+            state.arrays[prop] = np.asarray(values, dtype=float).ravel()
+            state.settings["maps"][prop] = [int(shape[0]), int(shape[1])]
         self._writing = True
         try:
             write_state(obj, state)

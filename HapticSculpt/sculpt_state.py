@@ -21,6 +21,16 @@ FORMAT_VERSION = 1
 ARRAY_NAMES = ("Poles", "Velocities", "KnotsU", "KnotsV", "Weights", "RestLengths",
                "MassMap", "DampingMap", "StiffnessMap")
 _MAPS = {"MassMap": "mass_map", "DampingMap": "damping_map", "StiffnessMap": "stiffness_map"}
+
+
+def map_property(name: str) -> str:
+    """The document property of material map ``name`` ("mass", "damping" or "stiffness")."""
+    for prop, attr in _MAPS.items():
+        if attr == name + "_map":
+            return prop
+    raise ValueError(f"map: one of mass, damping, stiffness, not {name!r}")
+
+
 _TOOL_PARAMS = {
     "rope": ("stiffness", "stiff_stiffness", "threshold", "reel_time"),
     "magnet": ("radius", "stiffness", "falloff"),

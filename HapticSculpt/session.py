@@ -44,6 +44,7 @@ class Session:
         self._timer: Any = None
         self._frame_base: Any = None  # knots, weights, degrees for GUI frames (they do not change)
         self._start_args: dict[str, Any] = {}
+        self._airbrush: dict[str, Any] = {"map": None}
         #: the newest pole snapshot the GUI received ((nu*nv, 3)), for overlays; None before one
         self.latest_poles: np.ndarray | None = None
 
@@ -75,6 +76,7 @@ class Session:
                                 max_stiffness=max_stiffness, stale_limit=stale_limit, record_seconds=record_seconds,
                                 stop_when_finished=stop_when_finished, realtime=realtime)
         proxy.session = self
+        runtime.set_airbrush(**self._airbrush)
         runtime.start()
         _ACTIVE.add(self)
         _Observer.ensure()
@@ -121,6 +123,27 @@ class Session:
             args["tool"] = obj.Proxy.surface.tool.name
             self.start(obj, **args)
         return result
+
+    def set_airbrush(self, map: str | None, radius: float = 0.08, factor: float = 3.0, strength: float = 0.25,
+                     rate: float = 30.0) -> None:
+        """Switches the airbrush: while ``map`` ("mass", "damping", "stiffness") is set, the device's
+        button sprays that map instead of grabbing (the tool lets go, no force), a dab every
+        1/``rate`` s at the mass point nearest the cursor moving it toward ``factor`` times its mean
+        at the spray's start (``radius`` in map coordinates, the unit square). Each spray becomes one
+        undo transaction like a stroke. ``None`` switches it off. Kept across edits and restarts."""
+        if map is not None and map not in core.MAPS:
+            raise ValueError(f"map: one of {', '.join(core.MAPS)}, or None (off)")
+        settings = dict(map=map, radius=float(radius), factor=float(factor), strength=float(strength), rate=float(rate))
+        if self._runtime is not None:
+            self._runtime.set_airbrush(**settings)  # validates the numbers, naming the bad one
+        else:
+            _core.HapticRuntime.validate_airbrush(**settings)
+        self._airbrush = settings
+
+    @property
+    def airbrush(self) -> str | None:
+        """The map the airbrush sprays, None when it is off."""
+        return self._airbrush["map"]
 
     @property
     def running(self) -> bool:
@@ -190,8 +213,10 @@ class Session:
     def _commit_strokes(self, runtime: Any, obj: Any) -> int:
         n = 0
         while (stroke := runtime.take_stroke()) is not None:
-            with transaction(obj.Document, "Sculpt stroke"):
-                obj.Proxy.write_arrays(stroke["poles"], stroke["velocities"], stroke["rest_lengths"])
+            painted = stroke["painted"]
+            with transaction(obj.Document, f"Paint {painted}" if painted else "Sculpt stroke"):
+                obj.Proxy.write_arrays(stroke["poles"], stroke["velocities"], stroke["rest_lengths"],
+                                       (painted, stroke["map_shape"], stroke["map_values"]) if painted else None)
                 obj.Strokes = obj.Strokes + 1
                 obj.purgeTouched()
             n += 1

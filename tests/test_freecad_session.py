@@ -47,6 +47,36 @@ class TestSession(DocumentTestCase):
             self.doc.undo()
         self.assertTrue(np.array_equal(np.asarray(obj.Proxy.surface.poles), before))
 
+    def test_airbrush_sprays_with_the_device_button_as_one_undo_step(self):
+        obj = hs.make_sculpt(self.doc, controls=(8, 8), mesh=(24, 24))
+        poles = np.array(obj.Proxy.surface.poles)
+        undo = self.doc.UndoCount
+        # The button held while the device sweeps across the patch at 1 mm over it, then released.
+        spray = hs.ReplayDevice.stroke((-30.0, 0.0, 1.0), (30.0, 0.0, 1.0), seconds=0.6)
+        session = hs.Session()
+        with self.assertRaisesRegex(ValueError, "map"):
+            session.set_airbrush("paint")
+        with self.assertRaisesRegex(ValueError, "radius"):
+            session.set_airbrush("damping", radius=2.0)
+        session.set_airbrush("damping", factor=5.0, rate=100.0)
+        self.assertEqual(session.airbrush, "damping")
+        session.start(obj, spray, stop_when_finished=True)
+        self.assertTrue(session.wait(timeout=20))
+        status = session.status()
+        self.assertEqual(status["error"], "")
+        self.assertEqual(status["strokes"], 1)
+        self.assertEqual(self.doc.UndoNames[: self.doc.UndoCount - undo], ["Paint damping"])
+        painted = np.asarray(obj.Proxy.surface.damping_map.values)
+        self.assertGreater(painted.size, 1)  # no longer uniform
+        self.assertGreater(painted.max(), 2.0)   # the default damping is 1; the spray's target 5
+        self.assertLessEqual(painted.max(), 5.0 + 1e-9)
+        self.assertEqual(sorted(obj.DampingMap), sorted(painted.ravel()))  # stored
+        # the tool let go: no force, the shape as it was
+        self.assertEqual(np.linalg.norm(status["force"]), 0.0)
+        self.assertLess(float(np.abs(np.asarray(obj.Proxy.surface.poles) - poles).max()), 1e-9)
+        self.doc.undo()
+        self.assertEqual(np.asarray(obj.Proxy.surface.damping_map.values).size, 1)
+
     def test_recording_replays_exactly(self):
         obj = hs.make_sculpt(self.doc, mesh=(20, 20))
         session = hs.Session().start(obj, two_strokes(), record_seconds=3.0, stop_when_finished=True)

@@ -129,6 +129,16 @@ try:
     pump(1.0)  # the stroke ends (released) and is committed by the session's timer
     ctl.stop_session()
     out["strokes"] = obj.Strokes
+    # the airbrush during a session: the paint command, then the device's button sprays (no grab)
+    Gui.runCommand("HapticSculpt_PaintDamping")
+    undo_before = doc.UndoCount
+    ctl.start_session(hs.ReplayDevice.stroke((-30, 0, 1), (30, 0, 1), seconds=0.6))
+    out["session_airbrush"] = ctl.session.airbrush
+    pump(1.5)
+    ctl.stop_session()
+    out["session_spray_undo"] = doc.UndoNames[:doc.UndoCount - undo_before]
+    out["damping_values"] = int(np.asarray(obj.Proxy.surface.damping_map.values).size)
+    Gui.runCommand("HapticSculpt_PaintDamping")  # off again
     ov.cursor = None
     # the display commands, each pressed as a user would: ShowCurvature cycles curvature, mean,
     # Gaussian; ShowMap cycles mass, damping, stiffness; Zebra toggles
@@ -206,6 +216,11 @@ def test_overlay_commands_keys_and_pictures(tmp_path):
     assert out["constraints"] == ["curvature", "normal", "point"]
     assert out["painting"] == "stiffness" and out["painting_after"] is None
     assert out["paint_undo_steps"] == 1  # a whole airbrush stroke is one undo step
+    assert out["session_airbrush"] == "damping"  # the command switched the session's airbrush on
+    # one spray and no grab stroke (the surface may still be swinging from the last stroke: session end)
+    assert out["session_spray_undo"].count("Paint damping") == 1, out["session_spray_undo"]
+    assert "Sculpt stroke" not in out["session_spray_undo"], out["session_spray_undo"]
+    assert out["damping_values"] > 1
     assert out["stiffness_range"][1] > 2 * out["stiffness_range"][0]
     assert out["magnet"] == ["magnet", "cylindrical"]
     assert {"Add point constraint", "Paint stiffness", "Tool: rope"} <= set(out["undo"]), out["undo"]

@@ -56,6 +56,24 @@ py::dict infoDict(const HidInfo& i) {
     return d;
 }
 
+AirbrushSettings airbrushSettings(const py::object& map, double radius, double factor, double strength, double rate) {
+    AirbrushSettings a;
+    if (!map.is_none()) {
+        if (!py::isinstance<py::str>(map)) throw std::invalid_argument("map: one of 'mass', 'damping', 'stiffness', or None (off)");
+        const std::string name = py::cast<std::string>(map);
+        if (name == "mass") a.map = AirbrushSettings::Map::Mass;
+        else if (name == "damping") a.map = AirbrushSettings::Map::Damping;
+        else if (name == "stiffness") a.map = AirbrushSettings::Map::Stiffness;
+        else throw std::invalid_argument("map: one of 'mass', 'damping', 'stiffness', or None (off)");
+    }
+    a.radius = radius;
+    a.factor = factor;
+    a.strength = strength;
+    a.rate = rate;
+    a.validate();
+    return a;
+}
+
 HidRecording loadRecording(const std::string& path) {
     std::FILE* f = std::fopen(path.c_str(), "rb");
     if (!f) throw std::invalid_argument("recording: cannot open " + path);
@@ -290,6 +308,7 @@ void bindRuntime(py::module_& m) {
             d["orientation"] = std::vector<double>{s.orientation.w(), s.orientation.x(), s.orientation.y(), s.orientation.z()};
             d["grab"] = s.grab;
             d["contact"] = s.contactValid ? py::cast(Vec3(s.contact)) : py::object(py::none());
+            d["spraying"] = s.spraying;
             return d;
         })
         .def("take_poles", [](HapticRuntime& r) -> py::object {
@@ -305,8 +324,26 @@ void bindRuntime(py::module_& m) {
             d["poles"] = py::cast(s.poles);
             d["velocities"] = py::cast(s.velocities);
             d["rest_lengths"] = py::cast(s.restLengths);
+            if (s.painted == AirbrushSettings::Map::Off) {
+                d["painted"] = py::none();
+            } else {
+                d["painted"] = mapName(s.painted);
+                d["map_shape"] = py::make_tuple(s.mapRows, s.mapCols);
+                d["map_values"] = py::cast(s.mapValues);
+            }
             return d;
-        }, "The oldest uncollected stroke end (poles, velocities, rest lengths), else None.")
+        }, "The oldest uncollected stroke end (poles, velocities, rest lengths; for a spray also the painted map: "
+           "'painted' names it, 'map_shape' and 'map_values' hold it), else None.")
+        .def("set_airbrush", [](HapticRuntime& r, py::object map, double radius, double factor, double strength, double rate) {
+            r.setAirbrush(airbrushSettings(map, radius, factor, strength, rate));
+        }, py::arg("map"), py::arg("radius") = 0.08, py::arg("factor") = 3.0, py::arg("strength") = 0.25, py::arg("rate") = 30.0,
+           "Airbrush during the session: while `map` is set, the device's first button sprays it (the tool lets go) with a "
+           "dab every 1/rate s at the mass point nearest the cursor, moving it toward factor x its mean at the spray's "
+           "start; each spray ends as one stroke. None switches it off.")
+        .def_static("validate_airbrush", [](py::object map, double radius, double factor, double strength, double rate) {
+            airbrushSettings(map, radius, factor, strength, rate);
+        }, py::arg("map"), py::arg("radius") = 0.08, py::arg("factor") = 3.0, py::arg("strength") = 0.25, py::arg("rate") = 30.0,
+           "Raises ValueError naming the first bad argument of set_airbrush.")
         .def("ticks", [](const HapticRuntime& r) {
             const auto& ticks = r.ticks();
             const auto n = static_cast<py::ssize_t>(ticks.size());

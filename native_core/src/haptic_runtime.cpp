@@ -52,6 +52,80 @@ HapticRuntime::~HapticRuntime() { stop(); }
 
 double HapticRuntime::now() const { return std::chrono::duration<double>(Clock::now() - t0_).count(); }
 
+void AirbrushSettings::validate() const {
+    if (!(radius > 0 && radius <= 1)) throw std::invalid_argument("radius: must be in (0, 1] (map coordinates)");
+    if (!(factor >= 1e-6 && factor <= 1e6)) throw std::invalid_argument("factor: must be in [1e-6, 1e6]");
+    if (!(strength > 0 && strength <= 1)) throw std::invalid_argument("strength: must be in (0, 1]");
+    if (!(rate > 0 && rate <= 1000)) throw std::invalid_argument("rate: must be in (0, 1000] dabs per second");
+}
+
+const char* mapName(AirbrushSettings::Map map) {
+    switch (map) {
+        case AirbrushSettings::Map::Mass: return "mass";
+        case AirbrushSettings::Map::Damping: return "damping";
+        case AirbrushSettings::Map::Stiffness: return "stiffness";
+        case AirbrushSettings::Map::Off: break;
+    }
+    return "";
+}
+
+void HapticRuntime::setAirbrush(const AirbrushSettings& a) {
+    a.validate();
+    std::lock_guard<std::mutex> lock(airbrushMutex_);
+    airbrushPending_ = a;
+    airbrushChanged_.store(true, std::memory_order_release);
+}
+
+void HapticRuntime::airbrush(bool spraying, double simTime) {
+    using Map = AirbrushSettings::Map;
+    const Map want = spraying ? airbrush_.map : Map::Off;
+    if (sprayMap_ != Map::Off && want != sprayMap_) {  // released, switched off or to another map
+        pushStroke(simTime, sprayMap_);
+        sprayMap_ = Map::Off;
+    }
+    spraying_.store(want != Map::Off, std::memory_order_relaxed);
+    if (want == Map::Off) return;
+    MaterialMap& m = want == Map::Mass ? surface_->massMap() : want == Map::Damping ? surface_->dampingMap()
+                                                                                   : surface_->stiffnessMap();
+    if (sprayMap_ == Map::Off) {
+        sprayMap_ = want;
+        // One target for the whole spray, so dabs saturate at it instead of compounding.
+        sprayTarget_ = std::clamp(airbrush_.factor * m.mean(), want == Map::Damping ? 0.0 : kMinMaterial, kMaxMaterial);
+        nextDab_ = simTime;
+    }
+    if (simTime < nextDab_) return;
+    nextDab_ = std::max(nextDab_ + 1.0 / airbrush_.rate, simTime);  // no burst after a dropped backlog
+    // Map coordinates of the mass point nearest the cursor, as the lumped masses sample the maps.
+    const int i = surface_->nearestMeshIndex(surface_->cursor().position);
+    const int g = surface_->g(), h = surface_->h();
+    m.dab(static_cast<double>(i / h) / (g - 1), static_cast<double>(i % h) / (h - 1), airbrush_.radius, sprayTarget_,
+          Falloff::Spherical, airbrush_.strength);
+}
+
+void HapticRuntime::pushStroke(double simTime, AirbrushSettings::Map painted) {
+    const std::uint64_t head = strokeHead_.load(std::memory_order_relaxed);
+    // A full queue (nobody collecting) merges this stroke into the next one.
+    if (head - strokeTail_.load(std::memory_order_acquire) < kStrokeSlots) {
+        StrokeSnapshot& s = strokes_[head % kStrokeSlots];
+        s.time = simTime;
+        s.poles = surface_->poles();
+        s.velocities = surface_->velocities();
+        const auto& rest = static_cast<const DynamicSurface&>(*surface_).springs().rest();
+        std::copy(rest.begin(), rest.end(), s.restLengths.begin());
+        s.painted = painted;
+        if (painted != AirbrushSettings::Map::Off) {
+            const MaterialMap& m = painted == AirbrushSettings::Map::Mass ? surface_->massMap()
+                                 : painted == AirbrushSettings::Map::Damping ? surface_->dampingMap()
+                                                                              : surface_->stiffnessMap();
+            s.mapRows = m.rows();
+            s.mapCols = m.cols();
+            s.mapValues = m.values();  // allocates only when the map's size changed (a spray end, not a step)
+        }
+        strokeHead_.store(head + 1, std::memory_order_release);
+    }
+    strokeCount_.fetch_add(1, std::memory_order_relaxed);
+}
+
 void HapticRuntime::fail(const char* message) {
     bool expected = false;
     if (failed_.compare_exchange_strong(expected, true)) {
@@ -166,7 +240,7 @@ void HapticRuntime::simLoop() {
     const double dt = settings_.simDt;
     const double graphicsEvery = settings_.graphicsRate > 0 ? 1.0 / settings_.graphicsRate : INFINITY;
     double simTime = 0, nextGraphics = 0;
-    bool grabbed = surface_->tool().grabbed();
+    bool grabbed = surface_->tool().grabbed(), button = false;
     HapticEstimate previous, current;
     Reaction reaction;
     std::uint64_t sequence = 0;
@@ -184,7 +258,15 @@ void HapticRuntime::simLoop() {
                 simTime += drop;
             }
             const bool fresh = cursor_.update();
-            if (surface_->asleep() && !surface_->tool().grabbed() && !(fresh && (cursor_.front().buttons & 1u))) {
+            if (fresh) button = (cursor_.front().buttons & 1u) != 0;
+            const bool airbrushTaken = airbrushChanged_.exchange(false, std::memory_order_acq_rel);
+            if (airbrushTaken) {
+                std::lock_guard<std::mutex> lock(airbrushMutex_);
+                airbrush_ = airbrushPending_;
+            }
+            const bool painting = airbrush_.map != AirbrushSettings::Map::Off;
+            if (surface_->asleep() && !surface_->tool().grabbed() && !(fresh && button) &&
+                sprayMap_ == AirbrushSettings::Map::Off) {
                 // At rest and nobody grabbing: nothing can move, so idle (the haptic loop keeps
                 // reading the device) and look again in 5 ms; simulated time follows the clock.
                 simIdle_.store(true, std::memory_order_relaxed);
@@ -193,12 +275,12 @@ void HapticRuntime::simLoop() {
                 continue;
             }
             simIdle_.store(false, std::memory_order_relaxed);
-            if (fresh) {
+            if (fresh || airbrushTaken) {
                 const DeviceSample& s = cursor_.front();
                 Cursor c;
                 c.position = s.position;
                 c.orientation = s.orientation;
-                c.grab = (s.buttons & 1u) != 0;
+                c.grab = button && !painting;  // the airbrush takes the button: the tool lets go
                 surface_->setCursor(c);
             }
             const StepReport r = surface_->step(dt);
@@ -220,20 +302,8 @@ void HapticRuntime::simLoop() {
             previous = current;
             // Stroke ends: a release edge hands the state over for one undo transaction.
             const bool nowGrabbed = surface_->tool().grabbed();
-            if (grabbed && !nowGrabbed) {
-                const std::uint64_t head = strokeHead_.load(std::memory_order_relaxed);
-                // A full queue (nobody collecting) merges this stroke into the next one.
-                if (head - strokeTail_.load(std::memory_order_acquire) < kStrokeSlots) {
-                    StrokeSnapshot& s = strokes_[head % kStrokeSlots];
-                    s.time = simTime;
-                    s.poles = surface_->poles();
-                    s.velocities = surface_->velocities();
-                    const auto& rest = static_cast<const DynamicSurface&>(*surface_).springs().rest();
-                    std::copy(rest.begin(), rest.end(), s.restLengths.begin());
-                    strokeHead_.store(head + 1, std::memory_order_release);
-                }
-                strokeCount_.fetch_add(1, std::memory_order_relaxed);
-            }
+            if (grabbed && !nowGrabbed) pushStroke(simTime, AirbrushSettings::Map::Off);
+            airbrush(button && painting, simTime);
             grabbed = nowGrabbed;
             if (simTime >= nextGraphics) {
                 poles_.back() = surface_->poles();
@@ -241,6 +311,7 @@ void HapticRuntime::simLoop() {
                 nextGraphics = simTime + graphicsEvery;
             }
         }
+        airbrush(false, simTime);  // a spray under way at the stop is still one undo step
     } catch (const std::exception& ex) {
         fail(ex.what());
     } catch (...) {
@@ -278,6 +349,7 @@ RuntimeStatus HapticRuntime::status() const {
     s.grab = (shown.cursor.buttons & 1u) != 0;
     s.contactValid = shown.contactValid;
     s.contact = shown.contact;
+    s.spraying = spraying_.load(std::memory_order_relaxed);
     if (s.elapsed > 0) {
         s.hapticHz = static_cast<double>(s.hapticTicks) / s.elapsed;
         s.simHz = static_cast<double>(s.simSteps) / s.elapsed;

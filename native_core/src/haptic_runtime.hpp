@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -50,6 +51,7 @@ struct RuntimeStatus {
     Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
     bool grab = false, contactValid = false;
     Vec3 contact = Vec3::Zero();
+    bool spraying = false;          ///< the airbrush is spraying (button held with the airbrush on)
 };
 
 /// What the haptic loop shows the GUI each tick (one writer, one reader: status()).
@@ -67,11 +69,30 @@ struct HapticTick {
     Vec3 rendered = Vec3::Zero();   ///< what was sent to the device
 };
 
-/// Sculpt state at the end of a stroke (a grab released), for one undo transaction each.
+/// The airbrush during a session. While it is on, the device's first button sprays the map
+/// instead of grabbing (the tool lets go and renders no force): a dab every 1/rate seconds at the
+/// mass point nearest the cursor moves the map toward `factor` times its mean at the spray's start.
+struct AirbrushSettings {
+    enum class Map { Off, Mass, Damping, Stiffness };
+    Map map = Map::Off;
+    double radius = 0.08;    ///< in map coordinates (the unit square)
+    double factor = 3.0;     ///< target = factor * the map's mean when the spray started
+    double strength = 0.25;  ///< per dab, at the centre
+    double rate = 30;        ///< dabs per second of simulated time
+    /// Throws std::invalid_argument naming the first bad field.
+    void validate() const;
+};
+const char* mapName(AirbrushSettings::Map map);  ///< "mass", "damping", "stiffness" ("" when off)
+
+/// Sculpt state at the end of a stroke (a grab released, or a spray ended), for one undo
+/// transaction each. A spray also carries the painted map (`painted` names it).
 struct StrokeSnapshot {
     double time = 0;
     Points poles, velocities;
     std::vector<double> restLengths;
+    AirbrushSettings::Map painted = AirbrushSettings::Map::Off;
+    int mapRows = 1, mapCols = 1;
+    Eigen::VectorXd mapValues;
 };
 
 class HapticRuntime {
@@ -92,6 +113,8 @@ public:
     bool takePoles(Points& out);
     /// Oldest unclaimed stroke end, if any (session thread).
     bool takeStroke(StrokeSnapshot& out);
+    /// Switches the airbrush (any thread); the simulation takes it up before its next step.
+    void setAirbrush(const AirbrushSettings& a);
 
     // --- analysis (after stop, with logSeconds > 0) --------------------------------------------
     const std::vector<HapticTick>& ticks() const { return ticks_; }
@@ -105,6 +128,9 @@ private:
     void simLoop();
     double now() const;
     void fail(const char* message);
+    /// Simulation thread: sprays while `spraying`, and hands a finished spray over as a stroke.
+    void airbrush(bool spraying, double simTime);
+    void pushStroke(double simTime, AirbrushSettings::Map painted);
 
     std::shared_ptr<DynamicSurface> surface_;
     std::shared_ptr<Device> device_;
@@ -120,6 +146,16 @@ private:
     TripleBuffer<HapticEstimate> estimate_; // simulation -> haptic
     TripleBuffer<Points> poles_;            // simulation -> GUI
     mutable TripleBuffer<ShownCursor> shown_;  // haptic -> GUI (status(): one reader)
+
+    // GUI -> simulation: the airbrush, taken up between steps (the lock only when it changed).
+    std::mutex airbrushMutex_;
+    AirbrushSettings airbrushPending_;
+    std::atomic<bool> airbrushChanged_{false};
+    // simulation thread only
+    AirbrushSettings airbrush_;
+    AirbrushSettings::Map sprayMap_ = AirbrushSettings::Map::Off;  // the map of the spray under way
+    double sprayTarget_ = 0, nextDab_ = 0;
+    std::atomic<bool> spraying_{false};  // for status()
 
     static constexpr int kStrokeSlots = 8;
     std::array<StrokeSnapshot, kStrokeSlots> strokes_;

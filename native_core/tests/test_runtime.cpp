@@ -229,6 +229,77 @@ TEST(HapticRuntime, StatusShowsTheCursorAndTheRopeContactForTheOverlay) {
     EXPECT_LT(std::abs(st.contact.x()) + std::abs(st.contact.y()), 10.0);  // the point under the cursor
 }
 
+TEST(HapticRuntime, AirbrushSpraysAlongTheCursorAsOneStrokeAndRendersNoForce) {
+    auto s = patch();
+    // The cursor sweeps along x over the patch with the button held, then lets go.
+    const int n = 40;
+    std::vector<double> t(n);
+    Points xyz(n, 3);
+    Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> q(n, 4);
+    std::vector<std::uint32_t> buttons(n, 1);
+    for (int i = 0; i < n; ++i) {
+        t[static_cast<size_t>(i)] = 0.5 * i / (n - 1);
+        xyz.row(i) << -30.0 + 60.0 * i / (n - 1), 0, 1.0;
+        q.row(i) << 1, 0, 0, 0;
+    }
+    buttons.back() = 0;
+    RuntimeSettings settings;
+    settings.stopWhenFinished = true;
+    HapticRuntime rt(s, std::make_shared<ReplayDevice>(t, xyz, q, buttons), settings);
+    AirbrushSettings a;
+    a.map = AirbrushSettings::Map::Stiffness;
+    a.factor = 4.0;
+    a.rate = 100;
+    rt.setAirbrush(a);
+    rt.start();
+    for (int i = 0; i < 400 && rt.running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    rt.stop();
+    const RuntimeStatus st = rt.status();
+    EXPECT_EQ(st.error, "");
+    EXPECT_EQ(st.strokes, 1u);  // one spray, no grab
+    StrokeSnapshot stroke;
+    ASSERT_TRUE(rt.takeStroke(stroke));
+    EXPECT_FALSE(rt.takeStroke(stroke));
+    ASSERT_EQ(stroke.painted, AirbrushSettings::Map::Stiffness);
+    const MaterialMap& m = s->stiffnessMap();
+    ASSERT_FALSE(m.uniform());
+    ASSERT_EQ(stroke.mapValues.size(), m.values().size());
+    EXPECT_EQ((stroke.mapValues - m.values()).cwiseAbs().maxCoeff(), 0.0);
+    // Stiffer along the path (v = 0.5, u from 0.2 to 0.8), untouched far from it, never past the target.
+    EXPECT_GT(m.at(0.5, 0.5), 150.0);
+    EXPECT_GT(m.at(0.3, 0.5), 150.0);
+    EXPECT_GT(m.at(0.7, 0.5), 150.0);
+    EXPECT_NEAR(m.at(0.5, 0.05), 100.0, 1e-9);
+    EXPECT_LE(m.values().maxCoeff(), 400.0 + 1e-9);
+    // The tool never grabbed: no force, and the patch stayed flat.
+    EXPECT_EQ(st.force.norm(), 0.0);
+    EXPECT_LT(s->poles().col(2).cwiseAbs().maxCoeff(), 1e-9);
+}
+
+TEST(HapticRuntime, SwitchingTheAirbrushOnMidGrabReleasesTheTool) {
+    auto s = patch();
+    auto dev = std::make_shared<RecordingDevice>();  // holds the button and lifts
+    HapticRuntime rt(s, dev, RuntimeSettings{});
+    rt.start();
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    EXPECT_TRUE(s->tool().grabbed() || !rt.running());
+    AirbrushSettings a;
+    a.map = AirbrushSettings::Map::Mass;
+    rt.setAirbrush(a);
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    const RuntimeStatus st = rt.status();
+    rt.stop();
+    EXPECT_TRUE(st.spraying);
+    StrokeSnapshot stroke;
+    ASSERT_TRUE(rt.takeStroke(stroke));  // the grab's end
+    EXPECT_EQ(stroke.painted, AirbrushSettings::Map::Off);
+    ASSERT_TRUE(rt.takeStroke(stroke));  // the spray, ended by the stop
+    EXPECT_EQ(stroke.painted, AirbrushSettings::Map::Mass);
+    EXPECT_FALSE(s->massMap().uniform());
+    EXPECT_THROW(rt.setAirbrush(AirbrushSettings{AirbrushSettings::Map::Mass, 0.0}), std::invalid_argument);
+    EXPECT_THROW(rt.setAirbrush(AirbrushSettings{AirbrushSettings::Map::Mass, 0.1, 3.0, 0.25, 0.0}), std::invalid_argument);
+}
+
 TEST(HapticEstimate, SafetyLayerFadesStaleSnapshotsLimitsStiffnessAndClamps) {
     HapticEstimate e;
     e.kind = EstimateKind::Hold;
