@@ -233,8 +233,10 @@ double ConstraintSet::addForces(const Points& d, Points& f, std::vector<Constrai
 void ConstraintSet::addProjections(const Points& d, Points& out, std::vector<ConstraintTerm>& scratch, double scale) const {
     terms(d, scratch);
     for (const auto& t : scratch) {
-        out.row(t.a) += (scale * t.k) * t.t.transpose();
-        if (t.b >= 0) out.row(t.b) -= (scale * t.k) * t.t.transpose();
+        const Vec3 current = t.b >= 0 ? Vec3(d.row(t.a) - d.row(t.b)) : Vec3(d.row(t.a));
+        const Vec3 pull = (scale * t.k) * (t.t - current);
+        out.row(t.a) += pull.transpose();
+        if (t.b >= 0) out.row(t.b) -= pull.transpose();
     }
 }
 

@@ -43,12 +43,12 @@ public:
             if (c.kind == ConstraintKind::Curvature) return true;
         return false;
     }
-    /// The stiffest constraint whose projection moves with the mesh (all but point constraints,
-    /// whose targets are fixed); 0 if there is none.
-    double maxMovingStiffness() const {
+    /// The stiffest constraint (with `movingOnly`: whose projection moves with the mesh, all but
+    /// point constraints, whose targets are fixed); 0 if there is none.
+    double maxStiffness(bool movingOnly) const {
         double k = 0;
         for (const Constraint& c : items_)
-            if (c.kind != ConstraintKind::Point) k = std::max(k, c.stiffness);
+            if (!movingOnly || c.kind != ConstraintKind::Point) k = std::max(k, c.stiffness);
         return k;
     }
     int size() const { return static_cast<int>(items_.size()); }
@@ -76,7 +76,8 @@ public:
     void terms(const Points& d, std::vector<ConstraintTerm>& out) const;
     /// Adds penalty forces to f; returns the penalty energy.
     double addForces(const Points& d, Points& f, std::vector<ConstraintTerm>& scratch) const;
-    /// out += scale J t for the local/global solver.
+    /// out += scale (J t - K d) for the local/global solver: the pull toward the projections t,
+    /// relative to d (see SpringMesh::addProjections).
     void addProjections(const Points& d, Points& out, std::vector<ConstraintTerm>& scratch, double scale = 1.0) const;
     void addLaplacian(std::vector<Eigen::Triplet<double>>& t) const;
     /// out += K y with K the penalty springs' stiffness (targets held fixed).

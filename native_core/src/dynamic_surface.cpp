@@ -10,7 +10,7 @@ DynamicSurface::DynamicSurface(BSplineSurface surface, int g, int h)
     : surface_(std::move(surface)), A_(surface_, g, h), mass_(1.0, "mass"), damping_(1.0, "damping"),
       stiffness_(100.0, "stiffness") {
     const Eigen::Index S = static_cast<Eigen::Index>(g) * h, N = surface_.poles().rows();
-    for (Points* m : {&d_, &dd_, &fext_, &ftool_, &force_, &meshTmp_, &meshTmp2_, &base_, &dPrev_, &av_, &dHist_, &avHist_, &dHat_})
+    for (Points* m : {&d_, &dd_, &fext_, &ftool_, &force_, &meshTmp_, &meshTmp2_, &base_, &dPrev_, &av_, &dHist_, &avHist_, &dHat_, &yMesh_})
         m->setZero(S, 3);
     for (Points* m : {&v_, &fp_, &p0_, &v0_, &a0_, &pStep_, &vStep_, &acc_, &cgR_, &cgZ_, &cgP_, &cgQ_, &x_, &pHist_, &vHist_, &xHat_})
         m->setZero(N, 3);
@@ -101,6 +101,7 @@ void DynamicSurface::refreshMaterials() {
         }
     springs_.setStiffness(stiffness_, A_.us(), A_.vs());
     minMass_ = m_.minCoeff();
+    maxDampingRate_ = (gamma_.array() / m_.array()).maxCoeff();
     maxStiffness_ = stiffness_.values().maxCoeff();
     for (int i = 0; i < 3; ++i) materialKey_[i] = key[i];
     accelerationValid_ = false;
@@ -155,12 +156,14 @@ void DynamicSurface::setPointForce(int index, const Vec3& force) {
     const double n = force.norm();
     fext_.row(index) = (n > maxPointForce ? Vec3(force * (maxPointForce / n)) : force).transpose();
     hasExternal_ = true;
+    histValid_ = false;  // the force jumps: BDF2 restarts (see histValid_)
     touch();
 }
 
 void DynamicSurface::clearForces() {
     fext_.setZero();
     hasExternal_ = false;
+    histValid_ = false;
     touch();
 }
 
@@ -179,18 +182,20 @@ void DynamicSurface::setCursor(const Cursor& c) {
     n.orientation.normalize();
     if (n.grab && !tool_->grabbed()) {
         tool_->grab(meshView(), n);
+        histValid_ = false;
         touch();
     } else if (!n.grab && tool_->grabbed()) {
         tool_->release();
+        histValid_ = false;
         touch();
     }
     cursor_ = n;
 }
 
-void DynamicSurface::applyToolForces(double dt, StepReport& r) {
+void DynamicSurface::applyToolForces(double dt, StepReport& r, const Points& at) {
     if (tool_->grabbed()) {
         ftool_.setZero();
-        r.reaction = tool_->apply(meshView(), cursor_, dt, ftool_);
+        r.reaction = tool_->apply({at, g(), h(), spacingU_, spacingV_}, cursor_, dt, ftool_);
         toolForces_ = true;
         accelerationValid_ = false;
     } else if (toolForces_) {

@@ -179,9 +179,11 @@ private:
     StepReport stepLocalGlobal(double dt);
     void explicitSubstep(double dt, int depth, StepReport& r);
     void computeAcceleration();  // acc_ from the current p, v
-    void applyToolForces(double dt, StepReport& r);
-    /// Local/global BDF2: weight in [0, 1] of the second-order prediction of the step's end.
-    double predictorWeight(double dt) const;
+    /// The tool's force on the mesh `at` (the current mesh, or local/global's prediction of the step's end).
+    void applyToolForces(double dt, StepReport& r, const Points& at);
+    /// Local/global BDF2: weight in [0, 1] of a second-order extrapolation over dt (the prediction
+    /// of the step's end; with `fixedTargets`, point constraints count too: the history's start).
+    double predictorWeight(double dt, bool fixedTargets) const;
     void checkSleep(double dt);
     MeshView meshView() const { return {d_, g(), h(), spacingU_, spacingV_}; }
 
@@ -193,8 +195,14 @@ private:
     Points av_;  // local/global: A v kept from the last step (saves one A product a step)
     // local/global BDF2: the state one step back (poles, velocities, mesh, A v) and x^ = (4 x_n - x_n-1) / 3
     Points pHist_, vHist_, dHist_, avHist_, xHat_, dHat_;
+    Points yMesh_;  // local/global: the inertial prediction y on the mesh
     double histDt_ = 0;
-    bool histValid_ = false;  ///< the history is the previous step's at histDt_ (cleared with avValid_)
+    /// The history is the previous step's at histDt_ (cleared with avValid_, and where the applied
+    /// forces jump: external forces set or cleared, a grab or a release). BDF2 extrapolates the
+    /// acceleration from its history, so across a jump it overshoots: a force held for one step
+    /// from rest and then removed left 16/9 of the kinetic energy it put in. Restarting (the
+    /// history synthesised from the new forces) is the textbook cure for multistep methods.
+    bool histValid_ = false;
     Eigen::VectorXd m_, gamma_, cgInvDiag_;
     MaterialMap mass_, damping_, stiffness_;
     SpringMesh springs_;
@@ -207,7 +215,7 @@ private:
     std::uint64_t systemKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
     std::uint64_t wakeKey_[4] = {0, 0, 0, 0};
     double systemDt_ = -1;
-    double minMass_ = 0, maxStiffness_ = 0, size_ = 1, spacingU_ = 1, spacingV_ = 1;
+    double minMass_ = 0, maxStiffness_ = 0, maxDampingRate_ = 0, size_ = 1, spacingU_ = 1, spacingV_ = 1;
     double time_ = 0, work_ = 0, ceiling_ = 0;
     double accEnergy_ = 0;  // explicit: kinetic + elastic energy where acc_ was computed
     bool ceilingValid_ = false;

@@ -25,7 +25,7 @@ void DynamicSurface::computeAcceleration() {
 StepReport DynamicSurface::stepExplicit(double dt) {
     StepReport r;
     ensureMassFactor();
-    applyToolForces(dt, r);
+    applyToolForces(dt, r, d_);
     explicitSubstep(dt, 0, r);
     return r;
 }

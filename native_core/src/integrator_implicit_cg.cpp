@@ -10,7 +10,7 @@ namespace hs {
 StepReport DynamicSurface::stepImplicitCG(double dt) {
     StepReport r;
     ensureSystem(dt, false);
-    applyToolForces(dt, r);
+    applyToolForces(dt, r, d_);
     A_.apply(v_, dd_);
     meshForces(d_, dd_, dt);  // also records the springs' tangent stiffness at d
     auto stiffnessTimes = [&](const Points& y, Points& out) {

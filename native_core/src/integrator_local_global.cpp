@@ -2,12 +2,14 @@
 // Spring Systems") carried into the reduced control-point space. Springs and penalty constraints
 // are all terms 1/2 k |x_a - x_b - t|^2, so one step solves
 //   A^T (M + h D + h^2 L) A p' = A^T [ M y + h D x^ + h^2 (f_ext + J t) ]
-// alternating the projection of t (local) with a solve by the prefactored system (global).
+// alternating the projection of t (local) with a solve by the prefactored system (global), in
+// increments (see the loop).
 // Backward Euler (order 1) has x^ = x_n, y = x_n + dt v_n, h = dt. BDF2 (order 2, the default;
 // beyond the paper and Liu et al.) has the same form with
 //   x^ = (4 x_n - x_n-1) / 3,  v^ = (4 v_n - v_n-1) / 3,  y = x^ + h v^,  h = 2 dt / 3,
 // and v_n+1 = (x_n+1 - x^) / h, so it costs the same per step: one matrix, factored once.
-// Without history (first step, after an edit) BDF2 starts from x_n-1 = x_n - dt v_n, v_n-1 = v_n.
+// Without history (first step, after an edit) BDF2 starts from x_n-1 = x_n - dt v_n + dt^2/2 a_n,
+// v_n-1 = v_n - dt a_n.
 #include <algorithm>
 #include <cmath>
 
@@ -15,18 +17,26 @@
 
 namespace hs {
 
-double DynamicSurface::predictorWeight(double dt) const {
+namespace {
+// Weight of an explicit extrapolation over a step with rho = dt^2 omega_max^2: whole up to 1,
+// falling as 1/rho^2 past it (it went unstable near rho = 2.7), none once negligible.
+double extrapolationWeight(double rho) {
+    const double w = rho <= 1 ? 1.0 : 1.0 / (rho * rho);
+    return w > 1e-6 ? w : 0.0;
+}
+}  // namespace
+
+double DynamicSurface::predictorWeight(double dt, bool fixedTargets) const {
     // The prediction d_n + dt A v_n + dt^2/2 A a_n (a_n from the BDF2 history) is O(dt^3) off the
     // step's end, where the inertial prediction y is O(dt^2) off: one iteration from it stays second
     // order (17x smaller error at 16 us in bench/time_vs_error.py). Extrapolation feeds the stiffest
-    // modes back explicitly and is unstable past rho = dt^2 omega_max^2 ~ 2.7 (omega_max^2 <= 8 k /
-    // m_min, k the stiffest spring or moving penalty term), so its weight falls as 1/rho^2 past
-    // rho = 1. Non-linear laws can stiffen a spring by up to m / (4 h^2): no prediction there.
+    // modes back explicitly (omega_max^2 <= 8 k / m_min, k the stiffest spring or penalty term;
+    // point constraints pull toward fixed targets and do not feed back through a projection, but
+    // they do through an extrapolated history). Non-linear laws can stiffen a spring by up to
+    // m / (4 h^2): no prediction there.
     if (springs_.law.kind != LawKind::Linear) return 0.0;
-    const double k = std::max(maxStiffness_, constraints_.maxMovingStiffness());
-    const double rho = dt * dt * 8 * k / minMass_;
-    const double w = rho <= 1 ? 1.0 : 1.0 / (rho * rho);
-    return w > 1e-6 ? w : 0.0;
+    const double k = std::max(maxStiffness_, constraints_.maxStiffness(!fixedTargets));
+    return extrapolationWeight(dt * dt * 8 * k / minMass_);
 }
 
 StepReport DynamicSurface::stepLocalGlobal(double dt) {
@@ -34,27 +44,57 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     const bool bdf2 = solver.timeOrder == 2;
     const double h = bdf2 ? 2.0 * dt / 3.0 : dt;
     ensureSystem(h, true);
-    applyToolForces(dt, r);
     const Points& p = surface_.poles();
     if (!avValid_) A_.apply(v_, av_);
+    const double w = bdf2 ? predictorWeight(dt, false) : 0.0;
     const Points* dBase = &d_;  // x^ on the mesh
+    // y, the inertial prediction: x_ in control space, yMesh_ on the mesh (A y without a product by A)
     if (bdf2) {
         if (!histValid_ || histDt_ != dt) {
+            // The state one step back. Without the acceleration term v_n-1 = v_n is O(dt) off, and a
+            // start from rest under load (a pushed pole let go) was then first order throughout.
+            // Where extrapolation is unstable (predictorWeight, point constraints included: their
+            // stiff pull would enter as a velocity impulse) the term fades out.
             pHist_ = p - dt * v_;
             vHist_ = v_;
             dHist_ = d_ - dt * av_;
             avHist_ = av_;
+            // Heavy damping is a stiff mode too (rate gamma / m): a past accelerating freely
+            // against it is not one BDF2 can start from.
+            const double rate = dt * maxDampingRate_;
+            const double wh = dampingLaw.kind != LawKind::Linear
+                                  ? 0.0 : std::min(predictorWeight(dt, true), extrapolationWeight(rate * rate));
+            if (wh > 0) {
+                ensureMassFactor();
+                computeAcceleration();  // acc_, and A acc_ into dd_ below
+                A_.apply(acc_, dd_);
+                pHist_ += (0.5 * dt * dt * wh) * acc_;
+                vHist_ -= (dt * wh) * acc_;
+                dHist_ += (0.5 * dt * dt * wh) * dd_;
+                avHist_ -= (dt * wh) * dd_;
+            }
         }
         xHat_ = (4.0 / 3.0) * p - (1.0 / 3.0) * pHist_;
         x_ = xHat_ + h * ((4.0 / 3.0) * v_ - (1.0 / 3.0) * vHist_);
         dHat_ = (4.0 / 3.0) * d_ - (1.0 / 3.0) * dHist_;
-        meshTmp_ = dHat_ + h * ((4.0 / 3.0) * av_ - (1.0 / 3.0) * avHist_);
+        yMesh_ = dHat_ + h * ((4.0 / 3.0) * av_ - (1.0 / 3.0) * avHist_);
         dBase = &dHat_;
     } else {
         x_ = p + dt * v_;
-        meshTmp_ = d_ + dt * av_;  // predicted mesh d + dt A v, without a product by A
+        yMesh_ = d_ + dt * av_;
     }
-    base_ = m_.asDiagonal() * meshTmp_ + (h * gamma_).asDiagonal() * *dBase;
+    // The tool pulls where the mesh is predicted at the step's end, as BDF2 wants its forces: taken
+    // at the start, they made the rope scene first order. The tool is explicit, so its own slope
+    // limits the prediction as the springs' does (the smooth tool's slope is unknown: none).
+    const double wt = w > 0 && tool_->grabbed() ? std::min(w, extrapolationWeight(dt * dt * tool_->slope() / minMass_)) : 0.0;
+    if (wt > 0) {
+        meshTmp_ = d_ + wt * (dt * av_ + (0.5 * dt) * (av_ - avHist_));
+        applyToolForces(dt, r, meshTmp_);
+    } else {
+        applyToolForces(dt, r, d_);
+    }
+    // The parts of the right-hand side that do not depend on the iterate.
+    base_.setZero();
     if (hasExternal_) base_ += (h * h) * fext_;
     if (toolForces_) base_ += (h * h) * ftool_;
     if (dampingLaw.kind != LawKind::Linear) {
@@ -64,22 +104,32 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
         for (Eigen::Index i = 0; i < d_.rows(); ++i) {
             const double extra = (dampingLaw.dampingFactor(force_.row(i).norm()) - 1.0) * gamma_[i];
             const double limited = std::min(extra, m_[i] / h);
-            base_.row(i) -= h * limited * (meshTmp_.row(i) - dBase->row(i));  // h^2 * extra * v^
+            base_.row(i) -= h * limited * (yMesh_.row(i) - dBase->row(i));  // h^2 * extra * v^
         }
     }
-    // The first local step projects at the end of the step predicted to O(dt^3) (predictorWeight).
-    const double w = bdf2 ? predictorWeight(dt) : 0.0;
-    if (w > 0) meshTmp_ += w * (d_ + dt * av_ + (0.5 * dt) * (av_ - avHist_) - meshTmp_);
+    // The first iterate: y, or the end of the step predicted to O(dt^3) (predictorWeight).
+    if (w > 0) {
+        x_ += w * (p + dt * v_ + (0.5 * dt) * (v_ - vHist_) - x_);
+        meshTmp_ = yMesh_ + w * (d_ + dt * av_ + (0.5 * dt) * (av_ - avHist_) - yMesh_);
+    } else {
+        meshTmp_ = yMesh_;
+    }
+    // Each iteration solves for the increment from the iterate x (mesh d = A x):
+    //   S (x' - x) = A^T [ M (y - d) + h D (x^ - d) + h^2 (f + J t - L d) ]
+    // Every term is small, so rounding stays relative to the step's motion. Solving for x' itself
+    // puts M y (large) beside h^2 f (small): the solve's rounding, of the order of the positions,
+    // then biases every step the same way, and BDF2 turns that into a drifting velocity (error
+    // 4.7e-5 at a 1 us step in bench/time_vs_error.py's oscillation, growing as the step shrinks).
     double change = 0;
     for (int it = 0; it < solver.iterations; ++it) {
         if (it > 0) A_.apply(x_, meshTmp_);
-        meshTmp2_ = base_;  // + h^2 J t, added in place by the local steps
+        meshTmp2_ = base_ + m_.asDiagonal() * (yMesh_ - meshTmp_) + (h * gamma_).asDiagonal() * (*dBase - meshTmp_);
         springs_.addProjections(meshTmp_, meshTmp2_, 0.25 * minMass_ / (h * h), h * h);
         if (!constraints_.empty()) constraints_.addProjections(meshTmp_, meshTmp2_, terms_, h * h);
         A_.applyTransposed(meshTmp2_, fp_);
         systemSolver_.solve(fp_, acc_);
-        change = (acc_ - x_).cwiseAbs().maxCoeff();
-        x_ = acc_;
+        change = acc_.cwiseAbs().maxCoeff();
+        x_ += acc_;
         ++r.iterations;
     }
     r.residual = change / size_;

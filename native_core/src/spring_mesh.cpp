@@ -37,9 +37,10 @@ void projectRun(Law lw, int n, const double* __restrict xa, const double* __rest
         const double e = l - rest[j];
         const double cap = maxExtra * std::abs(e);
         const double force = std::min(std::max(lw.value(kj * e), kj * e - cap), kj * e + cap);
-        // c = k * target / l with target = l - force / k; a zero-length spring has no direction
+        // k t - k (d_a - d_b) = c (d_a - d_b) with c = k target / l - k, target = l - force / k;
+        // a zero-length spring has no direction (t = 0)
         const double live = l > minL ? 1.0 : 0.0;  // a select of constants keeps the loop branch-free
-        const double c = live * ((kj * l - force) / std::max(l, minL));
+        const double c = live * ((kj * l - force) / std::max(l, minL)) - kj;
         cx[j] = c * dx;
         cy[j] = c * dy;
         cz[j] = c * dz;

@@ -47,8 +47,10 @@ public:
     double addForces(const Points& d, Points& f);
     /// out += K y with K the tangent stiffness at the last addForces() state (clamped to be PSD).
     void addTangentStiffness(const Points& y, Points& out) const;
-    /// Local step of the local/global solver: out += scale J t with t the projected spring vectors.
-    /// maxExtraStiffness caps |g(k e) - k e| / |e|: the part of a non-linear law the prefactored
+    /// Local step of the local/global solver: out += scale (J t - L d), the pull of every spring
+    /// toward its projected vector t (|t| its target length along d_a - d_b). Relative to d, not
+    /// J t alone: J t and L d are large and nearly cancel, and the solver solves for the increment
+    /// (see integrator_local_global.cpp). maxExtraStiffness caps |g(k e) - k e| / |e|: the part of a non-linear law the prefactored
     /// matrix does not hold is explicit, and stays stable only below about m / dt^2.
     void addProjections(const Points& d, Points& out, double maxExtraStiffness, double scale = 1.0) const;
     /// Plastic flow over a step of length dt.

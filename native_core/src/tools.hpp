@@ -1,5 +1,7 @@
 // Sculpting tools: each adds forces on the mesh points and returns the exact reaction on the cursor.
 #pragma once
+#include <algorithm>
+#include <limits>
 #include <Eigen/Geometry>
 #include <memory>
 #include <string>
@@ -49,6 +51,9 @@ public:
     Reaction apply(const MeshView& mesh, const Cursor& cursor, double dt, Points& f);
     /// Mass point the tool is attached to (nearest point for the rope), -1 if none.
     virtual int anchor() const { return -1; }
+    /// Steepest force per unit displacement on one mass point (infinite when unknown): how stiff
+    /// the tool is as an explicit force, for the local/global step's prediction.
+    virtual double slope() const { return std::numeric_limits<double>::infinity(); }
     /// Fills the local model the haptic loop renders between steps (positions, law, parameters;
     /// velocities are left to the caller). The default holds the last reaction.
     void describe(const MeshView& mesh, const Reaction& last, HapticEstimate& e) const;
@@ -80,6 +85,7 @@ public:
     const char* name() const override { return "rope"; }
     void grab(const MeshView& mesh, const Cursor& cursor) override;
     int anchor() const override { return grabbed_ ? point_ : -1; }
+    double slope() const override { return std::max(stiffness, stiffStiffness); }
     double restLength() const;
     double stiffness = 10.0;        ///< force per length while slack is below threshold
     double stiffStiffness = 200.0;  ///< past the threshold
@@ -102,6 +108,7 @@ public:
     const char* name() const override { return "magnet"; }
     void grab(const MeshView& mesh, const Cursor& cursor) override;
     int selected() const { return static_cast<int>(points_.size()); }
+    double slope() const override { return stiffness; }  // stiffness * falloff weight <= stiffness per point
     double radius = 10.0;
     double stiffness = 10.0;
     Falloff falloff = Falloff::Spherical;
@@ -123,6 +130,7 @@ public:
     const char* name() const override { return "orientation"; }
     void grab(const MeshView& mesh, const Cursor& cursor) override;
     int anchor() const override { return grabbed_ ? center_ : -1; }
+    double slope() const override { return stiffness; }
     double stiffness = 10.0;
 
 protected:
