@@ -9,8 +9,8 @@ normal or curvature constraint at the nearest point; M switches between shading 
 Airbrush: a paint command switches painting of that map on (again: off). Without a session, holding
 the left button sprays dabs along the mouse path, shown live in the map display, and the release
 makes the whole stroke one undo step. With a session, the device's button sprays instead of
-grabbing: the simulation thread lays the dabs between its steps along the device's path, and each
-spray is one undo step, shown in the map display when it ends (Session.set_airbrush).
+grabbing: the simulation thread lays the dabs between its steps along the device's path, shown
+live in the map display, and each spray is one undo step (Session.set_airbrush).
 """
 from __future__ import annotations
 

@@ -39,10 +39,12 @@ def readable_surface(obj: Any) -> core.DynamicSurface:
 
 def material_values(obj: Any, name: str) -> np.ndarray:
     """Material map ``name`` ("mass", "damping", "stiffness") as a (rows, cols) array. While a
-    session runs its simulation thread may be spraying the live map, so this reads the stored one:
-    each spray is stored (one undo step) when it ends."""
+    session runs its simulation thread may be spraying the live map, so this reads the session's
+    newest snapshot of a sprayed map (published at the graphics rate), else the stored one."""
     session = getattr(obj.Proxy, "session", None)
     if session is not None and session.running:
+        if name in session.latest_maps:
+            return session.latest_maps[name]
         prop = sculpt_state.map_property(name)
         rows, cols = sculpt_state.parse_settings(obj.SculptSettings)["maps"][prop]
         return np.asarray(getattr(obj, prop), dtype=float).reshape(int(rows), int(cols))

@@ -47,6 +47,8 @@ class Session:
         self._airbrush: dict[str, Any] = {"map": None}
         #: the newest pole snapshot the GUI received ((nu*nv, 3)), for overlays; None before one
         self.latest_poles: np.ndarray | None = None
+        #: the newest snapshot of each map the airbrush sprayed this run ((rows, cols)), for overlays
+        self.latest_maps: dict[str, np.ndarray] = {}
 
     # --- life cycle -------------------------------------------------------------------------------
     def start(self, obj: Any, device: Any, tool: str = "rope", haptic_rate: float = 1000.0,
@@ -76,6 +78,7 @@ class Session:
                                 max_stiffness=max_stiffness, stale_limit=stale_limit, record_seconds=record_seconds,
                                 stop_when_finished=stop_when_finished, realtime=realtime)
         proxy.session = self
+        self.latest_maps = {}
         runtime.set_airbrush(**self._airbrush)
         runtime.start()
         _ACTIVE.add(self)
@@ -252,6 +255,9 @@ class Session:
         if poles is not None and _alive(obj):
             self.latest_poles = poles
             obj.Proxy.show_poles(poles, self._frame_base)
+        painted = runtime.take_painted_map()
+        if painted is not None:
+            self.latest_maps[painted["map"]] = painted["values"]
         self.poll()
 
 

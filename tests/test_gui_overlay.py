@@ -135,6 +135,7 @@ try:
     ctl.start_session(hs.ReplayDevice.stroke((-30, 0, 1), (30, 0, 1), seconds=0.6))
     out["session_airbrush"] = ctl.session.airbrush
     pump(1.5)
+    out["live_map"] = sorted(ctl.session.latest_maps)
     ctl.stop_session()
     out["session_spray_undo"] = doc.UndoNames[:doc.UndoCount - undo_before]
     out["damping_values"] = int(np.asarray(obj.Proxy.surface.damping_map.values).size)
@@ -221,6 +222,7 @@ def test_overlay_commands_keys_and_pictures(tmp_path):
     assert out["session_spray_undo"].count("Paint damping") == 1, out["session_spray_undo"]
     assert "Sculpt stroke" not in out["session_spray_undo"], out["session_spray_undo"]
     assert out["damping_values"] > 1
+    assert out["live_map"] == ["damping"]  # the overlay saw the spray while it went on
     assert out["stiffness_range"][1] > 2 * out["stiffness_range"][0]
     assert out["magnet"] == ["magnet", "cylindrical"]
     assert {"Add point constraint", "Paint stiffness", "Tool: rope"} <= set(out["undo"]), out["undo"]

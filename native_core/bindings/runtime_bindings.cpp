@@ -316,6 +316,17 @@ void bindRuntime(py::module_& m) {
             if (!r.takePoles(p)) return py::none();
             return py::cast(p);
         }, "Newest pole snapshot ((nu*nv, 3) array) if one arrived since the last call, else None.")
+        .def("take_painted_map", [](HapticRuntime& r) -> py::object {
+            PaintedMap p;
+            if (!r.takePaintedMap(p)) return py::none();
+            py::dict d;
+            d["map"] = mapName(p.map);
+            py::array_t<double> values({p.rows, p.cols});
+            std::copy(p.values.data(), p.values.data() + p.values.size(), values.mutable_data());
+            d["values"] = values;
+            return d;
+        }, "The map a spray is painting ({'map': name, 'values': (rows, cols) array}) if it changed since the last "
+           "call, else None; published at the graphics rate while the spray goes on.")
         .def("take_stroke", [](HapticRuntime& r) -> py::object {
             StrokeSnapshot s;
             if (!r.takeStroke(s)) return py::none();

@@ -69,6 +69,17 @@ const char* mapName(AirbrushSettings::Map map) {
     return "";
 }
 
+MaterialMap& HapticRuntime::mapOf(AirbrushSettings::Map map) {
+    return map == AirbrushSettings::Map::Mass ? surface_->massMap()
+         : map == AirbrushSettings::Map::Damping ? surface_->dampingMap() : surface_->stiffnessMap();
+}
+
+bool HapticRuntime::takePaintedMap(PaintedMap& out) {
+    if (!painted_.update()) return false;
+    out = painted_.front();
+    return true;
+}
+
 void HapticRuntime::setAirbrush(const AirbrushSettings& a) {
     a.validate();
     std::lock_guard<std::mutex> lock(airbrushMutex_);
@@ -85,8 +96,7 @@ void HapticRuntime::airbrush(bool spraying, double simTime) {
     }
     spraying_.store(want != Map::Off, std::memory_order_relaxed);
     if (want == Map::Off) return;
-    MaterialMap& m = want == Map::Mass ? surface_->massMap() : want == Map::Damping ? surface_->dampingMap()
-                                                                                   : surface_->stiffnessMap();
+    MaterialMap& m = mapOf(want);
     if (sprayMap_ == Map::Off) {
         sprayMap_ = want;
         // One target for the whole spray, so dabs saturate at it instead of compounding.
@@ -100,6 +110,7 @@ void HapticRuntime::airbrush(bool spraying, double simTime) {
     const int g = surface_->g(), h = surface_->h();
     m.dab(static_cast<double>(i / h) / (g - 1), static_cast<double>(i % h) / (h - 1), airbrush_.radius, sprayTarget_,
           Falloff::Spherical, airbrush_.strength);
+    paintedDirty_ = true;
 }
 
 void HapticRuntime::pushStroke(double simTime, AirbrushSettings::Map painted) {
@@ -114,9 +125,7 @@ void HapticRuntime::pushStroke(double simTime, AirbrushSettings::Map painted) {
         std::copy(rest.begin(), rest.end(), s.restLengths.begin());
         s.painted = painted;
         if (painted != AirbrushSettings::Map::Off) {
-            const MaterialMap& m = painted == AirbrushSettings::Map::Mass ? surface_->massMap()
-                                 : painted == AirbrushSettings::Map::Damping ? surface_->dampingMap()
-                                                                              : surface_->stiffnessMap();
+            const MaterialMap& m = mapOf(painted);
             s.mapRows = m.rows();
             s.mapCols = m.cols();
             s.mapValues = m.values();  // allocates only when the map's size changed (a spray end, not a step)
@@ -308,6 +317,16 @@ void HapticRuntime::simLoop() {
             if (simTime >= nextGraphics) {
                 poles_.back() = surface_->poles();
                 poles_.publish();
+                if (paintedDirty_ && sprayMap_ != AirbrushSettings::Map::Off) {
+                    PaintedMap& p = painted_.back();
+                    const MaterialMap& m = mapOf(sprayMap_);
+                    p.map = sprayMap_;
+                    p.rows = m.rows();
+                    p.cols = m.cols();
+                    p.values = m.values();  // allocates only when the map's size changed
+                    painted_.publish();
+                    paintedDirty_ = false;
+                }
                 nextGraphics = simTime + graphicsEvery;
             }
         }

@@ -95,6 +95,13 @@ struct StrokeSnapshot {
     Eigen::VectorXd mapValues;
 };
 
+/// The map a spray is painting, as the GUI shows it while the spray goes on.
+struct PaintedMap {
+    AirbrushSettings::Map map = AirbrushSettings::Map::Off;
+    int rows = 1, cols = 1;
+    Eigen::VectorXd values;
+};
+
 class HapticRuntime {
 public:
     HapticRuntime(std::shared_ptr<DynamicSurface> surface, std::shared_ptr<Device> device, RuntimeSettings settings);
@@ -111,6 +118,8 @@ public:
 
     /// Newest pole snapshot if one arrived since the last call (GUI thread).
     bool takePoles(Points& out);
+    /// The map being sprayed, if it changed since the last call (GUI thread; at the graphics rate).
+    bool takePaintedMap(PaintedMap& out);
     /// Oldest unclaimed stroke end, if any (session thread).
     bool takeStroke(StrokeSnapshot& out);
     /// Switches the airbrush (any thread); the simulation takes it up before its next step.
@@ -131,6 +140,7 @@ private:
     /// Simulation thread: sprays while `spraying`, and hands a finished spray over as a stroke.
     void airbrush(bool spraying, double simTime);
     void pushStroke(double simTime, AirbrushSettings::Map painted);
+    MaterialMap& mapOf(AirbrushSettings::Map map);  ///< the surface's map (not Off)
 
     std::shared_ptr<DynamicSurface> surface_;
     std::shared_ptr<Device> device_;
@@ -145,6 +155,7 @@ private:
     TripleBuffer<DeviceSample> cursor_;     // haptic -> simulation
     TripleBuffer<HapticEstimate> estimate_; // simulation -> haptic
     TripleBuffer<Points> poles_;            // simulation -> GUI
+    TripleBuffer<PaintedMap> painted_;      // simulation -> GUI, while spraying
     mutable TripleBuffer<ShownCursor> shown_;  // haptic -> GUI (status(): one reader)
 
     // GUI -> simulation: the airbrush, taken up between steps (the lock only when it changed).
@@ -155,6 +166,7 @@ private:
     AirbrushSettings airbrush_;
     AirbrushSettings::Map sprayMap_ = AirbrushSettings::Map::Off;  // the map of the spray under way
     double sprayTarget_ = 0, nextDab_ = 0;
+    bool paintedDirty_ = false;  // a dab since the last graphics snapshot
     std::atomic<bool> spraying_{false};  // for status()
 
     static constexpr int kStrokeSlots = 8;

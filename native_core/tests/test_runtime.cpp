@@ -261,6 +261,11 @@ TEST(HapticRuntime, AirbrushSpraysAlongTheCursorAsOneStrokeAndRendersNoForce) {
     ASSERT_TRUE(rt.takeStroke(stroke));
     EXPECT_FALSE(rt.takeStroke(stroke));
     ASSERT_EQ(stroke.painted, AirbrushSettings::Map::Stiffness);
+    PaintedMap shown;  // what the GUI showed during the spray
+    ASSERT_TRUE(rt.takePaintedMap(shown));
+    EXPECT_EQ(shown.map, AirbrushSettings::Map::Stiffness);
+    EXPECT_EQ(shown.values.size(), shown.rows * shown.cols);
+    EXPECT_GT(shown.values.maxCoeff(), 150.0);
     const MaterialMap& m = s->stiffnessMap();
     ASSERT_FALSE(m.uniform());
     ASSERT_EQ(stroke.mapValues.size(), m.values().size());
