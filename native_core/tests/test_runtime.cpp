@@ -287,7 +287,7 @@ TEST(HapticRuntime, SwitchingTheAirbrushOnMidGrabReleasesTheTool) {
     HapticRuntime rt(s, dev, RuntimeSettings{});
     rt.start();
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
-    EXPECT_TRUE(s->tool().grabbed() || !rt.running());
+    EXPECT_TRUE(rt.status().contactValid);  // the rope holds a mesh point (read through status: race-free)
     AirbrushSettings a;
     a.map = AirbrushSettings::Map::Mass;
     rt.setAirbrush(a);
