@@ -19,10 +19,11 @@ namespace hs {
 
 namespace {
 // Weight of an explicit extrapolation over a step with rho = dt^2 omega_max^2: whole up to 1,
-// falling as 1/rho^2 past it (it went unstable near rho = 2.7), none once negligible.
+// falling as 1/rho^2 past it (it went unstable near rho = 2.7), none below a tenth (rho > 3.2),
+// where it no longer buys accuracy but would still cost a pass over the mesh.
 double extrapolationWeight(double rho) {
     const double w = rho <= 1 ? 1.0 : 1.0 / (rho * rho);
-    return w > 1e-6 ? w : 0.0;
+    return w >= 0.1 ? w : 0.0;
 }
 }  // namespace
 
@@ -93,8 +94,8 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     } else {
         applyToolForces(dt, r, d_);
     }
-    // The parts of the right-hand side that do not depend on the iterate.
-    base_.setZero();
+    // The parts of the right-hand side that do not depend on the iterate (see the loop).
+    base_ = (h * gamma_).asDiagonal() * (*dBase - yMesh_);
     if (hasExternal_) base_ += (h * h) * fext_;
     if (toolForces_) base_ += (h * h) * ftool_;
     if (dampingLaw.kind != LawKind::Linear) {
@@ -108,24 +109,28 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
         }
     }
     // The first iterate: y, or the end of the step predicted to O(dt^3) (predictorWeight).
+    const Points* iterate = &yMesh_;
     if (w > 0) {
         x_ += w * (p + dt * v_ + (0.5 * dt) * (v_ - vHist_) - x_);
         meshTmp_ = yMesh_ + w * (d_ + dt * av_ + (0.5 * dt) * (av_ - avHist_) - yMesh_);
-    } else {
-        meshTmp_ = yMesh_;
+        iterate = &meshTmp_;
     }
     // Each iteration solves for the increment from the iterate x (mesh d = A x):
-    //   S (x' - x) = A^T [ M (y - d) + h D (x^ - d) + h^2 (f + J t - L d) ]
+    //   S (x' - x) = A^T [ (M + h D)(y - d) + h D (x^ - y) + h^2 (f + J t - L d) ]
     // Every term is small, so rounding stays relative to the step's motion. Solving for x' itself
     // puts M y (large) beside h^2 f (small): the solve's rounding, of the order of the positions,
     // then biases every step the same way, and BDF2 turns that into a drifting velocity (error
     // 4.7e-5 at a 1 us step in bench/time_vs_error.py's oscillation, growing as the step shrinks).
     double change = 0;
     for (int it = 0; it < solver.iterations; ++it) {
-        if (it > 0) A_.apply(x_, meshTmp_);
-        meshTmp2_ = base_ + m_.asDiagonal() * (yMesh_ - meshTmp_) + (h * gamma_).asDiagonal() * (*dBase - meshTmp_);
-        springs_.addProjections(meshTmp_, meshTmp2_, 0.25 * minMass_ / (h * h), h * h);
-        if (!constraints_.empty()) constraints_.addProjections(meshTmp_, meshTmp2_, terms_, h * h);
+        if (it > 0) {
+            A_.apply(x_, meshTmp_);
+            iterate = &meshTmp_;
+        }
+        if (iterate == &yMesh_) meshTmp2_ = base_;  // d = y
+        else meshTmp2_ = base_ + (m_ + h * gamma_).asDiagonal() * (yMesh_ - *iterate);
+        springs_.addProjections(*iterate, meshTmp2_, 0.25 * minMass_ / (h * h), h * h);
+        if (!constraints_.empty()) constraints_.addProjections(*iterate, meshTmp2_, terms_, h * h);
         A_.applyTransposed(meshTmp2_, fp_);
         systemSolver_.solve(fp_, acc_);
         change = acc_.cwiseAbs().maxCoeff();
