@@ -140,6 +140,21 @@ try:
     out["session_spray_undo"] = doc.UndoNames[:doc.UndoCount - undo_before]
     out["damping_values"] = int(np.asarray(obj.Proxy.surface.damping_map.values).size)
     Gui.runCommand("HapticSculpt_PaintDamping")  # off again
+    # the SpaceMouse path: with one listed, the Start command takes it over the mouse (a recorded
+    # SpaceMouse stands in for the hardware, whose reports issue 4's device tests replay)
+    from HapticSculpt import devices as hsdev
+    listed, opener = hsdev.list_devices, hsdev.spacemouse
+    hsdev.list_devices = lambda: [{{"spacemouse": True, "kind": "spacemouse", "path": "/dev/hidraw-recorded"}}]
+    hsdev.spacemouse = lambda path=None, **kw: opener(recording={recording!r}, **kw)  # the defaults: rate control
+    try:
+        Gui.runCommand("HapticSculpt_Session")
+        pump(1.0)
+        st = ctl.session.status()
+        out["spacemouse"] = [ctl.mouse is None, ctl.session.running, float(np.linalg.norm(st["cursor"]))]
+        Gui.runCommand("HapticSculpt_Session")  # stop
+        out["spacemouse_stopped"] = ctl.session is None
+    finally:
+        hsdev.list_devices, hsdev.spacemouse = listed, opener
     ov.cursor = None
     # the display commands, each pressed as a user would: ShowCurvature cycles curvature, mean,
     # Gaussian; ShowMap cycles mass, damping, stiffness; Zebra toggles
@@ -207,7 +222,8 @@ def colour_fraction(img: np.ndarray, test) -> float:
 @pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
 def test_overlay_commands_keys_and_pictures(tmp_path):
     os.makedirs(SHOTS, exist_ok=True)
-    out = run_freecad_gui(GUI_SCRIPT.format(shots=SHOTS, answer="{answer}"), str(tmp_path))
+    recording = os.path.join(ROOT, "tests", "fixtures", "hid", "spacemouse_wireless.hid")
+    out = run_freecad_gui(GUI_SCRIPT.format(shots=SHOTS, recording=recording, answer="{answer}"), str(tmp_path))
     with open(os.path.join(SHOTS, "overlay_cost.json"), "w") as f:
         json.dump({k: v for k, v in out.items() if k.startswith(("frame_ms", "sim_hz"))}, f, indent=1)
     # disabled without a document, enabled with a sculpt (constraint and paint need a cursor: they had one)
@@ -223,6 +239,9 @@ def test_overlay_commands_keys_and_pictures(tmp_path):
     assert "Sculpt stroke" not in out["session_spray_undo"], out["session_spray_undo"]
     assert out["damping_values"] > 1
     assert out["live_map"] == ["damping"]  # the overlay saw the spray while it went on
+    no_mouse, running, cursor_travel = out["spacemouse"]
+    assert no_mouse and running and out["spacemouse_stopped"]
+    assert cursor_travel > 0.5  # the recorded deflections moved the cursor (rate control: 2.6 mm)
     assert out["stiffness_range"][1] > 2 * out["stiffness_range"][0]
     assert out["magnet"] == ["magnet", "cylindrical"]
     assert {"Add point constraint", "Paint stiffness", "Tool: rope"} <= set(out["undo"]), out["undo"]
