@@ -384,6 +384,9 @@ def _legend(mesh: np.ndarray, display: str, rng: tuple[float, float]) -> Any:
         tr = coin.SoTranslation()
         tr.translation = (float(x0 + 1.3 * w), float(y), float(z0))
         label.addChild(tr)
+        font = coin.SoFont()
+        font.size = 18.0  # screen points: Coin's default bitmap font is hard to read beside a patch
+        label.addChild(font)
         txt = coin.SoText2()
         txt.string = text
         label.addChild(txt)
