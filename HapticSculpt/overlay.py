@@ -378,7 +378,7 @@ def _legend(mesh: np.ndarray, display: str, rng: tuple[float, float]) -> Any:
     units = {"mass": "", "damping": "", "stiffness": "", "curvature": " 1/mm", "mean": " 1/mm",
              "gauss": " 1/mm^2", "zebra": ""}[display]
     for y, text in ((ys[0], f"{rng[0]:.3g}{units}"), (ys[-1], f"{rng[1]:.3g}{units}"),
-                    (ys[-1] + 0.05 * size, display)):
+                    (ys[-1] + 0.15 * size, display)):
         label = coin.SoSeparator()
         label.addChild(_material((1.0, 1.0, 1.0)))
         tr = coin.SoTranslation()

@@ -31,6 +31,7 @@ def pump(seconds=0.0):
 
 def shot(name):
     ov.frame()
+    view.fitAll()  # the legend and the panel too
     pump()
     view.saveImage(os.path.join(shots, "overlay_" + name + ".png"), 800, 600, "Black")
 
@@ -115,6 +116,7 @@ try:
     out["undo"] = doc.UndoNames[:8]
     # A replay stroke through the session path the mouse and the devices use.
     ov = ctl.overlay(obj)
+    ctl.set_display("shading")  # (painting left the stiffness map on)
     stroke = hs.ReplayDevice.stroke((0, 0, 0), (0, 0, 30.0), seconds=0.8, hold=0.8)
     ctl.start_session(stroke)
     pump(1.0)
