@@ -30,19 +30,26 @@ std::shared_ptr<DynamicSurface> patch(int controls = 8, int mesh = 24) {
     return std::make_shared<DynamicSurface>(BSplineSurface::plane(controls, controls, 3, 3, 100, 100), mesh, mesh);
 }
 
-std::shared_ptr<ReplayDevice> lift(double seconds, double height, bool releaseAtEnd = true) {
-    const int n = 50;
-    std::vector<double> t(n);
+// A replayed device whose cursor follows path(s), s from 0 to 1 over `seconds`, with the button
+// held (released on the last sample if releaseAtEnd).
+template <class Path>
+std::shared_ptr<ReplayDevice> replay(double seconds, int n, bool releaseAtEnd, Path path) {
+    std::vector<double> t(static_cast<size_t>(n));
     Points xyz(n, 3);
     Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> q(n, 4);
-    std::vector<std::uint32_t> buttons(n, 1);
+    std::vector<std::uint32_t> buttons(static_cast<size_t>(n), 1);
     for (int i = 0; i < n; ++i) {
-        t[static_cast<size_t>(i)] = seconds * i / (n - 1);
-        xyz.row(i) << 0, 0, height * std::sin(3.14159 * 0.5 * i / (n - 1));
+        const double s = static_cast<double>(i) / (n - 1);
+        t[static_cast<size_t>(i)] = seconds * s;
+        xyz.row(i) = path(s).transpose();
         q.row(i) << 1, 0, 0, 0;
     }
     if (releaseAtEnd) buttons.back() = 0;
     return std::make_shared<ReplayDevice>(t, xyz, q, buttons);
+}
+
+std::shared_ptr<ReplayDevice> lift(double seconds, double height, bool releaseAtEnd = true) {
+    return replay(seconds, 50, releaseAtEnd, [height](double s) { return Vec3(0, 0, height * std::sin(3.14159 * 0.5 * s)); });
 }
 
 // Records the last force it was asked to render, from any thread.
@@ -231,21 +238,10 @@ TEST(HapticRuntime, StatusShowsTheCursorAndTheRopeContactForTheOverlay) {
 
 TEST(HapticRuntime, AirbrushSpraysAlongTheCursorAsOneStrokeAndRendersNoForce) {
     auto s = patch();
-    // The cursor sweeps along x over the patch with the button held, then lets go.
-    const int n = 40;
-    std::vector<double> t(n);
-    Points xyz(n, 3);
-    Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> q(n, 4);
-    std::vector<std::uint32_t> buttons(n, 1);
-    for (int i = 0; i < n; ++i) {
-        t[static_cast<size_t>(i)] = 0.5 * i / (n - 1);
-        xyz.row(i) << -30.0 + 60.0 * i / (n - 1), 0, 1.0;
-        q.row(i) << 1, 0, 0, 0;
-    }
-    buttons.back() = 0;
     RuntimeSettings settings;
     settings.stopWhenFinished = true;
-    HapticRuntime rt(s, std::make_shared<ReplayDevice>(t, xyz, q, buttons), settings);
+    // The cursor sweeps along x over the patch with the button held, then lets go.
+    HapticRuntime rt(s, replay(0.5, 40, true, [](double u) { return Vec3(-30.0 + 60.0 * u, 0, 1.0); }), settings);
     AirbrushSettings a;
     a.map = AirbrushSettings::Map::Stiffness;
     a.factor = 4.0;
