@@ -71,6 +71,17 @@ TEST(PrefactoredSolver, RejectsSingularMatrix) {
     EXPECT_ANY_THROW(solver.factor(m, "test"));
 }
 
+TEST(SamplingOperator, SamplesOnKnotsKeepNoVanishingBasisEntries) {
+    // Degree-1 poles sampled exactly at their knots: A is the identity, and the matrix the solvers
+    // factor must not carry the basis functions that vanish there (they tripled the solve's fill).
+    const BSplineSurface plane = BSplineSurface::plane(9, 7, 1, 1, 100, 100);
+    const SamplingOperator a(plane, 9, 7);
+    const Eigen::SparseMatrix<double> m = a.matrix().toEigen();
+    EXPECT_EQ(m.nonZeros(), 9 * 7);
+    for (int k = 0; k < m.outerSize(); ++k)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(m, k); it; ++it) EXPECT_NEAR(it.value(), 1.0, 1e-12);
+}
+
 class AllocationFree : public ::testing::TestWithParam<IntegratorKind> {};
 
 TEST_P(AllocationFree, SteppingWithToolConstraintsAndLawsDoesNotAllocate) {
