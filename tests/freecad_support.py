@@ -36,17 +36,23 @@ class DocumentTestCase(unittest.TestCase):
         shutil.rmtree(self.tmp, ignore_errors=True)
 
 
+def _addon_home(tmp: str, name: str) -> str:
+    """A private FREECAD_USER_HOME under ``tmp`` whose Mod/HapticSculpt links this checkout."""
+    home = os.path.join(tmp, name)
+    os.makedirs(os.path.join(home, "Mod"), exist_ok=True)
+    link = os.path.join(home, "Mod", "HapticSculpt")
+    if not os.path.lexists(link):
+        os.symlink(ROOT, link)
+    return home
+
+
 def run_freecadcmd(script: str, tmp: str, timeout: float = 300) -> dict:
     """Runs ``script`` in a new ``freecadcmd`` process with this checkout installed as an addon (a
     private FREECAD_USER_HOME whose Mod/HapticSculpt links here); the script stores its answer with
     ``answer(dict)``, which this returns."""
     if FREECADCMD is None:
         raise unittest.SkipTest("freecadcmd is not installed")
-    home = os.path.join(tmp, "fchome")
-    os.makedirs(os.path.join(home, "Mod"), exist_ok=True)
-    link = os.path.join(home, "Mod", "HapticSculpt")
-    if not os.path.lexists(link):
-        os.symlink(ROOT, link)
+    home = _addon_home(tmp, "fchome")
     out = os.path.join(tmp, "answer.json")
     path = os.path.join(tmp, "script.py")
     with open(path, "w") as f:
@@ -69,11 +75,7 @@ def run_freecad_gui(script: str, tmp: str, timeout: float = 300) -> dict:
     """Runs ``script`` in the real FreeCAD GUI under Xvfb with this checkout installed as an addon;
     the script's text may use ``{answer}`` (formatted in here with the path, as a repr) to dump its
     result dict as JSON before ``os._exit(0)``, which this returns."""
-    home = os.path.join(tmp, "guihome")
-    os.makedirs(os.path.join(home, "Mod"), exist_ok=True)
-    link = os.path.join(home, "Mod", "HapticSculpt")
-    if not os.path.lexists(link):
-        os.symlink(ROOT, link)
+    home = _addon_home(tmp, "guihome")
     out = os.path.join(tmp, "answer.json")
     path = os.path.join(tmp, "gui.py")
     with open(path, "w") as f:

@@ -61,10 +61,10 @@ AirbrushSettings airbrushSettings(const py::object& map, double radius, double f
     if (!map.is_none()) {
         if (!py::isinstance<py::str>(map)) throw std::invalid_argument("map: one of 'mass', 'damping', 'stiffness', or None (off)");
         const std::string name = py::cast<std::string>(map);
-        if (name == "mass") a.map = AirbrushSettings::Map::Mass;
-        else if (name == "damping") a.map = AirbrushSettings::Map::Damping;
-        else if (name == "stiffness") a.map = AirbrushSettings::Map::Stiffness;
-        else throw std::invalid_argument("map: one of 'mass', 'damping', 'stiffness', or None (off)");
+        for (auto m : {AirbrushSettings::Map::Mass, AirbrushSettings::Map::Damping, AirbrushSettings::Map::Stiffness})
+            if (name == mapName(m)) a.map = m;
+        if (a.map == AirbrushSettings::Map::Off)
+            throw std::invalid_argument("map: one of 'mass', 'damping', 'stiffness', or None (off)");
     }
     a.radius = radius;
     a.factor = factor;
