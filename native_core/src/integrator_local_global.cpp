@@ -87,9 +87,10 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     // The tool pulls where the mesh is predicted at the step's end, as BDF2 wants its forces: taken
     // at the start, they made the rope scene first order. The tool is explicit, so its own slope
     // limits the prediction as the springs' does (the smooth tool's slope is unknown: none).
+    if (w > 0) dd_ = dt * av_ + (0.5 * dt) * (av_ - avHist_);  // the predicted motion over the step (mesh)
     const double wt = w > 0 && tool_->grabbed() ? std::min(w, extrapolationWeight(dt * dt * tool_->slope() / minMass_)) : 0.0;
     if (wt > 0) {
-        meshTmp_ = d_ + wt * (dt * av_ + (0.5 * dt) * (av_ - avHist_));
+        meshTmp_ = d_ + wt * dd_;
         applyToolForces(dt, r, meshTmp_);
     } else {
         applyToolForces(dt, r, d_);
@@ -112,7 +113,7 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     const Points* iterate = &yMesh_;
     if (w > 0) {
         x_ += w * (p + dt * v_ + (0.5 * dt) * (v_ - vHist_) - x_);
-        meshTmp_ = yMesh_ + w * (d_ + dt * av_ + (0.5 * dt) * (av_ - avHist_) - yMesh_);
+        meshTmp_ = yMesh_ + w * (d_ + dd_ - yMesh_);
         iterate = &meshTmp_;
     }
     // Each iteration solves for the increment from the iterate x (mesh d = A x):
