@@ -44,6 +44,7 @@ def summarise(log: str, first: int, scenes: int) -> dict:
             c["steps"] += r["steps"]
             c["refused_steps"] += r["refused_steps"]
             c["energy_limited_steps"] += r["energy_limited_steps"]
+            c["verlet_steps"] += r.get("verlet_steps", 0)
             c["invalid_inputs_refused"] += r["invalid_inputs_refused"]
             if r["failure"]:
                 c["failures"] += 1
@@ -75,11 +76,11 @@ def main() -> int:
         print("\ninterrupted: finished scenes are kept in the log; rerun to resume", file=sys.stderr)
     summary = summarise(a.log, a.first, a.scenes)
     summary["complete"] = not interrupted and sum(c["scenes"] for c in summary["per_integrator"].values()) == a.scenes
-    print(f"{'integrator':<14}{'scenes':>9}{'steps':>10}{'refused':>10}{'energy guard':>14}{'invalid refused':>17}"
-          f"{'failures':>10}")
+    print(f"{'integrator':<14}{'scenes':>9}{'steps':>10}{'verlet':>10}{'refused':>10}{'energy guard':>14}"
+          f"{'invalid refused':>17}{'failures':>10}")
     for k, c in summary["per_integrator"].items():
-        print(f"{k:<14}{c['scenes']:>9}{c['steps']:>10}{c['refused_steps']:>10}{c['energy_limited_steps']:>14}"
-              f"{c['invalid_inputs_refused']:>17}{c.get('failures', 0):>10}")
+        print(f"{k:<14}{c['scenes']:>9}{c['steps']:>10}{c['verlet_steps']:>10}{c['refused_steps']:>10}"
+              f"{c['energy_limited_steps']:>14}{c['invalid_inputs_refused']:>17}{c.get('failures', 0):>10}")
     for f in summary["failures"][:20]:
         print(f"seed {f['seed']} ({f['integrator']}): {f['failure']}")
     with open(a.out, "w") as f:

@@ -43,6 +43,7 @@ class SceneResult:
     steps: int = 0
     refused_steps: int = 0
     energy_limited_steps: int = 0
+    verlet_steps: int = 0  # local/global steps taken by its explicit branch
     substeps: int = 0
     max_energy_ratio: float = 0.0
     invalid_inputs_refused: int = 0
@@ -196,6 +197,7 @@ def run_scene(seed: int, steps: int = STEPS) -> SceneResult:
             res.steps += 1
             res.refused_steps += int(rep.refused)
             res.energy_limited_steps += int(rep.energy_limited)
+            res.verlet_steps += int(rep.verlet)
             res.substeps += rep.substeps
             if not _finite(s):
                 res.failure = f"non-finite state after step {k}"

@@ -10,10 +10,12 @@ DT = 1e-3
 
 
 @pytest.mark.parametrize("tool", core.TOOLS)
-@pytest.mark.parametrize("order", [1, 2])
-def test_reaction_is_exact_newton_third_law(tool, order):
+@pytest.mark.parametrize("scheme", ["backward_euler", "bdf2", "verlet"])
+def test_reaction_is_exact_newton_third_law(tool, scheme):
     ds = core.patch((8, 8), (3, 3), (20, 20))
-    ds.time_order = order
+    ds.time_order = 1 if scheme == "backward_euler" else 2
+    # this soft patch is well within Verlet's stability limit: the implicit schemes must be asked for
+    ds.explicit_when_stable = scheme == "verlet"
     ds.set_tool(tool)
     if tool in ("magnet", "smooth"):
         ds.tool.radius = 30.0
@@ -32,8 +34,10 @@ def test_reaction_is_exact_newton_third_law(tool, order):
         ds.set_cursor([2.0 + 0.3 * k, 1.0, 1.0 + 0.5 * k], orientation=q, grab=True)
         r = ds.step(DT)
         after = (m[:, None] * ds.mesh_velocities().reshape(-1, 3)).sum(axis=0)
-        # backward Euler: P' - P = F dt; BDF2: P' - 4/3 P + 1/3 P_old = 2/3 F dt
-        impulse = after - before if order == 1 else 1.5 * (after - 4 / 3 * before + older / 3)
+        # backward Euler and Verlet: P' - P = F dt; BDF2: P' - 4/3 P + 1/3 P_old = 2/3 F dt
+        # (the smooth tool's slope is unknown, so Verlet is never taken with it)
+        assert r.verlet == (scheme == "verlet" and tool != "smooth")
+        impulse = after - before if scheme == "backward_euler" or r.verlet else 1.5 * (after - 4 / 3 * before + older / 3)
         older, before = before, after
         reaction = np.asarray(r.force)
         assert np.linalg.norm(reaction) > 0 or k == 0
@@ -176,6 +180,9 @@ def test_normal_constraint_reaches_target():
 
 def test_tangent_constraint_holds_plane():
     ds = core.patch((8, 8), (3, 3), (21, 21))
+    # Damped so that it settles in the 3 s: this soft patch steps by Verlet, which (unlike BDF2 at
+    # long steps) takes no numerical damping out of the constraint's ringing.
+    ds.damping_map.set_uniform(10.0)
     n = [0.0, math.sin(0.2), math.cos(0.2)]
     cid = ds.add_constraint("tangent", uv=(0.5, 0.5), target=n)
     settle(ds)
@@ -436,10 +443,14 @@ def _released_pole(offset: float = 0.0) -> core.DynamicSurface:
     return ds
 
 
-def _released_pole_mesh(dt: float, seconds: float = 0.02, offset: float = 0.0, iterations: int = 1) -> np.ndarray:
+def _released_pole_mesh(dt: float, seconds: float = 0.02, offset: float = 0.0, iterations: int = 1,
+                        verlet: bool = False) -> np.ndarray:
+    """The released pole's mesh after `seconds`: by BDF2 (the implicit step), or with local/global's
+    explicit Verlet branch allowed (`verlet`; then every step must have taken it)."""
     ds = _released_pole(offset)
     ds.iterations = iterations
-    ds.step(dt, round(seconds / dt))
+    ds.explicit_when_stable = verlet
+    assert ds.step(dt, round(seconds / dt)).verlet == verlet
     m = np.array(ds.mesh)
     m[..., 0] -= offset
     return m
@@ -460,3 +471,54 @@ def test_local_global_does_not_depend_on_where_the_surface_is():
     far = _released_pole_mesh(1e-3 / 256, offset=1000.0)
     motion = float(np.abs(near - _released_pole(0.0).mesh).max())
     assert float(np.abs(far - near).max()) < 1e-8 * motion * 1e3
+
+
+def test_verlet_branch_is_second_order():
+    ref = _released_pole_mesh(1e-3 / 512, iterations=8)
+    assert _released_pole().verlet_step_limit > 1e-3 / 4
+    errors = [float(np.abs(_released_pole_mesh(1e-3 / div, verlet=True) - ref).max()) for div in (4, 8, 16)]
+    assert errors[0] / errors[1] > 3.5 and errors[1] / errors[2] > 3.5, errors
+
+
+def _pd_stiffness(ds: core.DynamicSurface, k: float) -> tuple[np.ndarray, np.ndarray]:
+    """A^T L A and A^T M A (dense, per coordinate) for a uniform spring stiffness k: the springs'
+    Laplacian in control space, built here independently of the core (structural, diagonal and
+    anti-diagonal springs of the g x h mesh)."""
+    indptr, indices, data, shape = ds.sampling_matrix()
+    a = np.zeros(shape)
+    for row in range(shape[0]):
+        a[row, indices[indptr[row]:indptr[row + 1]]] = data[indptr[row]:indptr[row + 1]]
+    g, h = ds.mesh.shape[:2]
+    lap = np.zeros((g * h, g * h))
+    for i in range(g):
+        for j in range(h):
+            for di, dj in ((0, 1), (1, 0), (1, 1), (1, -1)):
+                if i + di < g and 0 <= j + dj < h:
+                    p, q = i * h + j, (i + di) * h + j + dj
+                    lap[[p, q], [p, q]] += k
+                    lap[p, q] -= k
+                    lap[q, p] -= k
+    m = np.asarray(ds.point_masses())
+    return a.T @ lap @ a, a.T @ (m[:, None] * a)
+
+
+def test_verlet_step_limit_bounds_the_highest_mode():
+    # The power iteration's bound against a dense eigen-solve of the same matrices, on a patch with
+    # an uneven mass map: safe (never above the limit omega_max says) and not far below it.
+    from scipy import linalg
+    ds = core.patch((7, 6), (3, 3), (17, 15))
+    ds.stiffness_map.set_uniform(1e4)
+    ds.damping_map.set_uniform(0.0)
+    ds.mass_map.set_values(np.array([[1.0, 3.0, 0.5], [2.0, 0.2, 1.0]]))
+    k, mp = _pd_stiffness(ds, 1e4)
+    omega = math.sqrt(linalg.eigh(k, mp, eigvals_only=True).max())
+    exact = 1.8 / omega
+    assert 0.9 * exact <= ds.verlet_step_limit <= exact
+    ds.set_tool("smooth")
+    ds.set_cursor([0.0, 0.0, 0.0], grab=True)
+    assert ds.verlet_step_limit == 0.0  # the smooth tool's slope is unknown: never explicit
+    ds.set_cursor([0.0, 0.0, 0.0], grab=False)
+    ds.damping_map.set_uniform(1e3)  # rate gamma / m up to 1e3 / 0.2 (the lightest mass): 0.1 / 5e3 s
+    assert ds.verlet_step_limit == pytest.approx(2e-5)
+    ds.explicit_when_stable = False
+    assert ds.verlet_step_limit == 0.0

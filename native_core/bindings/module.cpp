@@ -255,6 +255,7 @@ PYBIND11_MODULE(_core, m) {
         .def_readonly("iterations", &StepReport::iterations)
         .def_readonly("residual", &StepReport::residual)
         .def_readonly("slept", &StepReport::slept)
+        .def_readonly("verlet", &StepReport::verlet, "local_global took an explicit velocity Verlet step (stable at this dt)")
         .def_readonly("refused", &StepReport::refused)
         .def_readonly("energy_limited", &StepReport::energyLimited, "the energy guard scaled velocities or refused the step")
         .def_property_readonly("reason", [](const StepReport& r) { return std::string(r.reason); })
@@ -446,6 +447,10 @@ PYBIND11_MODULE(_core, m) {
         .def_property("time_order", [](const DynamicSurface& s) { return s.solver.timeOrder; },
                       [](DynamicSurface& s, int n) { if (n != 1 && n != 2) throw std::invalid_argument("time_order: 1 (backward Euler) or 2 (BDF2)"); s.solver.timeOrder = n; s.wake(); },
                       "local_global's time discretisation: 2 = BDF2 (default, second order), 1 = backward Euler")
+        .def_property("explicit_when_stable", [](const DynamicSurface& s) { return s.solver.explicitWhenStable; },
+                      [](DynamicSurface& s, bool e) { s.solver.explicitWhenStable = e; s.wake(); },
+                      "local_global: take an explicit velocity Verlet step wherever it is provably stable for the "
+                      "step (cheaper and more accurate there), the implicit step elsewhere (default on)")
         .def_property("cg_iterations", [](const DynamicSurface& s) { return s.solver.cgIterations; },
                       [](DynamicSurface& s, int n) { if (n < 1 || n > 10000) throw std::invalid_argument("cg_iterations: 1..10000"); s.solver.cgIterations = n; })
         .def_property("acceleration_limit", [](const DynamicSurface& s) { return s.solver.accelerationLimit; },
@@ -462,6 +467,8 @@ PYBIND11_MODULE(_core, m) {
                       "put in); runs for explicit, implicit, non-linear laws, curvature constraints and very long steps")
         .def_property("energy_slack", [](const DynamicSurface& s) { return s.energyGuard.slack; },
                       [](DynamicSurface& s, double x) { checkParam(x, "energy_slack", true); s.energyGuard.slack = x; })
+        .def_property_readonly("verlet_step_limit", &DynamicSurface::verletStepLimit,
+                               "longest step local_global takes by its explicit Verlet branch now (0: never)")
         .def_property_readonly("energy_ceiling", &DynamicSurface::energyCeiling,
                                "the energy guard's ceiling (0 when the guard is not running for this scene)")
         .def_property_readonly("asleep", &DynamicSurface::asleep)
@@ -478,6 +485,7 @@ PYBIND11_MODULE(_core, m) {
                     total.iterations += r.iterations;
                     total.residual = r.residual;
                     total.slept = r.slept;
+                    total.verlet = r.verlet;
                     total.reaction = r.reaction;
                     if (r.energyLimited) { total.energyLimited = true; total.reason = r.reason; }
                     if (r.refused) { total.refused = true; total.reason = r.reason; break; }

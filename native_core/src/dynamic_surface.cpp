@@ -12,7 +12,7 @@ DynamicSurface::DynamicSurface(BSplineSurface surface, int g, int h)
     const Eigen::Index S = static_cast<Eigen::Index>(g) * h, N = surface_.poles().rows();
     for (Points* m : {&d_, &dd_, &fext_, &ftool_, &force_, &meshTmp_, &meshTmp2_, &base_, &dPrev_, &av_, &dHist_, &avHist_, &dHat_, &yMesh_})
         m->setZero(S, 3);
-    for (Points* m : {&v_, &fp_, &p0_, &v0_, &a0_, &pStep_, &vStep_, &acc_, &cgR_, &cgZ_, &cgP_, &cgQ_, &x_, &pHist_, &vHist_, &xHat_})
+    for (Points* m : {&v_, &fp_, &p0_, &v0_, &a0_, &pStep_, &vStep_, &acc_, &cgR_, &cgZ_, &cgP_, &cgQ_, &x_, &pHist_, &vHist_, &xHat_, &aVerlet_})
         m->setZero(N, 3);
     m_.setZero(S);
     gamma_.setZero(S);
@@ -104,7 +104,7 @@ void DynamicSurface::refreshMaterials() {
     maxDampingRate_ = (gamma_.array() / m_.array()).maxCoeff();
     maxStiffness_ = stiffness_.values().maxCoeff();
     for (int i = 0; i < 3; ++i) materialKey_[i] = key[i];
-    accelerationValid_ = false;
+    accelerationValid_ = verletValid_ = false;
 }
 
 void DynamicSurface::ensureMassFactor() {
@@ -192,10 +192,10 @@ void DynamicSurface::setCursor(const Cursor& c) {
     cursor_ = n;
 }
 
-void DynamicSurface::applyToolForces(double dt, StepReport& r, const Points& at) {
+void DynamicSurface::applyToolForces(double dt, StepReport& r, const Points& at, double phase) {
     if (tool_->grabbed()) {
         ftool_.setZero();
-        r.reaction = tool_->apply({at, g(), h(), spacingU_, spacingV_}, cursor_, dt, ftool_);
+        r.reaction = tool_->apply({at, g(), h(), spacingU_, spacingV_}, cursor_, dt, ftool_, phase);
         toolForces_ = true;
         accelerationValid_ = false;
     } else if (toolForces_) {
@@ -228,13 +228,19 @@ StepReport DynamicSurface::step(double dt) {
     const std::uint64_t key[4] = {mass_.version(), damping_.version(), stiffness_.version(), constraints_.version()};
     for (int i = 0; i < 4; ++i)
         if (key[i] != wakeKey_[i]) { touch(); resetEnergyCeiling(); wakeKey_[i] = key[i]; }
-    if (tool_->grabbed()) touch();
+    if (tool_->grabbed()) {  // awake; Verlet's carried forces hold no tool force and stay valid
+        const bool carried = verletValid_;
+        touch();
+        verletValid_ = carried;
+    }
     StepReport r;
     if (asleep_) {
         r.slept = true;
         return r;
     }
-    const bool guard = guardsEnergy(dt);
+    const bool verlet = solver.kind == IntegratorKind::LocalGlobal && verletStable(dt);
+    const bool guard = guardsEnergy(dt, verlet);
+    stepPotential_ = -1;
     if (!guard) ceilingValid_ = false;
     else if (!ceilingValid_) {
         ceiling_ = kineticEnergy() + potentialEnergy();
@@ -247,10 +253,11 @@ StepReport DynamicSurface::step(double dt) {
     // The mesh before the step: for the work of the applied forces, and for local/global's A v.
     if (tracksWork || solver.kind == IntegratorKind::LocalGlobal) dPrev_ = d_;
     if (solver.kind != IntegratorKind::LocalGlobal) avValid_ = histValid_ = false;
+    if (!verlet) verletValid_ = false;
     switch (solver.kind) {
         case IntegratorKind::Explicit: r = stepExplicit(dt); break;
         case IntegratorKind::ImplicitCG: r = stepImplicitCG(dt); break;
-        case IntegratorKind::LocalGlobal: r = stepLocalGlobal(dt); break;
+        case IntegratorKind::LocalGlobal: r = verlet ? stepVerlet(dt) : stepLocalGlobal(dt); break;
     }
     if (!surface_.poles().allFinite() || !v_.allFinite()) {
         restoreStepStart(true);
@@ -267,15 +274,20 @@ StepReport DynamicSurface::step(double dt) {
     }
     if (guard && !limitEnergy(work, r)) return r;
     work_ += work;
-    if (springs_.plasticity.enabled) springs_.applyPlasticity(d_, dt);
+    if (springs_.plasticity.enabled) {
+        springs_.applyPlasticity(d_, dt);
+        verletValid_ = false;  // the rest lengths moved under the forces Verlet carries over
+    }
     time_ += dt;
     ++steps_;
     checkSleep(dt);
     return r;
 }
 
-bool DynamicSurface::guardsEnergy(double dt) const {
+bool DynamicSurface::guardsEnergy(double dt, bool verlet) const {
     if (!energyGuard.enabled) return false;
+    // Verlet is stable here but not a descent method: the guard stays as for every explicit scheme.
+    if (verlet) return true;
     // Point, tangent and normal constraints project onto convex sets, so they keep the guarantee.
     if (solver.kind != IntegratorKind::LocalGlobal || springs_.law.kind != LawKind::Linear || constraints_.anyNonConvex())
         return true;
@@ -290,7 +302,7 @@ bool DynamicSurface::limitEnergy(double work, StepReport& r) {
     const double ceiling = ceiling_ + std::max(0.0, work);
     // Below this floor energy is rounding noise: 1e-12 of a surface-sized stretch at the mean stiffness.
     const double floor = 1e-12 * stiffness_.mean() * size_ * size_;
-    const double ke = kineticEnergy(), pe = potentialEnergy();
+    const double ke = kineticEnergy(), pe = stepPotential_ >= 0 ? stepPotential_ : potentialEnergy();
     if (ke + pe <= (1 + energyGuard.slack) * ceiling + floor) {
         ceiling_ = ceiling;
         return true;
@@ -301,7 +313,7 @@ bool DynamicSurface::limitEnergy(double work, StepReport& r) {
         v_ *= s;
         av_ *= s;
         histValid_ = false;
-        accelerationValid_ = false;
+        accelerationValid_ = verletValid_ = false;
         ceiling_ = ceiling;
         r.reason = "the step would have created energy; velocities scaled back to the energy ceiling (reduce dt or stiffness)";
         return true;
@@ -324,7 +336,7 @@ void DynamicSurface::checkSleep(double dt) {
     if (fp_.cwiseAbs().maxCoeff() < sleep.tolerance * stiffness_.mean() * size_) {
         asleep_ = true;
         v_.setZero();
-        avValid_ = histValid_ = false;
+        avValid_ = histValid_ = verletValid_ = false;
     } else {
         quietSteps_ = 0;
     }
@@ -343,7 +355,7 @@ void DynamicSurface::restoreStepStart(bool keepVelocity) {
     else v_.setZero();
     avValid_ = histValid_ = false;
     A_.apply(surface_.poles(), d_);
-    accelerationValid_ = false;
+    accelerationValid_ = verletValid_ = false;
 }
 
 double DynamicSurface::potentialEnergy() {

@@ -27,10 +27,18 @@ enum class IntegratorKind {
     LocalGlobal,  ///< backward Euler by prefactored local/global iterations in control space (default)
 };
 
+/// Local/global takes an explicit velocity Verlet step instead where that is provably stable
+/// (integrator_verlet.cpp): omega_max dt below this, omega_max bounded by the springs' and penalty
+/// terms' Laplacian (which bounds their Hessian for linear laws) and the tool's slope.
+constexpr double kVerletStability = 1.8;
+
 struct SolverSettings {
     IntegratorKind kind = IntegratorKind::LocalGlobal;
     int iterations = 1;              ///< local/global iterations per step
     int timeOrder = 2;               ///< local/global: 1 = backward Euler, 2 = BDF2 (same cost, second order)
+    /// local/global: take an explicit velocity Verlet step where it is stable (cheaper, second order,
+    /// no numerical damping); the implicit step otherwise
+    bool explicitWhenStable = true;
     int cgIterations = 5;            ///< implicit: CG iterations per step
     /// explicit: halve the step while any control-point acceleration exceeds this;
     /// 0 = automatic, 0.1 * size / h^2 for a substep h (no point may be flung a tenth of the surface in one substep)
@@ -68,6 +76,7 @@ struct StepReport {
     int iterations = 0;   ///< local/global or CG iterations in total
     double residual = 0;  ///< CG: relative residual; local/global: last update / size; explicit: 0
     bool slept = false;   ///< the surface was at rest and was not stepped
+    bool verlet = false;  ///< local/global took an explicit velocity Verlet step (stable for this dt)
     bool refused = false; ///< the step would have produced NaN/Inf or created energy; the state was kept
     bool energyLimited = false;  ///< the energy guard stepped in (velocities scaled down or step refused)
     const char* reason = "";
@@ -150,6 +159,9 @@ public:
     double workDone() const { return work_; }  ///< work of external and tool forces so far
     /// The energy guard's current ceiling (0 while the guard is not running for this scene).
     double energyCeiling() const { return ceilingValid_ ? ceiling_ : 0.0; }
+    /// Longest step local/global takes by its explicit Verlet branch in the current configuration
+    /// (0 where it never does: switched off, non-linear laws, curvature constraints, smooth tool).
+    double verletStepLimit();
 
     // --- measures -----------------------------------------------------------------------------
     double kineticEnergy();
@@ -160,10 +172,10 @@ public:
     Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> curvatureGrid() const;
 
 private:
-    void touch() { asleep_ = false; quietSteps_ = 0; accelerationValid_ = false; }
+    void touch() { asleep_ = false; quietSteps_ = 0; accelerationValid_ = false; verletValid_ = false; }
     /// Something outside a step changed the energy (shape, velocities, springs, materials, constraints).
     void resetEnergyCeiling() { ceilingValid_ = false; }
-    bool guardsEnergy(double dt) const;
+    bool guardsEnergy(double dt, bool verlet) const;
     /// Back to the state step() started from (refused steps); velocities kept or zeroed.
     void restoreStepStart(bool keepVelocity);
     /// Applies the energy guard after a finite step that did `work`; returns false if it refused the step.
@@ -174,13 +186,25 @@ private:
     /// Total mesh force (external, tool, springs, constraints, damping) into force_; returns the
     /// elastic energy. Needs dd_ (mesh velocity) current.
     double meshForces(const Points& d, const Points& dd, double dt);
+    /// Verlet's internal forces (linear springs, constraints, linear damping at mesh velocity dd)
+    /// into force_; returns the potential energy.
+    double verletForces(const Points& d, const Points& dd);
     StepReport stepExplicit(double dt);
     StepReport stepImplicitCG(double dt);
     StepReport stepLocalGlobal(double dt);
+    /// Whether local/global's explicit branch is stable at dt (computes omegaSquaredBound() lazily).
+    bool verletStable(double dt);
+    /// The tool's share of Verlet's omega^2 bound; infinite where Verlet is never taken.
+    double verletToolTerm() const;
+    /// Upper bound on omega_max^2 of the springs and penalty terms in control space, cached per
+    /// configuration; only a lower bound (cheaper) where that already exceeds `limit`. Allocates
+    /// when it recomputes.
+    double omegaSquaredBound(double limit);
+    StepReport stepVerlet(double dt);
     void explicitSubstep(double dt, int depth, StepReport& r);
     void computeAcceleration();  // acc_ from the current p, v
     /// The tool's force on the mesh `at` (the current mesh, or local/global's prediction of the step's end).
-    void applyToolForces(double dt, StepReport& r, const Points& at);
+    void applyToolForces(double dt, StepReport& r, const Points& at, double phase = 1.0);
     /// Local/global BDF2: weight in [0, 1] of a second-order extrapolation over dt (the prediction
     /// of the step's end; with `fixedTargets`, point constraints count too: the history's start).
     double predictorWeight(double dt, bool fixedTargets) const;
@@ -196,6 +220,12 @@ private:
     // local/global BDF2: the state one step back (poles, velocities, mesh, A v) and x^ = (4 x_n - x_n-1) / 3
     Points pHist_, vHist_, dHist_, avHist_, xHat_, dHat_;
     Points yMesh_;  // local/global: the inertial prediction y on the mesh
+    Points aVerlet_;  // Verlet: acceleration of the internal forces at the step's start (first same as last)
+    bool verletValid_ = false;  // aVerlet_ belongs to the current state (cleared by touch() and anything moving it)
+    double stepPotential_ = -1;  // Verlet: potential energy at the step's end, for the energy guard (-1: none)
+    std::uint64_t omegaKey_[3] = {~0ull, ~0ull, ~0ull};
+    double omega2_ = 0;  // omegaSquaredBound(): an upper bound if omega2Exact_, else a lower one
+    bool omega2Exact_ = false;
     double histDt_ = 0;
     /// The history is the previous step's at histDt_ (cleared with avValid_, and where the applied
     /// forces jump: external forces set or cleared, a grab or a release). BDF2 extrapolates the

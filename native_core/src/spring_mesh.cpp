@@ -25,11 +25,13 @@ auto withLaw(const ResponseLaw& law, Body&& body) {
     return body(FixedLaw<LawKind::Linear>{law.scale});
 }
 // c_j (x_a - x_b) for one run; branch-free so that it vectorises (Uniform: one stiffness for all).
-template <bool Uniform, class Law>
+// With Energy, also k e^2 into ce (summed by the caller: a reduction here would not vectorise).
+template <bool Uniform, bool Energy, class Law>
 void projectRun(Law lw, int n, const double* __restrict xa, const double* __restrict ya, const double* __restrict za,
                 const double* __restrict xb, const double* __restrict yb, const double* __restrict zb,
                 const double* __restrict rest, const double* __restrict k, double kUniform, double maxExtra,
-                double minL, double* __restrict cx, double* __restrict cy, double* __restrict cz) {
+                double minL, double* __restrict cx, double* __restrict cy, double* __restrict cz,
+                double* __restrict ce) {
     for (int j = 0; j < n; ++j) {
         const double kj = Uniform ? kUniform : k[j];
         const double dx = xa[j] - xb[j], dy = ya[j] - yb[j], dz = za[j] - zb[j];
@@ -44,6 +46,7 @@ void projectRun(Law lw, int n, const double* __restrict xa, const double* __rest
         cx[j] = c * dx;
         cy[j] = c * dy;
         cz[j] = c * dz;
+        if (Energy) ce[j] = kj * e * e;
     }
 }
 }  // namespace
@@ -67,7 +70,7 @@ SpringMesh::SpringMesh(int g, int h, const Points& d) : g_(g), h_(h) {
     dirx_.assign(n, 0); diry_.assign(n, 0); dirz_.assign(n, 0); axial_.assign(n, 0); lateral_.assign(n, 0);
     const Eigen::Index points = static_cast<Eigen::Index>(g) * h;
     for (Eigen::VectorXd* v : {&x_, &y_, &z_, &fx_, &fy_, &fz_}) v->setZero(points);
-    for (Eigen::VectorXd* v : {&cx_, &cy_, &cz_}) v->setZero(std::max(g, h) + 1);
+    for (Eigen::VectorXd* v : {&cx_, &cy_, &cz_, &ce_}) v->setZero(std::max(g, h) + 1);
     resetRest(d);
     rest0_ = rest_;
 }
@@ -143,7 +146,7 @@ void SpringMesh::addTangentStiffness(const Points& y, Points& out) const {
     }
 }
 
-void SpringMesh::addProjections(const Points& d, Points& out, double maxExtraStiffness, double scale) const {
+double SpringMesh::addProjections(const Points& d, Points& out, double maxExtraStiffness, double scale, bool energy) const {
     // Each spring's energy 1/2 k |x_a - x_b - t|^2 is minimised over |t| = target length;
     // a non-linear law changes the target length so that k (l - |t|) = g(k (l - r)).
     // Runs of one family in one row have contiguous endpoints a and a + offset: in structure-of-
@@ -165,6 +168,8 @@ void SpringMesh::addProjections(const Points& d, Points& out, double maxExtraSti
     const bool uniform = k_.empty();
     const double* kv = uniform ? nullptr : k_.data();
     const double kU = kUniform_, minL = minLength;
+    double* ce = ce_.data();
+    double twiceEnergy = 0;
     withLaw(law, [&](auto lw) {
         for (const Run& run : runs_) {
             const double* xa = X + run.a0;
@@ -175,8 +180,14 @@ void SpringMesh::addProjections(const Points& d, Points& out, double maxExtraSti
             const double* zb = za + run.offset;
             const double* r = rest + run.first;
             const double* kr = uniform ? nullptr : kv + run.first;
-            if (uniform) projectRun<true>(lw, run.length, xa, ya, za, xb, yb, zb, r, nullptr, kU, maxExtraStiffness, minL, cx, cy, cz);
-            else projectRun<false>(lw, run.length, xa, ya, za, xb, yb, zb, r, kr, kU, maxExtraStiffness, minL, cx, cy, cz);
+            if (energy) {
+                if (uniform) projectRun<true, true>(lw, run.length, xa, ya, za, xb, yb, zb, r, nullptr, kU, maxExtraStiffness, minL, cx, cy, cz, ce);
+                else projectRun<false, true>(lw, run.length, xa, ya, za, xb, yb, zb, r, kr, kU, maxExtraStiffness, minL, cx, cy, cz, ce);
+                twiceEnergy += Eigen::Map<const Eigen::VectorXd>(ce, run.length).sum();
+            } else {
+                if (uniform) projectRun<true, false>(lw, run.length, xa, ya, za, xb, yb, zb, r, nullptr, kU, maxExtraStiffness, minL, cx, cy, cz, ce);
+                else projectRun<false, false>(lw, run.length, xa, ya, za, xb, yb, zb, r, kr, kU, maxExtraStiffness, minL, cx, cy, cz, ce);
+            }
             double* fxa = fx_.data() + run.a0;
             double* fya = fy_.data() + run.a0;
             double* fza = fz_.data() + run.a0;
@@ -193,6 +204,7 @@ void SpringMesh::addProjections(const Points& d, Points& out, double maxExtraSti
         out(i, 1) += scale * fy_[i];
         out(i, 2) += scale * fz_[i];
     }
+    return energy && law.kind == LawKind::Linear ? 0.5 * twiceEnergy : 0.0;
 }
 
 void SpringMesh::applyPlasticity(const Points& d, double dt) {

@@ -52,7 +52,10 @@ public:
     /// J t alone: J t and L d are large and nearly cancel, and the solver solves for the increment
     /// (see integrator_local_global.cpp). maxExtraStiffness caps |g(k e) - k e| / |e|: the part of a non-linear law the prefactored
     /// matrix does not hold is explicit, and stays stable only below about m / dt^2.
-    void addProjections(const Points& d, Points& out, double maxExtraStiffness, double scale = 1.0) const;
+    /// With `energy`, also returns the elastic energy of a linear law (0 otherwise): for a linear law
+    /// J t - L d is the spring force, and this is the vectorised force pass of the Verlet step.
+    double addProjections(const Points& d, Points& out, double maxExtraStiffness, double scale = 1.0,
+                          bool energy = false) const;
     /// Plastic flow over a step of length dt.
     void applyPlasticity(const Points& d, double dt);
     /// Triplets of the weighted graph Laplacian sum_s k_s (e_a - e_b)(e_a - e_b)^T.
@@ -76,7 +79,7 @@ private:
     };
     std::vector<Run> runs_;
     // Structure-of-arrays scratch for the vectorised local step.
-    mutable Eigen::VectorXd x_, y_, z_, fx_, fy_, fz_, cx_, cy_, cz_;
+    mutable Eigen::VectorXd x_, y_, z_, fx_, fy_, fz_, cx_, cy_, cz_, ce_;
 };
 
 }  // namespace hs

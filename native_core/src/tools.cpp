@@ -16,9 +16,10 @@ void Tool::emit(int index, const Vec3& force) {
     force_.push_back(force);
 }
 
-Reaction Tool::apply(const MeshView& mesh, const Cursor& cursor, double dt, Points& f) {
+Reaction Tool::apply(const MeshView& mesh, const Cursor& cursor, double dt, Points& f, double phase) {
     Reaction r;
     if (!grabbed_) return r;
+    forceTime_ = time_ + phase * dt;
     time_ += dt;
     index_.clear();
     force_.clear();
@@ -26,7 +27,7 @@ Reaction Tool::apply(const MeshView& mesh, const Cursor& cursor, double dt, Poin
     Vec3 total = Vec3::Zero();
     for (const Vec3& fi : force_) total += fi;
     // Ramp in after the grab, then clamp the total; one scale for all points keeps the reaction exact.
-    double scale = limits.rampTime > 0 ? std::min(1.0, time_ / limits.rampTime) : 1.0;
+    double scale = limits.rampTime > 0 ? std::min(1.0, forceTime_ / limits.rampTime) : 1.0;
     const double mag = total.norm() * scale;
     if (mag > limits.maxForce) scale *= limits.maxForce / mag;
     for (size_t i = 0; i < index_.size(); ++i) {
@@ -104,15 +105,15 @@ void RopeTool::grab(const MeshView& mesh, const Cursor& cursor) {
     grabbed_ = true;
 }
 
-double RopeTool::restLength() const {
-    return reelTime > 0 ? length0_ * std::max(0.0, 1.0 - time_ / reelTime) : 0.0;
+double RopeTool::restLengthAt(double t) const {
+    return reelTime > 0 ? length0_ * std::max(0.0, 1.0 - t / reelTime) : 0.0;
 }
 
 void RopeTool::computeForces(const MeshView& mesh, const Cursor& cursor) {
     const Vec3 x = mesh.d.row(point_).transpose();
     const Vec3 toCursor = cursor.position - x;
     const double dist = toCursor.norm();
-    const double ext = dist - restLength();
+    const double ext = dist - restLengthAt(forceTime_);
     if (ext <= 0 || !(dist > 0)) return;  // a slack rope transmits nothing: it cannot push
     const double tension = stiffness * std::min(ext, threshold) + stiffStiffness * std::max(0.0, ext - threshold);
     emit(point_, tension / dist * toCursor);

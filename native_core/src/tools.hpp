@@ -48,7 +48,9 @@ public:
     virtual void release() { grabbed_ = false; }
     bool grabbed() const { return grabbed_; }
     /// Advances the tool's clock by dt and adds its forces to f; returns the reaction on the cursor.
-    Reaction apply(const MeshView& mesh, const Cursor& cursor, double dt, Points& f);
+    /// The forces are those at `phase` of the way through the step on the clock (ramp, reel): 1 its
+    /// end, as the implicit steps take them; 0.5 its middle, for Verlet's midpoint rule.
+    Reaction apply(const MeshView& mesh, const Cursor& cursor, double dt, Points& f, double phase = 1.0);
     /// Mass point the tool is attached to (nearest point for the rope), -1 if none.
     virtual int anchor() const { return -1; }
     /// Steepest force per unit displacement on one mass point (infinite when unknown): how stiff
@@ -69,6 +71,7 @@ protected:
     void emit(int index, const Vec3& force);
     bool grabbed_ = false;
     double time_ = 0;  ///< seconds since grab
+    double forceTime_ = 0;  ///< the clock the current forces are taken at (apply's phase)
 
 private:
     std::vector<int> index_;
@@ -86,7 +89,7 @@ public:
     void grab(const MeshView& mesh, const Cursor& cursor) override;
     int anchor() const override { return grabbed_ ? point_ : -1; }
     double slope() const override { return std::max(stiffness, stiffStiffness); }
-    double restLength() const;
+    double restLength() const { return restLengthAt(time_); }
     double stiffness = 10.0;        ///< force per length while slack is below threshold
     double stiffStiffness = 200.0;  ///< past the threshold
     double threshold = 5.0;         ///< extension beyond rest where the rope turns stiff
@@ -97,6 +100,7 @@ protected:
     bool describeLaw(const MeshView& mesh, HapticEstimate& e) const override;
 
 private:
+    double restLengthAt(double t) const;
     int point_ = -1;
     double length0_ = 0;
 };

@@ -111,6 +111,34 @@ TEST_P(AllocationFree, SteppingWithToolConstraintsAndLawsDoesNotAllocate) {
     EXPECT_EQ(g_allocations.load() - before, 0);
 }
 
+TEST(Verlet, SteppingWithToolConstraintsForcesAndPlasticityDoesNotAllocate) {
+    // Local/global's explicit branch on a soft patch (linear laws: the only ones it takes).
+    DynamicSurface s(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 30, 30);
+    s.sleep.enabled = false;
+    s.constraints().add(ConstraintKind::Point, 40, 1.0, s.mesh(), nullptr, nullptr, nullptr);
+    s.constraints().add(ConstraintKind::Normal, 300, 1.0, s.mesh(), nullptr, nullptr, nullptr);
+    s.springs().plasticity.enabled = true;
+    s.stiffnessMap().dab(0.5, 0.5, 0.2, 50.0, Falloff::Conical, 1.0);
+    Cursor c;
+    c.position = Vec3(1, 2, 3);
+    c.grab = true;
+    s.setCursor(c);
+    s.setPointForce(100, Vec3(0, 0, 5));
+    const double dt = 2e-4;
+    ASSERT_GT(s.verletStepLimit(), dt);
+    s.step(dt);  // warm-up: factorisation, the stability bound and first-use buffers
+    s.step(dt);
+    const long before = g_allocations.load();
+    for (int i = 0; i < 50; ++i) {
+        c.position.z() += 0.05;
+        s.setCursor(c);
+        const StepReport r = s.step(dt);
+        ASSERT_TRUE(r.verlet);
+        ASSERT_FALSE(r.refused);
+    }
+    EXPECT_EQ(g_allocations.load() - before, 0);
+}
+
 INSTANTIATE_TEST_SUITE_P(Integrators, AllocationFree,
                          ::testing::Values(IntegratorKind::Explicit, IntegratorKind::ImplicitCG, IntegratorKind::LocalGlobal));
 

@@ -1,0 +1,158 @@
+// Local/global's explicit branch: velocity Verlet in control space, taken instead of the implicit
+// step wherever it is provably stable (stiffness switching, as LSODA switches between its non-stiff
+// and stiff methods). Below its stability limit an explicit step is the better buy: one force
+// evaluation and one solve by the prefactored mass matrix, second order, and no numerical damping,
+// where BDF2 damps and dephases the mesh modes it cannot resolve (bench/time_vs_error.py: converged
+// BDF2 on the free oscillation at 125 us is 6x less accurate than the explicit scheme at the same
+// step).
+//   v+ = v_n + h/2 a_n,  x_n+1 = x_n + h v+,  v_n+1 = v+ + h/2 a_n+1
+// with a = (A^T M A)^-1 A^T f. The internal forces (springs, constraints, damping) are evaluated once
+// per step and carried to the next (first same as last); damping is taken at the second-order
+// estimate 2 v+ - v_n of v_n+1. The applied forces (tool, external) are held over the step, taken
+// at the mesh predicted half a step ahead (midpoint rule, second order), so a cursor that moves
+// between steps is seen at once.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "dynamic_surface.hpp"
+
+namespace hs {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+}  // namespace
+
+double DynamicSurface::omegaSquaredBound(double limit) {
+    const std::uint64_t key[3] = {mass_.version(), stiffness_.version(), constraints_.structureVersion()};
+    const bool same = key[0] == omegaKey_[0] && key[1] == omegaKey_[1] && key[2] == omegaKey_[2];
+    if (same && (omega2Exact_ || omega2_ > limit)) return omega2_;
+    // For linear springs the Hessian of 1/2 k (|x_a - x_b| - l)^2 is k n n^T + k (1 - l / |x_a - x_b|)
+    // (I - n n^T) <= k I: the Laplacian L bounds it whatever the state, and penalty terms are the
+    // same form (projections onto convex sets). So omega_max^2 <= lambda_max((A^T M A)^-1 A^T L A),
+    // found here by power iteration: Rayleigh quotients approach it from below, hence the margin.
+    ensureMassFactor();
+    std::vector<Eigen::Triplet<double>> lap;
+    springs_.addLaplacian(lap);
+    constraints_.addLaplacian(lap);
+    const Eigen::Index S = d_.rows();
+    Eigen::SparseMatrix<double> L(S, S);
+    L.setFromTriplets(lap.begin(), lap.end());
+    const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
+    const Eigen::SparseMatrix<double> K = A.transpose() * L * A;
+    const Eigen::SparseMatrix<double> M = A.transpose() * m_.asDiagonal() * A;
+    for (int i = 0; i < 3; ++i) omegaKey_[i] = key[i];
+    // max K_ii / M_ii is a Rayleigh quotient too: a lower bound that rules out long steps cheaply.
+    omega2_ = (K.diagonal().array() / M.diagonal().array()).maxCoeff();
+    omega2Exact_ = false;
+    if (omega2_ > limit) return omega2_;
+    // Three seeded random starts side by side (the mass solver works on N x 3 blocks); stop when
+    // the largest quotient has settled to 1e-4 over 5 iterations.
+    Points y(K.rows(), 3), z(K.rows(), 3), my(K.rows(), 3);
+    std::mt19937 rng(12345);
+    std::uniform_real_distribution<double> uni(-1.0, 1.0);
+    for (Eigen::Index i = 0; i < y.size(); ++i) y.data()[i] = uni(rng);
+    double best = omega2_, settled = best;
+    for (int it = 0; it < 300; ++it) {
+        z = K * y;
+        my = M * y;
+        for (int c = 0; c < 3; ++c) {
+            const double den = y.col(c).dot(my.col(c));
+            if (den > 0) best = std::max(best, y.col(c).dot(z.col(c)) / den);
+        }
+        if (it % 5 == 4) {
+            if (best <= settled * (1 + 1e-4)) break;
+            settled = best;
+        }
+        massSolver_.solve(z, y);
+        for (int c = 0; c < 3; ++c) {
+            const double n = y.col(c).cwiseAbs().maxCoeff();
+            if (n > 0) y.col(c) /= n;
+        }
+    }
+    omega2_ = 1.05 * best;
+    omega2Exact_ = true;
+    return omega2_;
+}
+
+double DynamicSurface::verletForces(const Points& d, const Points& dd) {
+    force_.setZero();
+    double energy = springs_.addProjections(d, force_, 0.0, 1.0, true);  // the spring forces, for a linear law
+    if (!constraints_.empty()) energy += constraints_.addForces(d, force_, terms_);
+    if (maxDampingRate_ > 0) force_ -= gamma_.asDiagonal() * dd;
+    return energy;
+}
+
+double DynamicSurface::verletToolTerm() const {
+    if (!solver.explicitWhenStable) return kInf;
+    // Non-linear laws stiffen without bound; curvature constraints project onto arcs (not convex).
+    if (springs_.law.kind != LawKind::Linear || dampingLaw.kind != LawKind::Linear || constraints_.anyNonConvex())
+        return kInf;
+    // The tool adds at most slope on each point it holds: omega^2 grows by at most slope / m_min.
+    return tool_->grabbed() ? tool_->slope() / minMass_ : 0.0;
+}
+
+bool DynamicSurface::verletStable(double dt) {
+    // Damping is explicit too (rate gamma / m, A^T D A <= rate A^T M A): stable up to rate dt = 0.1
+    // together with omega dt = 1.8 (the scalar recurrence's spectral radius is then 0.84).
+    if (dt * maxDampingRate_ > 0.1) return false;
+    const double tool = verletToolTerm();
+    if (!std::isfinite(tool)) return false;
+    const double limit = kVerletStability * kVerletStability / (dt * dt);
+    return omegaSquaredBound(limit - tool) + tool <= limit;
+}
+
+double DynamicSurface::verletStepLimit() {
+    refreshMaterials();
+    const double tool = verletToolTerm();
+    if (!std::isfinite(tool)) return 0.0;
+    double dt = kVerletStability / std::sqrt(omegaSquaredBound(kInf) + tool);
+    if (maxDampingRate_ > 0) dt = std::min(dt, 0.1 / maxDampingRate_);
+    return dt;
+}
+
+StepReport DynamicSurface::stepVerlet(double dt) {
+    StepReport r;
+    r.verlet = true;
+    r.substeps = 1;
+    ensureMassFactor();
+    const double h = dt;
+    if (!avValid_) A_.apply(v_, av_);
+    if (!verletValid_) {
+        verletForces(d_, av_);
+        A_.applyTransposed(force_, fp_);
+        massSolver_.solve(fp_, aVerlet_);
+    }
+    if (tool_->grabbed()) {
+        meshTmp_ = d_ + (0.5 * h) * av_;
+        applyToolForces(dt, r, meshTmp_, 0.5);
+    } else {
+        applyToolForces(dt, r, d_);
+    }
+    const bool applied = hasExternal_ || toolForces_;
+    if (applied) {  // their acceleration, held over the step, into acc_
+        if (hasExternal_ && toolForces_) meshTmp2_ = fext_ + ftool_;
+        A_.applyTransposed(hasExternal_ && toolForces_ ? meshTmp2_ : hasExternal_ ? fext_ : ftool_, fp_);
+        massSolver_.solve(fp_, acc_);
+        v_ += (0.5 * h) * acc_;
+    }
+    v_ += (0.5 * h) * aVerlet_;
+    surface_.mutablePoles() += h * v_;
+    A_.apply(surface_.poles(), d_);
+    // The mesh velocity at the step's end, to second order, for the damping: 2 v+ - v_n.
+    meshTmp_ = (2.0 / h) * (d_ - dPrev_) - av_;
+    stepPotential_ = verletForces(d_, meshTmp_);
+    A_.applyTransposed(force_, fp_);
+    massSolver_.solve(fp_, aVerlet_);
+    v_ += (0.5 * h) * aVerlet_;
+    if (applied) v_ += (0.5 * h) * acc_;
+    A_.apply(v_, av_);
+    avValid_ = verletValid_ = true;
+    histValid_ = accelerationValid_ = false;
+    return r;
+}
+
+}  // namespace hs
