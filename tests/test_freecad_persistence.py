@@ -50,6 +50,8 @@ class TestPersistence(DocumentTestCase):
         s = obj.Proxy.surface
         s.integrator = "implicit"
         s.cg_iterations = 7
+        s.time_order = 1
+        s.explicit_when_stable = False
         s.set_stiffness_law("cubic", 3.0)
         s.set_damping_law("saturating", 2.0)
         s.set_plasticity(True, 0.02, 0.5)
