@@ -72,26 +72,29 @@ def prepared(setup):
 
 
 def block(s, curvature):
+    """Microseconds per step over one block, and whether the last step was local/global's Verlet."""
     t0 = time.perf_counter()
     if curvature:  # one curvature grid per 1/60 s of simulated time
         for k in range(STEPS):
-            s.step(DT)
+            r = s.step(DT)
             if k % 17 == 0:
                 s.curvature_grid()
     else:
-        s.step(DT, STEPS)
-    return (time.perf_counter() - t0) / STEPS * 1e6
+        r = s.step(DT, STEPS)
+    return (time.perf_counter() - t0) / STEPS * 1e6, r.verlet
 
 
 def per_step_all():
     """Round-robin over the variants so machine noise hits them alike; min and median per variant."""
     scenes = {name: prepared(setup) for name, setup in VARIANTS.items()}
     times = {name: [] for name in VARIANTS}
+    verlet = {}
     for _ in range(BLOCKS):
         for name, s in scenes.items():
-            times[name].append(block(s, VARIANTS[name] == "curvature"))
-    return [{"variant": n, "us_per_step": float(np.median(t)), "us_per_step_min": float(np.min(t))}
-            for n, t in times.items()]
+            us, verlet[name] = block(s, VARIANTS[name] == "curvature")
+            times[name].append(us)
+    return [{"variant": n, "us_per_step": float(np.median(t)), "us_per_step_min": float(np.min(t)),
+             "step": "verlet" if verlet[n] else "implicit"} for n, t in times.items()]
 
 
 def cpu_seconds():
@@ -126,9 +129,11 @@ def main():
     for r in rows:
         r["ratio_to_plain"] = r["us_per_step_min"] / base
     cpu, asleep_us, slept = resting_cpu()
-    print(f"{'scene (12x12 controls, 40x40 mesh, local/global)':<44}{'min us':>9}{'median':>9}{'x plain':>9}")
+    print(f"{'scene (12x12 controls, 40x40 mesh, local/global)':<44}{'min us':>9}{'median':>9}{'x plain':>9}"
+          f"{'step':>10}")
     for r in rows:
-        print(f"{r['variant']:<44}{r['us_per_step_min']:>9.1f}{r['us_per_step']:>9.1f}{r['ratio_to_plain']:>9.2f}")
+        print(f"{r['variant']:<44}{r['us_per_step_min']:>9.1f}{r['us_per_step']:>9.1f}{r['ratio_to_plain']:>9.2f}"
+              f"{r['step']:>10}")
     print(f"resting scene, synchronous step: {asleep_us:.3f} us (slept: {slept})")
     print(f"resting scene, threaded session (1 kHz haptics on): {cpu:.2f} % of one core")
     out = {"controls": CONTROLS, "mesh": MESH, "rows": rows, "resting_step_us": asleep_us,
