@@ -16,6 +16,8 @@ DynamicSurface::DynamicSurface(BSplineSurface surface, int g, int h)
         m->setZero(N, 3);
     m_.setZero(S);
     gamma_.setZero(S);
+    appliedPoles_.reserve(static_cast<size_t>(N));
+    poleMark_.assign(static_cast<size_t>(N), 0);
     damping_.allowZero(true);
     A_.apply(surface_.poles(), d_);
     springs_ = SpringMesh(g, h, d_);
@@ -344,9 +346,11 @@ void DynamicSurface::checkSleep(double dt) {
 
 double DynamicSurface::kineticEnergy() {
     refreshMaterials();
-    if (avValid_) return 0.5 * (m_.asDiagonal() * av_).cwiseProduct(av_).sum();  // local/global keeps A v
-    A_.apply(v_, dd_);
-    return 0.5 * (m_.asDiagonal() * dd_).cwiseProduct(dd_).sum();
+    if (!avValid_) A_.apply(v_, dd_);  // local/global and Verlet keep A v
+    const double* w = (avValid_ ? av_ : dd_).data();
+    double e = 0;
+    for (Eigen::Index i = 0; i < m_.size(); ++i) e += m_[i] * (w[3 * i] * w[3 * i] + w[3 * i + 1] * w[3 * i + 1] + w[3 * i + 2] * w[3 * i + 2]);
+    return 0.5 * e;
 }
 
 void DynamicSurface::restoreStepStart(bool keepVelocity) {

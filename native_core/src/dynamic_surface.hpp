@@ -201,6 +201,8 @@ private:
     /// when it recomputes.
     double omegaSquaredBound(double limit);
     StepReport stepVerlet(double dt);
+    /// acc_ = (A^T M A)^-1 A^T (external + tool forces), over the mesh points they act on only.
+    void solveApplied();
     void explicitSubstep(double dt, int depth, StepReport& r);
     void computeAcceleration();  // acc_ from the current p, v
     /// The tool's force on the mesh `at` (the current mesh, or local/global's prediction of the step's end).
@@ -221,6 +223,8 @@ private:
     Points pHist_, vHist_, dHist_, avHist_, xHat_, dHat_;
     Points yMesh_;  // local/global: the inertial prediction y on the mesh
     Points aVerlet_;  // Verlet: acceleration of the internal forces at the step's start (first same as last)
+    std::vector<int> appliedPoles_;  // solveApplied(): the poles the applied forces reach (reserved)
+    std::vector<char> poleMark_;
     bool verletValid_ = false;  // aVerlet_ belongs to the current state (cleared by touch() and anything moving it)
     double stepPotential_ = -1;  // Verlet: potential energy at the step's end, for the energy guard (-1: none)
     std::uint64_t omegaKey_[3] = {~0ull, ~0ull, ~0ull};

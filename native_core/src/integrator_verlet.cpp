@@ -130,6 +130,28 @@ double DynamicSurface::verletStepLimit() {
     return dt;
 }
 
+void DynamicSurface::solveApplied() {
+    const CsrMatrix& a = A_.matrix();
+    fp_.setZero();
+    appliedPoles_.clear();
+    for (Eigen::Index r = 0; r < d_.rows(); ++r) {
+        Vec3 f = Vec3::Zero();
+        if (hasExternal_) f += fext_.row(r).transpose();
+        if (toolForces_) f += ftool_.row(r).transpose();
+        if (f.isZero(0.0)) continue;
+        for (int e = a.rowStart[static_cast<size_t>(r)]; e < a.rowStart[static_cast<size_t>(r) + 1]; ++e) {
+            const int c = a.col[static_cast<size_t>(e)];
+            if (!poleMark_[static_cast<size_t>(c)]) {
+                poleMark_[static_cast<size_t>(c)] = 1;
+                appliedPoles_.push_back(c);
+            }
+            fp_.row(c) += a.value[static_cast<size_t>(e)] * f.transpose();
+        }
+    }
+    for (int c : appliedPoles_) poleMark_[static_cast<size_t>(c)] = 0;
+    massSolver_.solveSparse(fp_, appliedPoles_, acc_);
+}
+
 StepReport DynamicSurface::stepVerlet(double dt) {
     StepReport r;
     r.verlet = true;
@@ -150,9 +172,7 @@ StepReport DynamicSurface::stepVerlet(double dt) {
     }
     const bool applied = hasExternal_ || toolForces_;
     if (applied) {  // their acceleration, held over the step, into acc_
-        if (hasExternal_ && toolForces_) meshTmp2_ = fext_ + ftool_;
-        A_.applyTransposed(hasExternal_ && toolForces_ ? meshTmp2_ : hasExternal_ ? fext_ : ftool_, fp_);
-        massSolver_.solve(fp_, acc_);
+        solveApplied();
         v_ += (0.5 * h) * acc_;
     }
     v_ += (0.5 * h) * aVerlet_;

@@ -34,6 +34,21 @@ void PrefactoredSolver::factor(const Eigen::SparseMatrix<double>& m, const char*
     ready_ = true;
 }
 
+void PrefactoredSolver::solveSparse(const Points& b, const std::vector<int>& rows, Points& x) const {
+    if (!dense() || 4 * rows.size() > static_cast<size_t>(n_)) return solve(b, x);
+    x.setZero();
+    for (int j : rows) {  // the inverse is symmetric: its row j is its column j
+        const double* r = inverse_.data() + static_cast<Eigen::Index>(j) * n_;
+        const double b0 = b(j, 0), b1 = b(j, 1), b2 = b(j, 2);
+        double* o = x.data();
+        for (int i = 0; i < n_; ++i) {
+            o[3 * i] += r[i] * b0;
+            o[3 * i + 1] += r[i] * b1;
+            o[3 * i + 2] += r[i] * b2;
+        }
+    }
+}
+
 void PrefactoredSolver::solve(const Points& b, Points& x) const {
     if (dense()) {
         bx_ = b.col(0);

@@ -2,6 +2,7 @@
 // (up to kDenseLimit unknowns, e.g. 12x12 controls) keep the explicit inverse instead: one pass of
 // contiguous, vectorised dot products beats a sparse triangular solve's dependent, indexed updates.
 #pragma once
+#include <vector>
 #include <Eigen/SparseCholesky>
 
 #include "bspline_surface.hpp"
@@ -16,6 +17,9 @@ public:
     int size() const { return n_; }
     /// x = M^-1 b for the three columns at once; x and b may not alias.
     void solve(const Points& b, Points& x) const;
+    /// The same for a b that is zero outside `rows` (a force on a few mesh points): on the dense
+    /// path only those columns of the inverse are read.
+    void solveSparse(const Points& b, const std::vector<int>& rows, Points& x) const;
 
     static constexpr int kDenseLimit = 600;
     bool dense() const { return inverse_.size() != 0; }
