@@ -22,8 +22,10 @@ from HapticSculpt import core  # noqa: E402
 CONFIGS = [((4, 4), (10, 10), 0.5, 10), ((4, 4), (20, 20), 2, 11), ((4, 4), (40, 40), 10, 19),
            ((8, 8), (20, 20), 5, 100), ((8, 8), (40, 40), 25, 120), ((12, 12), (25, 25), 42, 780),
            ((12, 12), (40, 40), None, None), ((32, 32), (128, 128), None, None)]
+# local_global is the default (Verlet where stable, else the implicit step); "bdf2" pins the
+# implicit step, to show both in one run
 SOLVERS = [("explicit", {}), ("implicit", {"cg_iterations": 5}), ("local_global", {"iterations": 1}),
-           ("local_global", {"iterations": 4})]
+           ("local_global", {"iterations": 4}), ("local_global", {"iterations": 1, "explicit_when_stable": False})]
 DT = 1e-3
 
 
@@ -86,6 +88,8 @@ def main() -> None:
             us = time_per_step(scene(controls, mesh, solver, settings))
             paper = paper_exp if solver == "explicit" else paper_imp if solver == "implicit" else None
             name = solver + (f"/{settings['iterations']}it" if "iterations" in settings else "")
+            if settings.get("explicit_when_stable") is False:
+                name += "/bdf2"
             rec = {"controls": f"{controls[0]}x{controls[1]}", "mesh": f"{mesh[0]}x{mesh[1]}", "solver": name,
                    "us_per_step": us, "paper_ms": paper, "error": err, "verlet": verlet}
             records.append(rec)

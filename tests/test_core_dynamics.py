@@ -522,3 +522,18 @@ def test_verlet_step_limit_bounds_the_highest_mode():
     assert ds.verlet_step_limit == pytest.approx(2e-5)
     ds.explicit_when_stable = False
     assert ds.verlet_step_limit == 0.0
+
+
+def test_painting_rescales_the_verlet_bound():
+    # A painted map rescales the last computed bound (no new eigen-solve each dab); a dab stiff enough
+    # to put the step past the limit switches to the implicit step at once.
+    ds = core.patch((8, 8), (3, 3), (24, 24))
+    dt = 0.5 * ds.verlet_step_limit
+    assert ds.step(dt).verlet
+    ds.stiffness_map.dab((0.5, 0.5), 0.2, 120.0, "spherical", 1.0)  # up to 1.2x: the limit falls by at most 1.1x
+    assert ds.step(dt).verlet
+    ds.stiffness_map.dab((0.5, 0.5), 0.2, 1e4, "spherical", 1.0)  # 100x stiffer: omega_max up to 10x
+    assert not ds.step(dt).verlet
+    assert ds.verlet_step_limit < dt
+    ds.mass_map.set_uniform(1e3)  # heavier everywhere: the step is explicit again
+    assert ds.step(dt).verlet

@@ -3,6 +3,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -192,14 +193,16 @@ private:
     StepReport stepExplicit(double dt);
     StepReport stepImplicitCG(double dt);
     StepReport stepLocalGlobal(double dt);
-    /// Whether local/global's explicit branch is stable at dt (computes omegaSquaredBound() lazily).
+    /// Whether local/global's explicit branch is stable at dt (omegaSquaredBelow(), lazily).
     bool verletStable(double dt);
     /// The tool's share of Verlet's omega^2 bound; infinite where Verlet is never taken.
     double verletToolTerm() const;
-    /// Upper bound on omega_max^2 of the springs and penalty terms in control space, cached per
-    /// configuration; only a lower bound (cheaper) where that already exceeds `limit`. Allocates
-    /// when it recomputes.
-    double omegaSquaredBound(double limit);
+    /// Whether omega_max^2 of the springs and penalty terms in control space is provably below
+    /// `limit` (verlet_stability_bound.cpp); `tight` makes omegaUpper_ the computed bound. Allocates
+    /// when it recomputes (a new configuration).
+    bool omegaSquaredBelow(double limit, bool tight = false);
+    void rescaleOmegaBounds();
+    void computeOmegaBounds(double limit);
     StepReport stepVerlet(double dt);
     /// acc_ = (A^T M A)^-1 A^T (external + tool forces), over the mesh points they act on only.
     void solveApplied();
@@ -228,8 +231,14 @@ private:
     bool verletValid_ = false;  // aVerlet_ belongs to the current state (cleared by touch() and anything moving it)
     double stepPotential_ = -1;  // Verlet: potential energy at the step's end, for the energy guard (-1: none)
     std::uint64_t omegaKey_[3] = {~0ull, ~0ull, ~0ull};
-    double omega2_ = 0;  // omegaSquaredBound(): an upper bound if omega2Exact_, else a lower one
-    bool omega2Exact_ = false;
+    // Bounds on omega_max^2 for omegaKey_ (upper infinite where unknown); tight: upper from Lanczos
+    // for exactly this configuration. The snapshot: stiffnesses, masses, constraint structure and
+    // bounds where they were last computed, which map changes rescale.
+    double omegaUpper_ = std::numeric_limits<double>::infinity(), omegaLower_ = 0;
+    bool omegaTight_ = false;
+    Eigen::VectorXd snapK_, snapM_;
+    std::uint64_t snapStructure_ = 0;
+    double snapUpper_ = 0, snapLower_ = 0;
     double histDt_ = 0;
     /// The history is the previous step's at histDt_ (cleared with avValid_, and where the applied
     /// forces jump: external forces set or cleared, a grab or a release). BDF2 extrapolates the

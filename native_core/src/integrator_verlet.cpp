@@ -13,11 +13,7 @@
 // between steps is seen at once.
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <Eigen/Eigenvalues>
 #include <limits>
-#include <random>
-#include <vector>
 
 #include "dynamic_surface.hpp"
 
@@ -26,73 +22,6 @@ namespace hs {
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
-
-double DynamicSurface::omegaSquaredBound(double limit) {
-    const std::uint64_t key[3] = {mass_.version(), stiffness_.version(), constraints_.structureVersion()};
-    const bool same = key[0] == omegaKey_[0] && key[1] == omegaKey_[1] && key[2] == omegaKey_[2];
-    if (same && (omega2Exact_ || omega2_ > limit)) return omega2_;
-    // For linear springs the Hessian of 1/2 k (|x_a - x_b| - l)^2 is k n n^T + k (1 - l / |x_a - x_b|)
-    // (I - n n^T) <= k I: the Laplacian L bounds it whatever the state, and penalty terms are the
-    // same form (projections onto convex sets). So omega_max^2 <= lambda_max((A^T M A)^-1 A^T L A),
-    // found here by power iteration: Rayleigh quotients approach it from below, hence the margin.
-    ensureMassFactor();
-    std::vector<Eigen::Triplet<double>> lap;
-    springs_.addLaplacian(lap);
-    constraints_.addLaplacian(lap);
-    const Eigen::Index S = d_.rows();
-    Eigen::SparseMatrix<double> L(S, S);
-    L.setFromTriplets(lap.begin(), lap.end());
-    const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
-    const Eigen::SparseMatrix<double> K = A.transpose() * L * A;
-    const Eigen::SparseMatrix<double> M = A.transpose() * m_.asDiagonal() * A;
-    for (int i = 0; i < 3; ++i) omegaKey_[i] = key[i];
-    // max K_ii / M_ii is a Rayleigh quotient too: a lower bound that rules out long steps cheaply.
-    omega2_ = (K.diagonal().array() / M.diagonal().array()).maxCoeff();
-    omega2Exact_ = false;
-    if (omega2_ > limit) return omega2_;
-    // Lanczos in the M inner product (M^-1 K is self-adjoint there): its largest Ritz value is a
-    // Rayleigh quotient too, and reaches lambda_max in a few dozen products where power iteration
-    // took over a hundred. Three seeded random starts run side by side (the mass solver works on
-    // N x 3 blocks); stop when the largest Ritz value has settled to 1e-6.
-    constexpr int kMaxSteps = 60;
-    const Eigen::Index n = K.rows();
-    Points q(n, 3), qPrev = Points::Zero(n, 3), kq(n, 3), w(n, 3), mw(n, 3);
-    std::mt19937 rng(12345);
-    std::uniform_real_distribution<double> uni(-1.0, 1.0);
-    for (Eigen::Index i = 0; i < q.size(); ++i) q.data()[i] = uni(rng);
-    mw = M * q;
-    for (int c = 0; c < 3; ++c) q.col(c) /= std::sqrt(q.col(c).dot(mw.col(c)));
-    Eigen::MatrixXd alpha = Eigen::MatrixXd::Zero(kMaxSteps, 3), beta = Eigen::MatrixXd::Zero(kMaxSteps, 3);
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> tri;
-    double best = omega2_, last = 0;
-    bool live[3] = {true, true, true};
-    for (int j = 0; j < kMaxSteps; ++j) {
-        kq = K * q;
-        massSolver_.solve(kq, w);
-        for (int c = 0; c < 3; ++c) {
-            if (!live[c]) continue;
-            alpha(j, c) = q.col(c).dot(kq.col(c));
-            w.col(c) -= alpha(j, c) * q.col(c) + (j > 0 ? beta(j - 1, c) : 0.0) * qPrev.col(c);
-            Eigen::VectorXd sub = beta.col(c).head(std::max(0, j));
-            tri.computeFromTridiagonal(alpha.col(c).head(j + 1), sub, Eigen::EigenvaluesOnly);
-            best = std::max(best, tri.eigenvalues().maxCoeff());
-        }
-        if (j > 2 && best <= last * (1 + 1e-6)) break;
-        last = best;
-        mw = M * w;
-        qPrev = q;
-        for (int c = 0; c < 3; ++c) {
-            const double b = std::sqrt(std::max(0.0, w.col(c).dot(mw.col(c))));
-            live[c] = live[c] && b > 1e-12 * std::abs(alpha(j, c));  // an invariant subspace: exact
-            beta(j, c) = b;
-            if (live[c]) q.col(c) = w.col(c) / b;
-        }
-        if (!live[0] && !live[1] && !live[2]) break;
-    }
-    omega2_ = 1.05 * best;
-    omega2Exact_ = true;
-    return omega2_;
-}
 
 double DynamicSurface::verletForces(const Points& d, const Points& dd) {
     force_.setZero();
@@ -118,14 +47,15 @@ bool DynamicSurface::verletStable(double dt) {
     const double tool = verletToolTerm();
     if (!std::isfinite(tool)) return false;
     const double limit = kVerletStability * kVerletStability / (dt * dt);
-    return omegaSquaredBound(limit - tool) + tool <= limit;
+    return omegaSquaredBelow(limit - tool);
 }
 
 double DynamicSurface::verletStepLimit() {
     refreshMaterials();
     const double tool = verletToolTerm();
     if (!std::isfinite(tool)) return 0.0;
-    double dt = kVerletStability / std::sqrt(omegaSquaredBound(kInf) + tool);
+    omegaSquaredBelow(kInf, true);
+    double dt = kVerletStability / std::sqrt(omegaUpper_ + tool);
     if (maxDampingRate_ > 0) dt = std::min(dt, 0.1 / maxDampingRate_);
     return dt;
 }
