@@ -3,7 +3,8 @@
 `make test` runs (tests/stress_scenes.py says what a scene is and what it must show).
 
 Each finished scene is appended to a JSON-lines file at once, so Ctrl-C loses nothing and a rerun
-resumes where it stopped. The summary (per integrator: scenes, steps, steps the energy guard or the
+resumes where it stopped (a log written by another build of the core is moved aside instead:
+`<log>.core` holds the build's SHA-256). The summary (per integrator: scenes, steps, steps the energy guard or the
 NaN guard refused, failures with their seeds) is printed and written to
 bench/results/stress_campaign.json. Exit status 1 if any scene failed.
 
@@ -14,6 +15,7 @@ from __future__ import annotations
 import argparse
 import collections
 import dataclasses
+import hashlib
 import json
 import os
 import sys
@@ -22,6 +24,26 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path[:0] = [ROOT, os.path.join(ROOT, "tests"), os.path.dirname(os.path.abspath(__file__))]
 from progress import progress  # noqa: E402
 from stress_scenes import run_scene  # noqa: E402
+
+
+def core_fingerprint() -> str:
+    """SHA-256 of the native core the scenes run on: a log from another build is not resumed."""
+    from HapticSculpt import _core
+    with open(_core.__file__, "rb") as f:
+        return hashlib.sha256(f.read()).hexdigest()
+
+
+def start_log(log: str) -> None:
+    """Keeps `log` only if it was written by this build of the core; otherwise moves it aside (its
+    results would not describe this core) and starts afresh."""
+    stamp, current = log + ".core", core_fingerprint()
+    previous = open(stamp).read().strip() if os.path.exists(stamp) else None
+    if os.path.exists(log) and previous != current:
+        aside = f"{log}.{(previous or 'unknown')[:12]}"
+        os.replace(log, aside)
+        print(f"the log was written by another build of the core: moved to {aside}; starting afresh", file=sys.stderr)
+    with open(stamp, "w") as f:
+        f.write(current + "\n")
 
 
 def done_seeds(log: str) -> set[int]:
@@ -61,6 +83,7 @@ def main() -> int:
     ap.add_argument("--out", default=os.path.join(ROOT, "bench", "results", "stress_campaign.json"))
     a = ap.parse_args()
     os.makedirs(os.path.dirname(a.log), exist_ok=True)
+    start_log(a.log)
     todo = [s for s in range(a.first, a.first + a.scenes) if s not in done_seeds(a.log)]
     interrupted = False
     try:
