@@ -12,7 +12,8 @@ explicit scheme at 1 ms / 256 and / 512, Richardson-extrapolated), over the grid
 blows up is unstable at this step.
 
 Ours runs the very same grid: a degree-1 B-spline with one control point per mass point, so d = A p
-with A the identity (that is Liu et al. 2013's prefactored local/global on a plain grid, with BDF2);
+with A the identity (that is Liu et al. 2013's prefactored local/global on a plain grid, with BDF2,
+and Verlet steps where those are stable);
 and, as the paper's dual representation, with 12..64 cubic poles per side driving the same mass
 points (same springs, masses and error measure; fewer degrees of freedom).
 Each peer runs at its iteration/substep settings; ours is then matched to it: the cheapest of our
@@ -52,7 +53,7 @@ def grid_surface(n: int, controls: int | None = None, degree: int = 1) -> core.D
     s.stiffness_map.set_uniform(K)
     s.damping_map.set_uniform(0.0)
     s.sleep_enabled = False
-    s.energy_guard = False  # the peers have none; the plain local/global scene runs none anyway
+    s.energy_guard = False  # the peers have none (ours would run it on Verlet steps)
     return s
 
 
