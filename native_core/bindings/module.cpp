@@ -441,7 +441,8 @@ PYBIND11_MODULE(_core, m) {
         // stepping
         .def_property("integrator", [](const DynamicSurface& s) { return integratorName(s.solver.kind); },
                       [](DynamicSurface& s, const std::string& k) { s.solver.kind = integratorFrom(k); s.wake(); },
-                      "explicit (paper eq. 8-9, adaptive halving), implicit (backward Euler, CG) or local_global (default)")
+                      "explicit (paper eq. 8-9, adaptive halving), implicit (backward Euler, CG) or local_global (default: "
+                      "BDF2 by local/global iterations, velocity Verlet where that is provably stable)")
         .def_property("iterations", [](const DynamicSurface& s) { return s.solver.iterations; },
                       [](DynamicSurface& s, int n) { if (n < 1 || n > 1000) throw std::invalid_argument("iterations: 1..1000"); s.solver.iterations = n; })
         .def_property("time_order", [](const DynamicSurface& s) { return s.solver.timeOrder; },

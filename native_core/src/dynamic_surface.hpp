@@ -25,7 +25,8 @@ constexpr double kMinDt = 1e-9;
 enum class IntegratorKind {
     Explicit,     ///< paper eq. 8-9 with recursive step halving
     ImplicitCG,   ///< linearised backward Euler, a fixed number of conjugate-gradient iterations
-    LocalGlobal,  ///< backward Euler by prefactored local/global iterations in control space (default)
+    LocalGlobal,  ///< BDF2 (or backward Euler) by prefactored local/global iterations in control space,
+                  ///< velocity Verlet where that is provably stable (default)
 };
 
 /// Local/global takes an explicit velocity Verlet step instead where that is provably stable

@@ -3,7 +3,8 @@
 // are all terms 1/2 k |x_a - x_b - t|^2, so one step solves
 //   A^T (M + h D + h^2 L) A p' = A^T [ M y + h D x^ + h^2 (f_ext + J t) ]
 // alternating the projection of t (local) with a solve by the prefactored system (global), in
-// increments (see the loop).
+// increments (see the loop). Where an explicit step is provably stable, step() takes the Verlet
+// step of integrator_verlet.cpp instead.
 // Backward Euler (order 1) has x^ = x_n, y = x_n + dt v_n, h = dt. BDF2 (order 2, the default;
 // beyond the paper and Liu et al.) has the same form with
 //   x^ = (4 x_n - x_n-1) / 3,  v^ = (4 v_n - v_n-1) / 3,  y = x^ + h v^,  h = 2 dt / 3,
