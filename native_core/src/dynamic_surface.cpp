@@ -286,6 +286,15 @@ StepReport DynamicSurface::step(double dt) {
     return r;
 }
 
+void DynamicSurface::prepare(double dt) {
+    if (!(dt >= kMinDt) || !std::isfinite(dt)) throw std::invalid_argument("dt: must be finite and >= 1e-9 s");
+    refreshMaterials();
+    ensureMassFactor();
+    if (solver.kind != IntegratorKind::LocalGlobal) return;
+    verletStable(dt);
+    ensureSystem(solver.timeOrder == 2 ? 2.0 * dt / 3.0 : dt, true);
+}
+
 bool DynamicSurface::guardsEnergy(double dt, bool verlet) const {
     if (!energyGuard.enabled) return false;
     // Verlet is stable here but not a descent method: the guard stays as for every explicit scheme.

@@ -154,6 +154,9 @@ public:
     EnergyGuardSettings energyGuard;
     /// Advances by dt seconds; never allocates after the first step with a given configuration.
     StepReport step(double dt);
+    /// Does ahead what a first step at dt would (factorisations, Verlet's stability bound), so that
+    /// a session's first real-time steps do not stall; throws what that step would.
+    void prepare(double dt);
     bool asleep() const { return asleep_; }
     void wake() { touch(); resetEnergyCeiling(); }
     std::uint64_t stepCount() const { return steps_; }

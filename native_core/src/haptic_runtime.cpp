@@ -156,6 +156,13 @@ void HapticRuntime::start() {
         ticks_.resize(static_cast<size_t>(settings_.logSeconds * settings_.hapticRate) + 16);
         snapshots_.resize(static_cast<size_t>(settings_.logSeconds / settings_.simDt) + 16);
     }
+    // Factor and bound before the clock starts: at 32x32 controls that takes tens of milliseconds,
+    // which the first steps would otherwise fall behind the device by. A configuration the core
+    // refuses is left for the first step to report, as it always was.
+    try {
+        surface_->prepare(settings_.simDt);
+    } catch (const std::exception&) {
+    }
     device_->start();
     t0_ = Clock::now();
     started_ = true;

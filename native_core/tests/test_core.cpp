@@ -130,6 +130,21 @@ TEST(Verlet, SteppingWithToolConstraintsForcesAndPlasticityDoesNotAllocate) {
               }), 0);
 }
 
+TEST(Prepare, TheFirstStepAfterItDoesNotAllocate) {
+    // What a session does before its clock starts: the first real-time step then factors nothing.
+    for (const double dt : {2e-4, 1e-3}) {  // a Verlet step and an implicit one
+        DynamicSurface fresh(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 30, 30);
+        fresh.stiffnessMap().setUniform(2e3);
+        fresh.prepare(dt);
+        const long before = g_allocations.load();
+        const StepReport r = fresh.step(dt);
+        EXPECT_EQ(g_allocations.load() - before, 0) << dt;
+        EXPECT_EQ(r.verlet, dt < 5e-4) << dt;
+    }
+    DynamicSurface s(BSplineSurface::plane(4, 4, 3, 3, 100, 100), 10, 10);
+    EXPECT_THROW(s.prepare(0.0), std::invalid_argument);
+}
+
 INSTANTIATE_TEST_SUITE_P(Integrators, AllocationFree,
                          ::testing::Values(IntegratorKind::Explicit, IntegratorKind::ImplicitCG, IntegratorKind::LocalGlobal));
 
