@@ -112,8 +112,8 @@ void DynamicSurface::refreshMaterials() {
 void DynamicSurface::ensureMassFactor() {
     if (massSolver_.ready() && massVersion_ == mass_.version()) return;
     const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
-    const Eigen::SparseMatrix<double> Mp = A.transpose() * m_.asDiagonal() * A;
-    massSolver_.factor(Mp, "mass matrix A^T M A");
+    massMatrix_ = A.transpose() * m_.asDiagonal() * A;
+    massSolver_.factor(massMatrix_, "mass matrix A^T M A");
     massVersion_ = mass_.version();
 }
 
@@ -124,15 +124,9 @@ void DynamicSurface::ensureSystem(double dt, bool factor) {
     for (int i = 0; i < 4; ++i) same = same && key[i] == systemKey_[i];
     if (same) return;
     // S = A^T (M + dt D + dt^2 L) A with L the Laplacian of springs and penalty terms.
-    std::vector<Eigen::Triplet<double>> t;
-    const Eigen::Index S = d_.rows();
-    for (Eigen::Index i = 0; i < S; ++i) t.emplace_back(i, i, m_[i] + dt * gamma_[i]);
-    std::vector<Eigen::Triplet<double>> lap;
-    springs_.addLaplacian(lap);
-    constraints_.addLaplacian(lap);
-    for (const auto& e : lap) t.emplace_back(e.row(), e.col(), dt * dt * e.value());
-    Eigen::SparseMatrix<double> Sm(S, S);
-    Sm.setFromTriplets(t.begin(), t.end());
+    Eigen::SparseMatrix<double> D(d_.rows(), d_.rows());
+    D = (m_ + dt * gamma_).asDiagonal();
+    const Eigen::SparseMatrix<double> Sm = D + (dt * dt) * laplacian();
     const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
     const Eigen::SparseMatrix<double> sys = A.transpose() * Sm * A;
     cgInvDiag_ = sys.diagonal().cwiseInverse();  // Jacobi preconditioner
@@ -150,6 +144,15 @@ void DynamicSurface::ensureSystem(double dt, bool factor) {
     systemFactored_ = factor;
     systemDt_ = dt;
     for (int i = 0; i < 4; ++i) systemKey_[i] = key[i];
+}
+
+Eigen::SparseMatrix<double> DynamicSurface::laplacian() const {
+    std::vector<Eigen::Triplet<double>> t;
+    springs_.addLaplacian(t);
+    constraints_.addLaplacian(t);
+    Eigen::SparseMatrix<double> L(d_.rows(), d_.rows());
+    L.setFromTriplets(t.begin(), t.end());
+    return L;
 }
 
 void DynamicSurface::setPointForce(int index, const Vec3& force) {
@@ -230,10 +233,10 @@ StepReport DynamicSurface::step(double dt) {
     const std::uint64_t key[4] = {mass_.version(), damping_.version(), stiffness_.version(), constraints_.version()};
     for (int i = 0; i < 4; ++i)
         if (key[i] != wakeKey_[i]) { touch(); resetEnergyCeiling(); wakeKey_[i] = key[i]; }
-    if (tool_->grabbed()) {  // awake; Verlet's carried forces hold no tool force and stay valid
-        const bool carried = verletValid_;
-        touch();
-        verletValid_ = carried;
+    // A held tool keeps the surface awake; its forces are refreshed by applyToolForces each step.
+    if (tool_->grabbed()) {
+        asleep_ = false;
+        quietSteps_ = 0;
     }
     StepReport r;
     if (asleep_) {
@@ -292,7 +295,7 @@ void DynamicSurface::prepare(double dt) {
     ensureMassFactor();
     if (solver.kind != IntegratorKind::LocalGlobal) return;
     verletStable(dt);
-    ensureSystem(solver.timeOrder == 2 ? 2.0 * dt / 3.0 : dt, true);
+    ensureSystem(localGlobalH(dt), true);
 }
 
 bool DynamicSurface::guardsEnergy(double dt, bool verlet) const {

@@ -188,6 +188,10 @@ private:
     void refreshMaterials();
     void ensureMassFactor();
     void ensureSystem(double dt, bool factor);
+    /// Laplacian of the springs and penalty terms on the mesh (S x S, per coordinate).
+    Eigen::SparseMatrix<double> laplacian() const;
+    /// local/global's h: 2 dt / 3 for BDF2, dt for backward Euler.
+    double localGlobalH(double dt) const { return solver.timeOrder == 2 ? 2.0 * dt / 3.0 : dt; }
     /// Total mesh force (external, tool, springs, constraints, damping) into force_; returns the
     /// elastic energy. Needs dd_ (mesh velocity) current.
     double meshForces(const Points& d, const Points& dd, double dt);
@@ -258,6 +262,7 @@ private:
     std::unique_ptr<Tool> tool_;
     Cursor cursor_;
     PrefactoredSolver massSolver_, systemSolver_;
+    Eigen::SparseMatrix<double> massMatrix_;  // A^T M A, as last factored by ensureMassFactor()
     std::uint64_t massVersion_ = ~0ull, materialKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
     std::uint64_t systemKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
     std::uint64_t wakeKey_[4] = {0, 0, 0, 0};

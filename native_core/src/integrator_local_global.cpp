@@ -44,7 +44,7 @@ double DynamicSurface::predictorWeight(double dt, bool fixedTargets) const {
 StepReport DynamicSurface::stepLocalGlobal(double dt) {
     StepReport r;
     const bool bdf2 = solver.timeOrder == 2;
-    const double h = bdf2 ? 2.0 * dt / 3.0 : dt;
+    const double h = localGlobalH(dt);
     ensureSystem(h, true);
     const Points& p = surface_.poles();
     if (!avValid_) A_.apply(v_, av_);

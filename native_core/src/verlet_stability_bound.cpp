@@ -56,15 +56,9 @@ void DynamicSurface::rescaleOmegaBounds() {
 
 void DynamicSurface::computeOmegaBounds(double limit) {
     ensureMassFactor();
-    std::vector<Eigen::Triplet<double>> lap;
-    springs_.addLaplacian(lap);
-    constraints_.addLaplacian(lap);
-    const Eigen::Index S = d_.rows();
-    Eigen::SparseMatrix<double> L(S, S);
-    L.setFromTriplets(lap.begin(), lap.end());
     const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
-    const Eigen::SparseMatrix<double> K = A.transpose() * L * A;
-    const Eigen::SparseMatrix<double> M = A.transpose() * m_.asDiagonal() * A;
+    const Eigen::SparseMatrix<double> K = A.transpose() * laplacian() * A;
+    const Eigen::SparseMatrix<double>& M = massMatrix_;
     snapK_.resize(static_cast<Eigen::Index>(springs_.first().size()));
     for (Eigen::Index s = 0; s < snapK_.size(); ++s) snapK_[s] = springs_.stiffness(static_cast<int>(s));
     snapM_ = m_;
