@@ -335,16 +335,42 @@ void bindRuntime(py::module_& m) {
             d["poles"] = py::cast(s.poles);
             d["velocities"] = py::cast(s.velocities);
             d["rest_lengths"] = py::cast(s.restLengths);
-            if (s.painted == AirbrushSettings::Map::Off) {
-                d["painted"] = py::none();
-            } else {
-                d["painted"] = mapName(s.painted);
-                d["map_shape"] = py::make_tuple(s.mapRows, s.mapCols);
-                d["map_values"] = py::cast(s.mapValues);
+            d["painted"] = s.painted == AirbrushSettings::Map::Off ? py::object(py::none()) : py::str(mapName(s.painted));
+            d["edit"] = s.edit == 0 ? py::object(py::none()) : py::int_(s.edit);
+            py::dict maps;
+            const AirbrushSettings::Map all[3] = {AirbrushSettings::Map::Mass, AirbrushSettings::Map::Damping,
+                                                  AirbrushSettings::Map::Stiffness};
+            for (int k = 0; k < 3; ++k) {
+                if (s.edit == 0 && all[k] != s.painted) continue;
+                py::array_t<double> values({s.maps[k].rows, s.maps[k].cols});
+                std::copy(s.maps[k].values.data(), s.maps[k].values.data() + s.maps[k].values.size(), values.mutable_data());
+                maps[mapName(all[k])] = values;
             }
+            d["maps"] = maps;
             return d;
-        }, "The oldest uncollected stroke end (poles, velocities, rest lengths; for a spray also the painted map: "
-           "'painted' names it, 'map_shape' and 'map_values' hold it), else None.")
+        }, "The oldest uncollected event, else None: a stroke's end, a spray's end or an applied edit, each with the "
+           "poles, velocities and rest lengths it left. 'painted' names a spray's map, 'edit' an edit's id; 'maps' "
+           "holds the maps it carries ((rows, cols) arrays by name: the painted one, or all three after an edit).")
+        .def("post_edit", [](HapticRuntime& r, std::uint64_t id, std::shared_ptr<DynamicSurface> next, bool restore,
+                             bool keepMaps, bool keepShape) {
+            SurfaceEdit e;
+            e.id = id;
+            e.next = std::move(next);
+            e.restore = restore;
+            e.keepMaps = keepMaps;
+            e.keepShape = keepShape;
+            py::gil_scoped_release release;  // preparing `next` factors its system
+            r.postEdit(std::move(e));
+        }, py::arg("id"), py::arg("next") = nullptr, py::arg("restore") = false, py::arg("keep_maps") = true,
+           py::arg("keep_shape") = false,
+           "Queues an edit for the simulation thread to take up between two steps: `next` (a configured surface of the "
+           "same sampling; None: none) continues from the live surface's motion, or with restore=True replaces it as "
+           "it is; keep_maps carries the live maps over; keep_shape then makes the current shape the rest shape. Its "
+           "event (take_stroke, 'edit' = id) follows.")
+        .def_property_readonly("surface", [](const HapticRuntime& r) {
+            if (!r.joined()) throw std::runtime_error("session: the simulation owns its surface until stop()");
+            return r.surface();
+        }, "The surface the simulation stepped last (edits replace it); readable once stopped.")
         .def("set_airbrush", [](HapticRuntime& r, py::object map, double radius, double factor, double strength, double rate) {
             r.setAirbrush(airbrushSettings(map, radius, factor, strength, rate));
         }, py::arg("map"), py::arg("radius") = 0.08, py::arg("factor") = 3.0, py::arg("strength") = 0.25, py::arg("rate") = 30.0,

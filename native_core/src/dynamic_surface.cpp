@@ -63,6 +63,35 @@ void DynamicSurface::setPoles(const Points& poles) {
     resetEnergyCeiling();
 }
 
+void DynamicSurface::continueFrom(DynamicSurface& live, bool keepMaps) {
+    if (live.g() != g() || live.h() != h() || live.poles().rows() != poles().rows())
+        throw std::invalid_argument("edit: the edited surface has another sampling or control net than the live one");
+    setPoles(live.poles());
+    setVelocities(live.velocities());
+    springs_.setRest(live.springs_.rest());
+    if (keepMaps) {
+        for (auto [mine, theirs] : {std::pair{&mass_, &live.mass_}, {&damping_, &live.damping_}, {&stiffness_, &live.stiffness_}})
+            if (mine->rows() != theirs->rows() || mine->cols() != theirs->cols() || mine->values() != theirs->values())
+                mine->setValues(theirs->rows(), theirs->cols(), theirs->values());
+    }
+    if (std::string(tool_->name()) == live.tool_->name()) {
+        live.tool_->copySettings(*tool_);
+        std::swap(tool_, live.tool_);
+    }
+    cursor_ = live.cursor_;
+    // The BDF2 history carries over, so the step after an edit stays second order.
+    pHist_ = live.pHist_;
+    vHist_ = live.vHist_;
+    dHist_ = live.dHist_;
+    avHist_ = live.avHist_;
+    histDt_ = live.histDt_;
+    histValid_ = live.histValid_;
+    time_ = live.time_;
+    work_ = live.work_;
+    steps_ = live.steps_;
+    touch();
+}
+
 void DynamicSurface::setVelocities(const Points& v) {
     if (v.rows() != v_.rows()) throw std::invalid_argument("velocities: wrong number of rows");
     if (!v.allFinite()) throw std::invalid_argument("velocities: contain NaN or Inf");

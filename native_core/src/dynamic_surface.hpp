@@ -157,6 +157,13 @@ public:
     /// Does ahead what a first step at dt would (factorisations, Verlet's stability bound), so that
     /// a session's first real-time steps do not stall; throws what that step would.
     void prepare(double dt);
+    /// Takes over from `live`, a surface of the same sampling that has been stepping: its poles,
+    /// velocities and BDF2 history, rest lengths (plastic flow), clock and, if this surface has the
+    /// same kind of tool, its tool with the grab (taking this one's settings), and with `keepMaps`
+    /// its material maps. What stays is this surface's configuration: constraints, laws, tool
+    /// settings, solver settings. An edit made during a session is a configured surface that
+    /// continues from the live one (see HapticRuntime::postEdit).
+    void continueFrom(DynamicSurface& live, bool keepMaps);
     bool asleep() const { return asleep_; }
     void wake() { touch(); resetEnergyCeiling(); }
     std::uint64_t stepCount() const { return steps_; }

@@ -30,6 +30,10 @@ HapticRuntime::HapticRuntime(std::shared_ptr<DynamicSurface> surface, std::share
       periodBins_(new std::atomic<std::uint32_t>[kBins + 1]) {
     if (!surface_) throw std::invalid_argument("surface: required");
     if (!device_) throw std::invalid_argument("device: required");
+    liveSurface_.store(surface_.get(), std::memory_order_relaxed);
+    sampling_ = {surface_->g(), surface_->h(), static_cast<int>(surface_->poles().rows())};
+    editsPending_.reserve(kEditSlots);
+    editsTaken_.reserve(kEditSlots);
     auto positive = [](double v, const char* name) {
         if (!(v > 0) || !std::isfinite(v)) throw std::invalid_argument(std::string(name) + ": must be finite and > 0");
     };
@@ -87,6 +91,44 @@ void HapticRuntime::setAirbrush(const AirbrushSettings& a) {
     airbrushChanged_.store(true, std::memory_order_release);
 }
 
+void HapticRuntime::postEdit(SurfaceEdit edit) {
+    if (edit.id == 0) throw std::invalid_argument("edit: id must be > 0");
+    if (edit.next) {
+        if (edit.next.get() == liveSurface_.load(std::memory_order_acquire) || edit.next->g() != sampling_[0] ||
+            edit.next->h() != sampling_[1] || edit.next->poles().rows() != sampling_[2])
+            throw std::invalid_argument("edit: the edited surface must be a new surface with the live one's sampling and control net");
+        edit.next->prepare(settings_.simDt);  // factor here, not in the simulation thread
+    }
+    std::lock_guard<std::mutex> lock(editMutex_);
+    editsPending_.push_back(std::move(edit));
+    editsQueued_.store(true, std::memory_order_release);
+}
+
+bool HapticRuntime::takeEdits(double simTime) {
+    {
+        std::lock_guard<std::mutex> lock(editMutex_);
+        std::swap(editsPending_, editsTaken_);
+        editsQueued_.store(false, std::memory_order_release);
+    }
+    for (SurfaceEdit& e : editsTaken_) {
+        if (e.next) {
+            // A spray whose map the edit replaces ends here, as one undo step before the edit's.
+            if (e.restore || !e.keepMaps) airbrush(false, simTime);
+            if (!e.restore) e.next->continueFrom(*surface_, e.keepMaps);
+            surface_ = std::move(e.next);
+            liveSurface_.store(surface_.get(), std::memory_order_release);
+        }
+        if (e.keepShape) {
+            surface_->springs().resetRest(surface_->mesh());
+            surface_->wake();
+        }
+        pushStroke(simTime, AirbrushSettings::Map::Off, e.id);
+    }
+    const bool any = !editsTaken_.empty();
+    editsTaken_.clear();  // the replaced surfaces are freed here, on the simulation thread
+    return any;
+}
+
 void HapticRuntime::airbrush(bool spraying, double simTime) {
     using Map = AirbrushSettings::Map;
     const Map want = spraying ? airbrush_.map : Map::Off;
@@ -113,9 +155,13 @@ void HapticRuntime::airbrush(bool spraying, double simTime) {
     paintedDirty_ = true;
 }
 
-void HapticRuntime::pushStroke(double simTime, AirbrushSettings::Map painted) {
+void HapticRuntime::pushStroke(double simTime, AirbrushSettings::Map painted, std::uint64_t edit) {
     const std::uint64_t head = strokeHead_.load(std::memory_order_relaxed);
-    // A full queue (nobody collecting) merges this stroke into the next one.
+    // A full queue (nobody collecting) merges this stroke into the next one; an edit's event waits
+    // for a free slot, since its configuration is only in the event.
+    while (edit != 0 && head - strokeTail_.load(std::memory_order_acquire) >= kStrokeSlots &&
+           !stopRequested_.load(std::memory_order_acquire))
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
     if (head - strokeTail_.load(std::memory_order_acquire) < kStrokeSlots) {
         StrokeSnapshot& s = strokes_[head % kStrokeSlots];
         s.time = simTime;
@@ -124,15 +170,20 @@ void HapticRuntime::pushStroke(double simTime, AirbrushSettings::Map painted) {
         const auto& rest = static_cast<const DynamicSurface&>(*surface_).springs().rest();
         std::copy(rest.begin(), rest.end(), s.restLengths.begin());
         s.painted = painted;
-        if (painted != AirbrushSettings::Map::Off) {
-            const MaterialMap& m = mapOf(painted);
-            s.mapRows = m.rows();
-            s.mapCols = m.cols();
-            s.mapValues = m.values();  // allocates only when the map's size changed (a spray end, not a step)
+        s.edit = edit;
+        // (copying a map allocates only when its size changed: at a spray's end or an edit, not a step)
+        const AirbrushSettings::Map all[3] = {AirbrushSettings::Map::Mass, AirbrushSettings::Map::Damping,
+                                              AirbrushSettings::Map::Stiffness};
+        for (int k = 0; k < 3; ++k) {
+            if (edit == 0 && all[k] != painted) continue;
+            const MaterialMap& m = mapOf(all[k]);
+            s.maps[k].rows = m.rows();
+            s.maps[k].cols = m.cols();
+            s.maps[k].values = m.values();
         }
         strokeHead_.store(head + 1, std::memory_order_release);
     }
-    strokeCount_.fetch_add(1, std::memory_order_relaxed);
+    if (edit == 0) strokeCount_.fetch_add(1, std::memory_order_relaxed);
 }
 
 void HapticRuntime::fail(const char* message) {
@@ -282,6 +333,7 @@ void HapticRuntime::simLoop() {
                 std::lock_guard<std::mutex> lock(airbrushMutex_);
                 airbrush_ = airbrushPending_;
             }
+            const bool edited = editsQueued_.load(std::memory_order_acquire) && takeEdits(simTime);
             const bool painting = airbrush_.map != AirbrushSettings::Map::Off;
             if (surface_->asleep() && !surface_->tool().grabbed() && !(fresh && button) &&
                 sprayMap_ == AirbrushSettings::Map::Off) {
@@ -295,7 +347,7 @@ void HapticRuntime::simLoop() {
                 continue;
             }
             simIdle_.store(false, std::memory_order_relaxed);
-            if (fresh || airbrushTaken) {
+            if (fresh || airbrushTaken || edited) {
                 const DeviceSample& s = cursor_.front();
                 Cursor c;
                 c.position = s.position;

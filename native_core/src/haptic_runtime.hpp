@@ -84,15 +84,37 @@ struct AirbrushSettings {
 };
 const char* mapName(AirbrushSettings::Map map);  ///< "mass", "damping", "stiffness" ("" when off)
 
-/// Sculpt state at the end of a stroke (a grab released, or a spray ended), for one undo
-/// transaction each. A spray also carries the painted map (`painted` names it).
+/// A material map's values as a snapshot carries them.
+struct MapSnapshot {
+    int rows = 1, cols = 1;
+    Eigen::VectorXd values;
+};
+
+/// An edit made while a session runs, taken up by the simulation thread between two steps.
+/// `next` is the surface as the edit leaves it, configured (maps, constraints, tool, laws,
+/// plasticity, integrator) and factored on the posting thread, so the simulation only swaps it
+/// in: it continues from the live surface (DynamicSurface::continueFrom: motion, plastic flow, the
+/// held tool; the live maps too unless the edit changed them). A `restore` (undo, redo) takes
+/// `next` as it is instead: its shape, at rest. `keepShape` then makes the current shape the rest
+/// shape. Without `next` only `keepShape` applies.
+struct SurfaceEdit {
+    std::uint64_t id = 0;  ///< > 0, names the edit in its event
+    std::shared_ptr<DynamicSurface> next;
+    bool restore = false;
+    bool keepMaps = true;
+    bool keepShape = false;
+};
+
+/// Sculpt state at the end of a stroke (a grab released, or a spray ended) or after an edit, for
+/// one undo transaction each. A spray also carries the painted map (`painted` names it); an edit
+/// (`edit` > 0) carries all three maps.
 struct StrokeSnapshot {
     double time = 0;
     Points poles, velocities;
     std::vector<double> restLengths;
     AirbrushSettings::Map painted = AirbrushSettings::Map::Off;
-    int mapRows = 1, mapCols = 1;
-    Eigen::VectorXd mapValues;
+    std::uint64_t edit = 0;
+    std::array<MapSnapshot, 3> maps;  ///< mass, damping, stiffness (those carried)
 };
 
 /// The map a spray is painting, as the GUI shows it while the spray goes on.
@@ -114,6 +136,8 @@ public:
     void stop();
     /// False once stopped or once a loop asked to stop (error, device lost, replay finished).
     bool running() const { return started_ && !stopRequested_.load(std::memory_order_acquire); }
+    /// True before start() and once stop() has joined the threads.
+    bool joined() const { return !started_ || joined_; }
     RuntimeStatus status() const;
 
     /// Newest pole snapshot if one arrived since the last call (GUI thread).
@@ -124,6 +148,14 @@ public:
     bool takeStroke(StrokeSnapshot& out);
     /// Switches the airbrush (any thread); the simulation takes it up before its next step.
     void setAirbrush(const AirbrushSettings& a);
+    /// Queues an edit (any thread; see SurfaceEdit): its surface is prepared for the session's
+    /// step here, the simulation thread swaps it in between two steps and reports it as an event
+    /// (takeStroke, `edit` = its id). The haptic thread never sees the queue. Throws
+    /// std::invalid_argument for an edit that cannot apply (another sampling, id 0).
+    void postEdit(SurfaceEdit edit);
+    /// The surface the simulation steps (it changes with each edit); read its state only while
+    /// stopped.
+    std::shared_ptr<DynamicSurface> surface() const { return surface_; }
 
     // --- analysis (after stop, with logSeconds > 0) --------------------------------------------
     const std::vector<HapticTick>& ticks() const { return ticks_; }
@@ -139,7 +171,9 @@ private:
     void fail(const char* message);
     /// Simulation thread: sprays while `spraying`, and hands a finished spray over as a stroke.
     void airbrush(bool spraying, double simTime);
-    void pushStroke(double simTime, AirbrushSettings::Map painted);
+    void pushStroke(double simTime, AirbrushSettings::Map painted, std::uint64_t edit = 0);
+    /// Simulation thread: applies the queued edits; true if any did (the cursor is set anew).
+    bool takeEdits(double simTime);
     MaterialMap& mapOf(AirbrushSettings::Map map);  ///< the surface's map (not Off)
 
     std::shared_ptr<DynamicSurface> surface_;
@@ -162,6 +196,13 @@ private:
     std::mutex airbrushMutex_;
     AirbrushSettings airbrushPending_;
     std::atomic<bool> airbrushChanged_{false};
+    // GUI -> simulation: edits (the lock only when the flag says the queue is not empty).
+    static constexpr size_t kEditSlots = 16;
+    std::mutex editMutex_;
+    std::vector<SurfaceEdit> editsPending_, editsTaken_;  // swapped, so taking them allocates nothing
+    std::atomic<bool> editsQueued_{false};
+    std::atomic<const DynamicSurface*> liveSurface_{nullptr};  // which surface steps (postEdit refuses it)
+    std::array<int, 3> sampling_{};  // g, h and the pole count every edit must keep
     // simulation thread only
     AirbrushSettings airbrush_;
     AirbrushSettings::Map sprayMap_ = AirbrushSettings::Map::Off;  // the map of the spray under way

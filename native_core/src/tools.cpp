@@ -201,6 +201,37 @@ void SmoothTool::computeForces(const MeshView& mesh, const Cursor& cursor) {
     }
 }
 
+// Settings only: the grab (point, offsets, clock) stays with the tool being held.
+void RopeTool::copySettings(const Tool& other) {
+    Tool::copySettings(other);
+    const auto& o = dynamic_cast<const RopeTool&>(other);
+    stiffness = o.stiffness;
+    stiffStiffness = o.stiffStiffness;
+    threshold = o.threshold;
+    reelTime = o.reelTime;
+}
+
+void MagnetTool::copySettings(const Tool& other) {
+    Tool::copySettings(other);
+    const auto& o = dynamic_cast<const MagnetTool&>(other);
+    radius = o.radius;
+    stiffness = o.stiffness;
+    falloff = o.falloff;
+}
+
+void OrientationTool::copySettings(const Tool& other) {
+    Tool::copySettings(other);
+    stiffness = dynamic_cast<const OrientationTool&>(other).stiffness;
+}
+
+void SmoothTool::copySettings(const Tool& other) {
+    Tool::copySettings(other);
+    const auto& o = dynamic_cast<const SmoothTool&>(other);
+    radius = o.radius;
+    strength = o.strength;
+    falloff = o.falloff;
+}
+
 std::unique_ptr<Tool> makeTool(const std::string& name) {
     if (name == "rope") return std::make_unique<RopeTool>();
     if (name == "magnet") return std::make_unique<MagnetTool>();

@@ -46,6 +46,9 @@ public:
     /// Starts a grab at the current cursor (selects mass points, records rest state).
     virtual void grab(const MeshView& mesh, const Cursor& cursor) = 0;
     virtual void release() { grabbed_ = false; }
+    /// Takes `other`'s settings (a tool of the same kind) and keeps its own grab: an edit made
+    /// while the tool is held changes the tool's settings without letting go.
+    virtual void copySettings(const Tool& other) { limits = other.limits; }
     bool grabbed() const { return grabbed_; }
     /// Advances the tool's clock by dt and adds its forces to f; returns the reaction on the cursor.
     /// The forces are those at `phase` of the way through the step on the clock (ramp, reel): 1 its
@@ -87,6 +90,7 @@ class RopeTool final : public Tool {
 public:
     const char* name() const override { return "rope"; }
     void grab(const MeshView& mesh, const Cursor& cursor) override;
+    void copySettings(const Tool& other) override;
     int anchor() const override { return grabbed_ ? point_ : -1; }
     double slope() const override { return std::max(stiffness, stiffStiffness); }
     double restLength() const { return restLengthAt(time_); }
@@ -111,6 +115,7 @@ class MagnetTool final : public Tool {
 public:
     const char* name() const override { return "magnet"; }
     void grab(const MeshView& mesh, const Cursor& cursor) override;
+    void copySettings(const Tool& other) override;
     int selected() const { return static_cast<int>(points_.size()); }
     double slope() const override { return stiffness; }  // stiffness * falloff weight <= stiffness per point
     double radius = 10.0;
@@ -133,6 +138,7 @@ class OrientationTool final : public Tool {
 public:
     const char* name() const override { return "orientation"; }
     void grab(const MeshView& mesh, const Cursor& cursor) override;
+    void copySettings(const Tool& other) override;
     int anchor() const override { return grabbed_ ? center_ : -1; }
     double slope() const override { return stiffness; }
     double stiffness = 10.0;
@@ -151,6 +157,7 @@ class SmoothTool final : public Tool {
 public:
     const char* name() const override { return "smooth"; }
     void grab(const MeshView& mesh, const Cursor& cursor) override;
+    void copySettings(const Tool& other) override;
     double radius = 10.0;
     double strength = 1.0;
     Falloff falloff = Falloff::Spherical;

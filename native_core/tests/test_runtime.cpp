@@ -264,8 +264,8 @@ TEST(HapticRuntime, AirbrushSpraysAlongTheCursorAsOneStrokeAndRendersNoForce) {
     EXPECT_GT(shown.values.maxCoeff(), 150.0);
     const MaterialMap& m = s->stiffnessMap();
     ASSERT_FALSE(m.uniform());
-    ASSERT_EQ(stroke.mapValues.size(), m.values().size());
-    EXPECT_EQ((stroke.mapValues - m.values()).cwiseAbs().maxCoeff(), 0.0);
+    ASSERT_EQ(stroke.maps[2].values.size(), m.values().size());
+    EXPECT_EQ((stroke.maps[2].values - m.values()).cwiseAbs().maxCoeff(), 0.0);
     // Stiffer along the path (v = 0.5, u from 0.2 to 0.8), untouched far from it, never past the target.
     EXPECT_GT(m.at(0.5, 0.5), 150.0);
     EXPECT_GT(m.at(0.3, 0.5), 150.0);
@@ -299,6 +299,95 @@ TEST(HapticRuntime, SwitchingTheAirbrushOnMidGrabReleasesTheTool) {
     EXPECT_FALSE(s->massMap().uniform());
     EXPECT_THROW(rt.setAirbrush(AirbrushSettings{AirbrushSettings::Map::Mass, 0.0}), std::invalid_argument);
     EXPECT_THROW(rt.setAirbrush(AirbrushSettings{AirbrushSettings::Map::Mass, 0.1, 3.0, 0.25, 0.0}), std::invalid_argument);
+}
+
+namespace {
+// Holds the button and lifts 20 mm over the first second; while `watching`, keeps the smallest
+// force it was asked to render (no allocation: it runs in the haptic thread).
+class HoldingDevice final : public Device {
+public:
+    std::string name() const override { return "holding"; }
+    DeviceCaps caps() const override { return {3, true, 1000, 1e6, 1e6}; }
+    bool sample(double t, DeviceSample& out) override {
+        out.position = Vec3(0, 0, 20.0 * std::min(1.0, t));
+        out.buttons = 1;
+        out.valid = true;
+        return true;
+    }
+    void setForce(const Vec3& f) override {
+        last.store(f.norm());
+        if (watching.load()) least.store(std::min(least.load(), f.norm()));
+    }
+    std::atomic<bool> watching{false};
+    std::atomic<double> last{0}, least{std::numeric_limits<double>::infinity()};
+};
+
+template <class Condition>
+bool waitFor(Condition done, double seconds = 20.0) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (!done()) {
+        if (std::chrono::steady_clock::now() > end) return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return true;
+}
+
+bool takeEvent(HapticRuntime& rt, StrokeSnapshot& out) {
+    return waitFor([&] { return rt.takeStroke(out); });
+}
+}  // namespace
+
+TEST(HapticRuntime, EditsReachARunningSessionWithoutLettingGoOfTheTool) {
+    auto s = patch();
+    auto dev = std::make_shared<HoldingDevice>();
+    HapticRuntime rt(s, dev, RuntimeSettings{});
+    rt.start();
+    ASSERT_TRUE(waitFor([&] { return dev->last.load() > 20.0; })) << "the rope never pulled";
+    const double held = dev->last.load();
+    dev->watching = true;
+    // A stiffer material, configured off the simulation thread, swapped in between two steps.
+    auto stiffer = patch();
+    stiffer->stiffnessMap().setUniform(300.0);
+    stiffer->setTool("rope");
+    rt.postEdit({7, stiffer, false, false, false});  // (its maps are the edit: not the live ones)
+    StrokeSnapshot e;
+    ASSERT_TRUE(takeEvent(rt, e));
+    EXPECT_EQ(e.edit, 7u);
+    EXPECT_EQ(e.maps[2].values.size(), 1);
+    EXPECT_EQ(e.maps[2].values[0], 300.0);
+    EXPECT_GT(e.poles.col(2).maxCoeff(), 1.0);  // the pulled shape, not the new surface's flat one
+    // Keep shape: the pulled shape becomes the rest shape, still holding.
+    rt.postEdit({8, nullptr, false, true, true});
+    ASSERT_TRUE(takeEvent(rt, e));
+    EXPECT_EQ(e.edit, 8u);
+    const RuntimeStatus during = rt.status();
+    dev->watching = false;
+    // A restore (undo) takes its surface as it is: flat and at rest, the rope grabbing anew.
+    auto flat = patch();
+    rt.postEdit({9, flat, true, false, false});
+    ASSERT_TRUE(takeEvent(rt, e));
+    EXPECT_EQ(e.edit, 9u);
+    EXPECT_EQ(e.poles.col(2).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_EQ(e.velocities.cwiseAbs().maxCoeff(), 0.0);
+    rt.stop();
+    EXPECT_TRUE(during.grab);
+    EXPECT_EQ(during.error, "");
+    EXPECT_EQ(during.strokes, 0u);  // no edit let go of the rope
+    // The force never dropped out over the edits (it eases with the softer rest shape, never to zero).
+    EXPECT_GT(dev->least.load(), 0.05 * held) << "held " << held;
+    EXPECT_EQ(rt.surface(), flat);
+    EXPECT_EQ(stiffer->stiffnessMap().values()[0], 300.0);
+    // The keep-shape edit made the pulled mesh the rest shape of the surface it then stepped.
+    EXPECT_NE(stiffer->springs().rest(), stiffer->springs().initialRest());
+}
+
+TEST(HapticRuntime, RefusesEditsThatCannotApply) {
+    auto s = patch();
+    HapticRuntime rt(s, std::make_shared<HoldingDevice>(), RuntimeSettings{});
+    EXPECT_THROW(rt.postEdit({0, patch(), false, true, false}), std::invalid_argument);  // no id
+    EXPECT_THROW(rt.postEdit({1, s, false, true, false}), std::invalid_argument);        // the live surface itself
+    EXPECT_THROW(rt.postEdit({2, patch(8, 16), false, true, false}), std::invalid_argument);  // another sampling
+    EXPECT_THROW(rt.postEdit({3, patch(6, 24), false, true, false}), std::invalid_argument);  // another control net
 }
 
 TEST(HapticEstimate, SafetyLayerFadesStaleSnapshotsLimitsStiffnessAndClamps) {
