@@ -23,7 +23,7 @@ class HapticSculptWorkbench(Gui.Workbench):
 
     def Activated(self):
         from HapticSculpt.gui import controller
-        controller().attach()  # the mouse cursor and the keys P, N, C, M in the active view
+        controller().activate()  # the mouse and the keys P, N, C, M in every 3D view, now and later
 
     def Deactivated(self):
         import HapticSculpt

@@ -1,7 +1,6 @@
 """Workbench commands (GUI only; registered from InitGui through FreeCADGui.addCommand)."""
 from __future__ import annotations
 
-import os
 from typing import Any
 
 import FreeCAD
@@ -10,7 +9,8 @@ import FreeCADGui as Gui
 from .undo import transaction
 from .view_provider import icon
 
-TOOLBAR = ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Session", "HapticSculpt_ToolRope",
+TOOLBAR = ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Session", "HapticSculpt_Material",
+           "HapticSculpt_KeepShape", "HapticSculpt_ToolRope",
            "HapticSculpt_ToolMagnet", "HapticSculpt_MagnetFalloff", "HapticSculpt_ToolOrientation",
            "HapticSculpt_ToolSmooth", "HapticSculpt_PointConstraint", "HapticSculpt_NormalConstraint",
            "HapticSculpt_CurvatureConstraint", "HapticSculpt_PaintMass", "HapticSculpt_PaintDamping",
@@ -36,7 +36,7 @@ class NewPatch:
 
     def Activated(self) -> None:
         from .api import make_sculpt
-        make_sculpt(FreeCAD.ActiveDocument)
+        make_sculpt(FreeCAD.ActiveDocument, material="clay")  # designers expect what they pull to stay
         FreeCAD.ActiveDocument.recompute()
         Gui.SendMsgToActiveView("ViewFit")
 
@@ -56,7 +56,7 @@ class SculptFace:
         from .api import make_sculpt
         sel = Gui.Selection.getSelectionEx()[0]
         face = next(n for n in sel.SubElementNames if n.startswith("Face"))
-        obj = make_sculpt(sel.Object.Document, source=(sel.Object, face))
+        obj = make_sculpt(sel.Object.Document, source=(sel.Object, face), material="clay")
         FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label} from {obj.SourceDescription}, "
                                      f"{obj.ConversionMethod}, error {obj.ConversionError:.3g} mm\n")
 
@@ -80,22 +80,17 @@ class Thicken:
 
 
 class ExportStep:
-    """Export the selected sculpts to a STEP file beside the document."""
+    """Export the selected sculpts with FreeCAD's own export dialog (it asks before overwriting)."""
 
     def GetResources(self) -> dict[str, str]:
         return {"Pixmap": icon("HapticSculpt"), "MenuText": "Export STEP",
-                "ToolTip": "Write the selected sculpt surfaces to <document>.step beside the document file"}
+                "ToolTip": "Export the selected sculpt surfaces (FreeCAD's export dialog: choose STEP and a file name)"}
 
     def IsActive(self) -> bool:
         return bool(_selected_sculpts())
 
     def Activated(self) -> None:
-        from .api import export_step
-        objs = _selected_sculpts()
-        doc = objs[0].Document
-        base = os.path.splitext(doc.FileName)[0] if doc.FileName else os.path.join(os.path.expanduser("~"), doc.Name)
-        path = export_step(objs, base + ".step")
-        FreeCAD.Console.PrintMessage(f"HapticSculpt: wrote {path}\n")
+        Gui.runCommand("Std_Export")
 
 
 def _ctl() -> Any:
@@ -104,7 +99,7 @@ def _ctl() -> Any:
 
 
 def _has_sculpt() -> bool:
-    return FreeCAD.ActiveDocument is not None and _ctl().active_sculpt() is not None
+    return _ctl().active_sculpt() is not None
 
 
 class _SculptCommand:
@@ -123,15 +118,43 @@ class _SculptCommand:
 class Session(_SculptCommand):
     icon_name = "Session"
     menu = "Start/stop sculpting"
-    tip = ("Start a sculpting session on the active sculpt with the attached SpaceMouse (the mouse when none "
-           "is attached: left button grabs); run again to stop")
+    tip = ("Start sculpting the selected sculpt (or the only one) with the attached SpaceMouse (the mouse when "
+           "none is attached: the left button grabs); run again to stop")
+
+    def IsActive(self) -> bool:
+        return _ctl().session is not None or _has_sculpt()
 
     def Activated(self) -> None:
         ctl = _ctl()
-        if ctl.session is not None and ctl.session.running:
+        if ctl.session is not None:
             ctl.stop_session()
         else:
-            ctl.start_session()
+            try:
+                ctl.start_session()
+            except RuntimeError as exc:
+                FreeCAD.Console.PrintWarning(f"HapticSculpt: {exc}\n")
+
+
+class Material(_SculptCommand):
+    icon_name, menu = "Session", "Elastic / Clay"
+    tip = ("Switch the sculpt's material: clay (what you pull stays) or elastic (springs back to its rest shape "
+           "unless held by constraints)")
+
+    def Activated(self) -> None:
+        from .api import material_of, set_material
+        obj = _ctl().active_sculpt()
+        new = "elastic" if material_of(obj) == "clay" else "clay"
+        set_material(obj, new)
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label} is {new} now\n")
+
+
+class KeepShape(_SculptCommand):
+    icon_name, menu = "Session", "Keep shape"
+    tip = "Make the current shape the rest shape: an elastic sculpt stays as it is now (also while sculpting)"
+
+    def Activated(self) -> None:
+        from .api import keep_shape
+        keep_shape(_ctl().active_sculpt())
 
 
 class _Tool(_SculptCommand):
@@ -275,6 +298,7 @@ class Panel(_SculptCommand):
 
 
 COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_SculptFace": SculptFace, "HapticSculpt_Session": Session,
+            "HapticSculpt_Material": Material, "HapticSculpt_KeepShape": KeepShape,
             "HapticSculpt_ToolRope": ToolRope, "HapticSculpt_ToolMagnet": ToolMagnet,
             "HapticSculpt_MagnetFalloff": MagnetFalloff, "HapticSculpt_ToolOrientation": ToolOrientation,
             "HapticSculpt_ToolSmooth": ToolSmooth, "HapticSculpt_PointConstraint": PointConstraint,

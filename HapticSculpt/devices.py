@@ -12,6 +12,16 @@ UDEV_RULES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file
                           "70-hapticsculpt.rules")
 
 
+def native_device(device: Any) -> Any:
+    """The C++ device for a Python-side device description."""
+    if isinstance(device, _core.Device):
+        return device
+    native = getattr(device, "native", None)
+    if isinstance(native, _core.Device):
+        return native
+    raise TypeError(f"device: expected a ReplayDevice or a HapticSculpt device, got {type(device).__name__}")
+
+
 def list_devices() -> list[dict[str, Any]]:
     """Attached HID interfaces, each with ``kind``: "spacemouse" for a known SpaceMouse, else "hid"."""
     out = []
@@ -45,7 +55,6 @@ def force_feedback(input_device: Any, output: Any, full_scale_force: float, max_
     """Cursor from ``input_device``, force to a HID PID device: ``output`` is its hidraw path or a
     transport (e.g. ``_core.PidEmulator()``). Forces are in the session's units (mN with mm, kg, s);
     ``full_scale_force`` maps to the device's largest magnitude."""
-    from .session import native_device
     driver = _core.PidForceDriver(output, full_scale_force=full_scale_force)
     return _core.ForceFeedbackDevice(native_device(input_device), driver, max_force, max_stiffness)
 
@@ -56,25 +65,31 @@ class MouseDevice:
 
     def __init__(self, name: str = "mouse") -> None:
         self.native = _core.ExternalDevice(name)
-        self._view: Any = None
-        self._callbacks: list[tuple[Any, Any]] = []
+        self._callbacks: list[tuple[Any, Any, Any]] = []
         self._buttons = 0
         self._position = (0.0, 0.0, 0.0)
 
     def attach(self, view: Any) -> None:
         """Follows the mouse in ``view`` (a FreeCADGui 3D view) until :meth:`detach`."""
+        self.attach_all([view])
+
+    def attach_all(self, views: Sequence[Any]) -> None:
+        """Follows the mouse in each of ``views``, wherever it is, until :meth:`detach`."""
         from pivy import coin
         self.detach()
-        self._view = view
-        for event, handler in ((coin.SoLocation2Event, self._on_move), (coin.SoMouseButtonEvent, self._on_button)):
-            self._callbacks.append((event, view.addEventCallbackPivy(event.getClassTypeId(), handler)))
+        for view in views:
+            for event, handler in ((coin.SoLocation2Event, self._on_move), (coin.SoMouseButtonEvent, self._on_button)):
+                bound = (lambda h, v: lambda cb: h(v, cb))(handler, view)
+                self._callbacks.append((view, event, view.addEventCallbackPivy(event.getClassTypeId(), bound)))
 
     def detach(self) -> None:
         """Stops following the mouse (the device stays usable; its cursor stays where it was)."""
-        if self._view is not None:
-            for event, handle in self._callbacks:
-                self._view.removeEventCallbackPivy(event.getClassTypeId(), handle)
-        self._callbacks, self._view = [], None
+        for view, event, handle in self._callbacks:
+            try:
+                view.removeEventCallbackPivy(event.getClassTypeId(), handle)
+            except Exception:  # noqa: BLE001 - the view may be closed
+                pass
+        self._callbacks = []
 
     def move_to(self, view: Any, pixel: Sequence[int]) -> tuple[float, float, float]:
         """Puts the cursor under ``pixel`` of ``view`` (surface point if any, else the focal plane)."""
@@ -94,12 +109,17 @@ class MouseDevice:
         self._buttons = 1 if held else 0
         self.native.push(list(self._position), buttons=self._buttons)
 
-    def _on_move(self, cb: Any) -> None:
+    def _on_move(self, view: Any, cb: Any) -> None:
         pos = cb.getEvent().getPosition()
-        self.move_to(self._view, (pos[0], pos[1]))
+        self.move_to(view, (pos[0], pos[1]))
+        if self._buttons:
+            cb.setHandled()  # a grab: not a selection box or a rotation
 
-    def _on_button(self, cb: Any) -> None:
+    def _on_button(self, view: Any, cb: Any) -> None:
         from pivy import coin
         event = cb.getEvent()
         if event.getButton() == coin.SoMouseButtonEvent.BUTTON1:
+            pos = event.getPosition()
+            self.move_to(view, (pos[0], pos[1]))
             self.press(event.getState() == coin.SoButtonEvent.DOWN)
+            cb.setHandled()

@@ -1,16 +1,22 @@
-"""What the workbench's commands and keys act on while it is active (GUI only): the active sculpt,
-its overlay in the active 3D view, the mouse cursor over the surface, and the session.
+"""What the workbench's commands, keys and mouse act on while it is active (GUI only).
 
-The cursor: with a session running it is the device's (the haptic loop's last sample); without one
-it follows the mouse over the surface (or the view's focal plane off it), so constraints and paint
-dabs go to the mass point nearest the mouse. Keys as in paper section 5: P, N, C toggle a point,
-normal or curvature constraint at the nearest point; M switches between shading and the map display.
+Input in every order: while the workbench is active, every 3D view of every document gets the
+workbench's event callbacks, whether it existed before the workbench was chosen or opens later
+(a Coin timer looks for new views four times a second and forgets closed ones). Each event acts
+on the view it happened in, on the sculpt under the mouse there (else the selected one, else the
+document's only one).
 
-Airbrush: a paint command switches painting of that map on (again: off). Without a session, holding
-the left button sprays dabs along the mouse path, shown live in the map display, and the release
-makes the whole stroke one undo step. With a session, the device's button sprays instead of
-grabbing: the simulation thread lays the dabs between its steps along the device's path, shown
-live in the map display, and each spray is one undo step (Session.set_airbrush).
+The cursor: with a session running it is the device's; without one it follows the mouse over the
+surface (or the view's focal plane off it), so constraints and paint dabs go to the mass point
+nearest the mouse. Keys as in paper section 5: P, N, C toggle a point, normal or curvature
+constraint at the nearest point; M switches between shading and the map display.
+
+The left button: while the airbrush is on (without a session) or a mouse session runs, the left
+button belongs to the workbench in every navigation style, so events reach the scene graph before
+the navigation style (FreeCAD's redirect-to-scene-graph), and what the workbench does not take
+(middle and right buttons, the wheel) still navigates. Airbrush strokes lay dabs along the whole
+mouse path, however fast it moves, and each stroke is one undo step. With a session the device's
+button sprays instead (Session.set_airbrush).
 """
 from __future__ import annotations
 
@@ -19,12 +25,70 @@ from typing import Any
 import numpy as np
 
 from . import core
-from .overlay import Overlay, readable_surface
+from .overlay import Overlay
 
 MAP_CYCLE = ("mass", "damping", "stiffness")
 CURVATURE_CYCLE = ("curvature", "mean", "gauss")
 KEYS = {"p": "point", "n": "normal", "c": "curvature"}
 AIRBRUSH_FACTOR = 3.0  # a stroke moves the map toward this times its mean when the stroke began
+AIRBRUSH_RADIUS = 0.08  # map coordinates (the unit square)
+VIEW_SCAN_SECONDS = 0.25  # how often new and closed 3D views are looked for
+#: Shown in the status bar when the workbench is chosen (the workbench selector keeps the keys).
+HELLO = ("HapticSculpt: click in the 3D view, then P / N / C toggle point, normal, curvature constraints at the "
+         "mouse, M shows the material map; Start/stop sculpting grabs with the left button\n")
+
+
+class ViewInput:
+    """The workbench's event callbacks in one 3D view; each handler knows its view."""
+
+    def __init__(self, ctl: "Controller", view: Any) -> None:
+        from pivy import coin
+        self.view = view
+        self._callbacks: list[tuple[Any, Any]] = []
+        for event, handler in ((coin.SoLocation2Event, ctl.on_move), (coin.SoKeyboardEvent, ctl.on_key),
+                               (coin.SoMouseButtonEvent, ctl.on_button)):
+            bound = (lambda h: lambda cb: h(view, cb))(handler)
+            self._callbacks.append((event, view.addEventCallbackPivy(event.getClassTypeId(), bound)))
+
+    def alive(self) -> bool:
+        try:
+            self.view.getSize()
+            return True
+        except Exception:  # noqa: BLE001 - a closed view raises on any access
+            return False
+
+    def take_left_button(self, take: bool) -> None:
+        """Events to the scene graph first (the workbench takes the left button), or back to normal."""
+        try:
+            viewer = self.view.getViewer()
+            if bool(viewer.isRedirectedToSceneGraph()) != take:
+                viewer.setRedirectToSceneGraph(take)
+        except Exception:  # noqa: BLE001 - a closed view
+            pass
+
+    def remove(self) -> None:
+        self.take_left_button(False)
+        for event, handle in self._callbacks:
+            try:
+                self.view.removeEventCallbackPivy(event.getClassTypeId(), handle)
+            except Exception:  # noqa: BLE001 - the view may already be closed
+                pass
+        self._callbacks = []
+
+
+def all_3d_views() -> list[Any]:
+    """Every open 3D view of every document."""
+    import FreeCAD
+    import FreeCADGui as Gui
+    views = []
+    for name in FreeCAD.listDocuments():
+        gdoc = Gui.getDocument(name)
+        if gdoc is None:
+            continue
+        for view in gdoc.mdiViewsOfType("Gui::View3DInventor"):
+            if hasattr(view, "addEventCallbackPivy"):
+                views.append(view)
+    return views
 
 
 class Controller:
@@ -32,22 +96,68 @@ class Controller:
 
     def __init__(self) -> None:
         self.overlays: dict[tuple[int, str], Overlay] = {}
+        self.inputs: list[ViewInput] = []
         self.mouse_point: np.ndarray | None = None
+        self.mouse_view: Any = None  # the view the mouse was last seen in
+        self.mouse_object: Any = None  # the sculpt under the mouse there, if any
         self.session: Any = None
         self.mouse: Any = None
-        self._view: Any = None
-        self._callbacks: list[tuple[Any, Any]] = []
+        self._scan: Any = None
+        self._observer: Any = None
         self.last_map = "mass"
         self.painting: str | None = None  # the map the airbrush paints, None when off
         self._paint_stroke: Any = None  # the sculpt being painted while the button is held
         self._paint_target = 0.0
+        self._last_dab: tuple[float, float] | None = None
         self.tool = "rope"
         self.falloff = "spherical"
 
-    # --- what commands act on ---------------------------------------------------------------------
+    # --- views ------------------------------------------------------------------------------------
+    def activate(self) -> None:
+        """The workbench was chosen: attach to every 3D view now and to each one that opens later."""
+        from pivy import coin
+        self.sync_views()
+        if self._scan is None:
+            self._scan = coin.SoTimerSensor(lambda *_: self.sync_views(), None)
+            self._scan.setInterval(coin.SbTime(VIEW_SCAN_SECONDS))
+            self._scan.schedule()
+        import FreeCAD
+        if self._observer is None:
+            self._observer = _UndoObserver(self)
+            FreeCAD.addDocumentObserver(self._observer)
+        FreeCAD.Console.PrintMessage(HELLO)
+
+    def sync_views(self) -> None:
+        """Attaches to views that opened and forgets closed ones."""
+        self.inputs = [i for i in self.inputs if i.alive() or i.remove()]
+        for key in [k for k, ov in self.overlays.items() if not ov.alive()]:
+            self.overlays.pop(key).remove()
+        for view in all_3d_views():
+            if not any(i.view is view for i in self.inputs):
+                self.inputs.append(ViewInput(self, view))
+        self._update_left_button()
+
+    def _update_left_button(self) -> None:
+        take = self.painting is not None or self.mouse is not None
+        for i in self.inputs:
+            i.take_left_button(take)
+
     @staticmethod
-    def active_sculpt() -> Any:
-        """The selected sculpt, else the active document's last sculpt, else None."""
+    def active_view() -> Any:
+        import FreeCADGui as Gui
+        doc = Gui.ActiveDocument
+        view = getattr(doc, "ActiveView", None) if doc is not None else None
+        return view if view is not None and hasattr(view, "getSceneGraph") else None
+
+    def view(self) -> Any:
+        """The view the mouse was last in (if still open), else the active 3D view."""
+        if self.mouse_view is not None and any(i.view is self.mouse_view and i.alive() for i in self.inputs):
+            return self.mouse_view
+        return self.active_view()
+
+    # --- what commands act on ---------------------------------------------------------------------
+    def active_sculpt(self) -> Any:
+        """The selected sculpt, else the one under the mouse, else the active document's only one."""
         import FreeCAD
         import FreeCADGui as Gui
 
@@ -55,28 +165,25 @@ class Controller:
         sel = [o for o in Gui.Selection.getSelection() if is_sculpt(o)]
         if sel:
             return sel[0]
+        if self.mouse_object is not None and _alive(self.mouse_object):
+            return self.mouse_object
         doc = FreeCAD.ActiveDocument
-        if doc is None:
-            return None
-        sculpts = [o for o in doc.Objects if is_sculpt(o)]
-        return sculpts[-1] if sculpts else None
+        sculpts = [o for o in doc.Objects if is_sculpt(o)] if doc is not None else []
+        return sculpts[0] if len(sculpts) == 1 else None
 
-    @staticmethod
-    def view() -> Any:
-        import FreeCADGui as Gui
-        doc = Gui.ActiveDocument
-        view = getattr(doc, "ActiveView", None) if doc is not None else None
-        return view if view is not None and hasattr(view, "getSceneGraph") else None
-
-    def overlay(self, obj: Any | None = None) -> Overlay | None:
+    def overlay(self, obj: Any | None = None, view: Any = None) -> Overlay | None:
         obj = obj or self.active_sculpt()
-        view = self.view()
-        if obj is None or view is None:
+        view = view or self.view()
+        if obj is None or view is None or not _alive(obj):
             return None
         key = (id(view), obj.Document.Name + "/" + obj.Name)
         if key not in self.overlays:
             self.overlays[key] = Overlay(view, obj)
         return self.overlays[key]
+
+    def overlays_of(self, obj: Any) -> list[Overlay]:
+        name = obj.Document.Name + "/" + obj.Name
+        return [ov for (_, n), ov in self.overlays.items() if n == name]
 
     def cursor(self) -> np.ndarray | None:
         """Where the cursor is: the session's device while one runs, else the mouse."""
@@ -85,58 +192,71 @@ class Controller:
         return self.mouse_point
 
     # --- mouse and keys ---------------------------------------------------------------------------
-    def attach(self) -> None:
-        """Follows the mouse and the keys in the active view (the workbench's Activated)."""
-        from pivy import coin
-        view = self.view()
-        if view is None or view is self._view:
-            return
-        self.detach()
-        self._view = view
-        for event, handler in ((coin.SoLocation2Event, self._on_move), (coin.SoKeyboardEvent, self._on_key),
-                               (coin.SoMouseButtonEvent, self._on_button)):
-            self._callbacks.append((event, view.addEventCallbackPivy(event.getClassTypeId(), handler)))
-
-    def detach(self) -> None:
-        if self._view is not None:
-            for event, handle in self._callbacks:
-                try:
-                    self._view.removeEventCallbackPivy(event.getClassTypeId(), handle)
-                except Exception:  # noqa: BLE001 - the view may already be closed
-                    pass
-        self._callbacks, self._view = [], None
-
     def point_at(self, view: Any, x: int, y: int) -> np.ndarray:
-        """The surface point under pixel (x, y), else the point on the view's focal plane."""
+        """The surface point under pixel (x, y), else the point on the view's focal plane; notes
+        which sculpt is under the mouse."""
+        import FreeCAD
+
+        from .sculpt_feature import is_sculpt
         info = view.getObjectInfo((x, y))
+        self.mouse_object = None
         if info and all(k in info for k in ("x", "y", "z")):
+            doc = FreeCAD.getDocument(info["Document"]) if info.get("Document") else None
+            obj = doc.getObject(info["Object"]) if doc is not None and info.get("Object") else None
+            if is_sculpt(obj):
+                self.mouse_object = obj
             return np.array([info["x"], info["y"], info["z"]], float)
         p = view.getPoint(x, y)
         return np.array([p.x, p.y, p.z], float)
 
-    def _on_move(self, cb: Any) -> None:
+    def on_move(self, view: Any, cb: Any) -> None:
         pos = cb.getEvent().getPosition()
-        self.mouse_point = self.point_at(self._view, int(pos[0]), int(pos[1]))
-        ov = self.overlay()
-        if ov is not None and not (self.session is not None and self.session.running):
-            ov.cursor = (self.mouse_point, np.array([1.0, 0, 0, 0]), self._paint_stroke is not None)
+        self.mouse_view = view
+        self.mouse_point = self.point_at(view, int(pos[0]), int(pos[1]))
         if self._paint_stroke is not None:
-            self._dab(self._paint_stroke, self.mouse_point)
+            self._dab_to(self._paint_stroke, self.mouse_point)
             cb.setHandled()
+        ov = self.overlay(view=view)
+        if ov is not None and ov.obj.Proxy.live.session is None:
+            ov.cursor = (self.mouse_point, np.array([1.0, 0, 0, 0]), self._paint_stroke is not None)
 
-    def _on_button(self, cb: Any) -> None:
+    def on_button(self, view: Any, cb: Any) -> None:
         from pivy import coin
         event = cb.getEvent()
-        if self.painting is None or event.getButton() != coin.SoMouseButtonEvent.BUTTON1:
+        if event.getButton() != coin.SoMouseButtonEvent.BUTTON1:
             return
-        if self.session is not None and self.session.running:
-            return  # the left button belongs to the session's mouse device then
+        if self.mouse is not None:
+            return  # the left button belongs to the session's mouse device (it follows every view)
+        if self.painting is None:
+            return
+        pos = event.getPosition()
+        self.mouse_view = view
         if event.getState() == coin.SoButtonEvent.DOWN:
-            pos = event.getPosition()
-            self.mouse_point = self.point_at(self._view, int(pos[0]), int(pos[1]))
+            self.mouse_point = self.point_at(view, int(pos[0]), int(pos[1]))
             self.begin_paint_stroke()
         else:
             self.end_paint_stroke()
+        cb.setHandled()
+
+    def on_key(self, view: Any, cb: Any) -> None:
+        from pivy import coin
+        event = cb.getEvent()
+        if event.getState() != coin.SoButtonEvent.DOWN:
+            return
+        key = event.getPrintableCharacter().lower() if hasattr(event, "getPrintableCharacter") else ""
+        if key not in KEYS and key != "m":
+            return
+        if event.wasCtrlDown() or event.wasAltDown():
+            return  # ctrl+N and the like belong to FreeCAD
+        self.mouse_view = view
+        try:
+            if key in KEYS:
+                self.toggle_constraint(KEYS[key])
+            else:
+                self.toggle_map()
+        except RuntimeError as exc:
+            import FreeCAD
+            FreeCAD.Console.PrintWarning(f"HapticSculpt: {exc}\n")
         cb.setHandled()
 
     # --- the airbrush ------------------------------------------------------------------------------
@@ -149,6 +269,7 @@ class Controller:
             self.session.set_airbrush(self.painting, factor=AIRBRUSH_FACTOR)
         if self.painting is not None:
             self.set_display(self.painting)
+        self._update_left_button()
         return self.painting
 
     def begin_paint_stroke(self) -> None:
@@ -157,69 +278,58 @@ class Controller:
         if obj is None or self.painting is None or self.mouse_point is None:
             return
         self._paint_stroke = obj
+        surface = obj.Proxy.live.surface
         # One target for the whole stroke (as the session's airbrush), so dabs saturate at it.
-        self._paint_target = AIRBRUSH_FACTOR * float(np.mean(getattr(obj.Proxy.surface, self.painting + "_map").values))
-        self._dab(obj, self.mouse_point)
+        self._paint_target = AIRBRUSH_FACTOR * float(np.mean(getattr(surface, self.painting + "_map").values))
+        self._last_dab = None
+        self._dab_to(obj, self.mouse_point)
 
     def end_paint_stroke(self) -> None:
         """Button up: the stroke's dabs become one undo step."""
         obj, self._paint_stroke = self._paint_stroke, None
-        if obj is not None:
-            from .api import _commit
-            _commit(obj, f"Paint {self.painting}")
+        if obj is not None and _alive(obj):
+            obj.Proxy.live.commit(f"Paint {self.painting}")
             self.refresh(obj)
 
-    def _dab(self, obj: Any, at: np.ndarray, radius: float = 0.08, strength: float = 0.25) -> None:
-        """One airbrush dab on the painted map around the mass point nearest `at` (no session runs)."""
-        m = getattr(obj.Proxy.surface, self.painting + "_map")  # (a uniform map gets a paint resolution on its first dab)
-        m.dab(self._map_uv(obj, at), radius, self._paint_target, "spherical", strength)
-        ov = self.overlay(obj)
-        if ov is not None:
+    def _dab_to(self, obj: Any, at: np.ndarray, strength: float = 0.25) -> None:
+        """Dabs from the last dab to the mass point nearest `at`, half a radius apart, so a fast
+        drag paints a continuous line (no session runs while the mouse paints)."""
+        surface = obj.Proxy.live.surface
+        m = getattr(surface, self.painting + "_map")  # (a uniform map gets a paint resolution on its first dab)
+        end = np.array(self._map_uv(obj, at))
+        start = end if self._last_dab is None else np.array(self._last_dab)
+        n = max(1, int(np.ceil(np.linalg.norm(end - start) / (0.5 * AIRBRUSH_RADIUS))))
+        for t in np.linspace(0.0, 1.0, n + 1)[1 if self._last_dab is not None else n:]:
+            u, v = start + t * (end - start)
+            m.dab((float(u), float(v)), AIRBRUSH_RADIUS, self._paint_target, "spherical", strength)
+        self._last_dab = (float(end[0]), float(end[1]))
+        for ov in self.overlays_of(obj):
             ov.frame()
-
-    def _on_key(self, cb: Any) -> None:
-        from pivy import coin
-        event = cb.getEvent()
-        if event.getState() != coin.SoButtonEvent.DOWN:
-            return
-        key = event.getPrintableCharacter().lower() if hasattr(event, "getPrintableCharacter") else ""
-        if key in KEYS:
-            self.toggle_constraint(KEYS[key])
-            cb.setHandled()
-        elif key == "m":
-            self.toggle_map()
-            cb.setHandled()
 
     # --- actions ----------------------------------------------------------------------------------
     def toggle_constraint(self, kind: str) -> str:
         """Adds a `kind` constraint at the mass point nearest the cursor, or removes the one there."""
-        from .session import edit_surface
         obj, at = self.active_sculpt(), self.cursor()
         if obj is None or at is None:
             raise RuntimeError("no sculpt or no cursor: move the mouse over a sculpt first")
-        index = int(self._nearest(obj, at))
-        existing = [c for c in readable_surface(obj).constraints if c["kind"] == kind and c["index"] == index]
+        live = obj.Proxy.live
+        index = int(live.snapshot().nearest_mesh_index(list(at)))
+        existing = [c for c in live.snapshot().constraints if c["kind"] == kind and c["index"] == index]
         if existing:
-            edit_surface(obj, lambda s: s.remove_constraint(existing[0]["id"]), f"Remove {kind} constraint")
+            live.edit(lambda s: s.remove_constraint(existing[0]["id"]), f"Remove {kind} constraint")
             result = "removed"
         else:
-            edit_surface(obj, lambda s: s.add_constraint(kind, index=index), f"Add {kind} constraint")
+            live.edit(lambda s: s.add_constraint(kind, index=index), f"Add {kind} constraint")
             result = "added"
         self.refresh(obj)
         return result
 
     def _map_uv(self, obj: Any, at: np.ndarray) -> tuple[float, float]:
         """Map coordinates (0..1 over the parametric domain) of the mass point nearest `at`."""
-        s = readable_surface(obj)
-        u, v = s.mesh_parameters(self._nearest(obj, at))
+        s = obj.Proxy.live.snapshot()
+        u, v = s.mesh_parameters(int(s.nearest_mesh_index(list(at))))
         (u0, u1), (v0, v1) = s.surface.domain
         return (u - u0) / (u1 - u0), (v - v0) / (v1 - v0)
-
-    def _nearest(self, obj: Any, at: np.ndarray) -> int:
-        """Mass point nearest `at` on the newest shape (the overlay's copy: never the stepped surface)."""
-        ov = self.overlay(obj)
-        surface = ov.scratch() if ov is not None else readable_surface(obj)
-        return int(surface.nearest_mesh_index(list(at)))
 
     def set_display(self, display: str) -> None:
         ov = self.overlay()
@@ -232,8 +342,9 @@ class Controller:
 
     def toggle_map(self) -> None:
         ov = self.overlay()
-        if ov is not None:
-            self.set_display("shading" if ov.display in MAP_CYCLE else self.last_map)
+        if ov is None:
+            raise RuntimeError("no sculpt here: move the mouse over a sculpt first")
+        self.set_display("shading" if ov.display in MAP_CYCLE else self.last_map)
 
     def cycle(self, cycle: tuple[str, ...]) -> str:
         ov = self.overlay()
@@ -246,7 +357,6 @@ class Controller:
         return nxt
 
     def set_tool(self, tool: str, falloff: str | None = None) -> None:
-        from .session import edit_surface
         if tool not in core.TOOLS:
             raise ValueError(f"tool: unknown tool {tool!r}")
         self.tool = tool
@@ -260,7 +370,7 @@ class Controller:
             s.set_tool(tool)
             if tool == "magnet":
                 s.tool.falloff = self.falloff
-        edit_surface(obj, change, f"Tool: {tool}")
+        obj.Proxy.live.edit(change, f"Tool: {tool}")
 
     def start_session(self, device: Any = None) -> Any:
         """Starts sculpting the active sculpt with `device`, else the first attached device, else the mouse."""
@@ -268,47 +378,91 @@ class Controller:
         from .session import Session
         obj = self.active_sculpt()
         if obj is None:
-            raise RuntimeError("no sculpt to sculpt: create a patch first")
+            raise RuntimeError("select the sculpt to sculpt (or create a patch first)")
         if device is None:
             found = [d for d in list_devices() if d.get("spacemouse")]
             if found:
                 device = spacemouse(found[0]["path"])
             else:
                 device = MouseDevice()
-                view = self.view()
-                if view is not None:
-                    device.attach(view)
+                device.attach_all([i.view for i in self.inputs] or [self.view()])
         self.mouse = device if isinstance(device, MouseDevice) else None
-        self.session = Session().start(obj, device, tool=readable_surface(obj).tool.name)
-        if self.painting is not None:
-            self.session.set_airbrush(self.painting, factor=AIRBRUSH_FACTOR)
+        session = Session()
+        session.set_airbrush(self.painting, factor=AIRBRUSH_FACTOR)  # before the first tick can grab
+        self.session = session.start(obj, device, tool=obj.Proxy.live.snapshot().tool.name)
+        self._update_left_button()
         self.refresh(obj)
         return self.session
 
     def stop_session(self) -> None:
         if self.session is not None:
+            obj = self.session_object()
             self.session.stop()
             self.session = None
+            if obj is not None:
+                self.refresh(obj)
         if self.mouse is not None:
             self.mouse.detach()
             self.mouse = None
-        self.refresh()
+        self._update_left_button()
+
+    def session_object(self) -> Any:
+        return getattr(self.session, "obj", None)
 
     def refresh(self, obj: Any | None = None) -> None:
-        ov = self.overlay(obj)
-        if ov is not None:
+        obj = obj or self.active_sculpt()
+        if obj is None:
+            return
+        for ov in self.overlays_of(obj) or [o for o in [self.overlay(obj)] if o is not None]:
             ov.refresh()
+
+    def refresh_all(self) -> None:
+        """Redraws every overlay (after Undo or Redo)."""
+        for ov in list(self.overlays.values()):
+            if _alive(ov.obj):
+                ov.refresh()
 
     def shutdown(self) -> None:
         """Leaving the workbench: stop the session, remove every overlay, drop the callbacks."""
         self.stop_session()
+        self.painting = None
+        if self._scan is not None:
+            self._scan.unschedule()
+            self._scan = None
         for ov in self.overlays.values():
             try:
                 ov.remove()
             except Exception:  # noqa: BLE001 - a closed view
                 pass
         self.overlays.clear()
-        self.detach()
+        for i in self.inputs:
+            i.remove()
+        self.inputs = []
+        if self._observer is not None:
+            import FreeCAD
+            FreeCAD.removeDocumentObserver(self._observer)
+            self._observer = None
+
+
+class _UndoObserver:
+    """Undo and Redo show at once: the overlays redraw from the restored state (a running session
+    takes it up through its own observer)."""
+
+    def __init__(self, ctl: Controller) -> None:
+        self.ctl = ctl
+
+    def slotUndoDocument(self, doc: Any) -> None:
+        self.ctl.refresh_all()
+
+    def slotRedoDocument(self, doc: Any) -> None:
+        self.ctl.refresh_all()
+
+
+def _alive(obj: Any) -> bool:
+    try:
+        return obj.Document is not None and obj.Document.getObject(obj.Name) is obj
+    except Exception:  # noqa: BLE001 - a deleted object raises on any access
+        return False
 
 
 _CONTROLLER: list[Controller] = []

@@ -13,6 +13,8 @@ from typing import Any
 
 import numpy as np
 
+from . import coin_shapes as shapes
+
 # name, label, low, high (log scale)
 SLIDERS = (("mass", "mass", 1e-2, 1e2), ("damping", "damping", 1e-2, 1e3), ("stiffness", "stiffness", 1e0, 1e5),
            ("curvature_u", "curvature u (1/mm)", 1e-4, 1e-1), ("curvature_v", "curvature v (1/mm)", 1e-4, 1e-1))
@@ -29,10 +31,10 @@ class SliderPanel:
     # --- values -----------------------------------------------------------------------------------
     @staticmethod
     def value(obj: Any, name: str) -> float:
-        from .overlay import material_values, readable_surface
+        live = obj.Proxy.live
         if name in ("mass", "damping", "stiffness"):
-            return float(np.mean(material_values(obj, name)))
-        s = readable_surface(obj)
+            return float(np.mean(live.map_values(name)))
+        s = live.snapshot()
         curv = [c for c in s.constraints if c["kind"] == "curvature"]
         if not curv:
             return 0.0
@@ -40,8 +42,7 @@ class SliderPanel:
 
     @staticmethod
     def apply(obj: Any, name: str, value: float) -> None:
-        from .session import edit_surface
-
+        """Sets slider ``name`` to ``value`` as one undo step (a running session takes it at once)."""
         def change(s: Any) -> None:
             if name in ("mass", "damping", "stiffness"):
                 getattr(s, name + "_map").set_uniform(value)
@@ -51,7 +52,7 @@ class SliderPanel:
                 ku, kv = curv[-1]["curvature"]
                 s.set_constraint_curvature(curv[-1]["id"], value if name == "curvature_u" else ku,
                                            value if name == "curvature_v" else kv)
-        edit_surface(obj, change, f"Set {name.replace('_', ' ')}")
+        obj.Proxy.live.edit(change, f"Set {name.replace('_', ' ')}")
 
     # --- geometry ---------------------------------------------------------------------------------
     def layout(self, mesh: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -100,8 +101,6 @@ class SliderPanel:
 
     def draw(self, obj: Any, mesh: np.ndarray) -> Any:
         from pivy import coin
-
-        from .overlay import _lines, _material, _sphere
         sep = coin.SoSeparator()
         tracks = self.layout(mesh)
         size = float(np.linalg.norm(mesh.reshape(-1, 3).max(0) - mesh.reshape(-1, 3).min(0))) or 1.0
@@ -109,10 +108,10 @@ class SliderPanel:
             a, b = tracks[name]
             value = self.pending if self.held == name and self.pending is not None else self.value(obj, name)
             knob = a + self.fraction(name, value) * (b - a)
-            sep.addChild(_lines(np.array([[a, b]]), (0.7, 0.7, 0.7), 2.0))
-            sep.addChild(_sphere(knob, 0.015 * size, (1.0, 0.6, 0.0) if self.held == name else (0.3, 0.8, 1.0)))
+            sep.addChild(shapes.lines(np.array([[a, b]]), (0.7, 0.7, 0.7), 2.0))
+            sep.addChild(shapes.sphere(knob, 0.015 * size, (1.0, 0.6, 0.0) if self.held == name else (0.3, 0.8, 1.0)))
             text = coin.SoSeparator()
-            text.addChild(_material((1.0, 1.0, 1.0)))
+            text.addChild(shapes.material((1.0, 1.0, 1.0)))
             tr = coin.SoTranslation()
             tr.translation = tuple(float(x) for x in b + [0.0, 0.0, 0.03 * size])
             text.addChild(tr)

@@ -4,7 +4,9 @@ The workbench owns sessions: closing the document, deleting the object, leaving 
 error in a loop or a lost device stops them (the force goes to zero first, then the threads join).
 Each stroke (a grab released) becomes one undo transaction when the session is polled: by the GUI's
 timer while FreeCAD's GUI runs, by :meth:`Session.poll` / :meth:`Session.wait` in console mode, and
-always at :meth:`Session.stop`.
+always at :meth:`Session.stop`. Edits made meanwhile (``obj.Proxy.live.edit``) reach the running
+simulation through the runtime's edit queue without stopping it, and are committed the same way
+when the simulation has applied them; Undo and Redo restore the session's surface in place.
 """
 from __future__ import annotations
 
@@ -15,22 +17,14 @@ from typing import Any
 import numpy as np
 
 from . import _core, core, sculpt_state
+from .devices import native_device
 from .replay_device import ReplayDevice
-from .sculpt_feature import is_sculpt, read_state
+from .sculpt_feature import is_sculpt
+from .sculpt_properties import read_state
 from .undo import transaction
 
 #: Sessions that may still run, so a document close or a workbench change can stop them all.
 _ACTIVE: "weakref.WeakSet[Session]" = weakref.WeakSet()
-
-
-def native_device(device: Any) -> Any:
-    """The C++ device for a Python-side device description."""
-    if isinstance(device, _core.Device):
-        return device
-    native = getattr(device, "native", None)
-    if isinstance(native, _core.Device):
-        return native
-    raise TypeError(f"device: expected a ReplayDevice or a HapticSculpt device, got {type(device).__name__}")
 
 
 class Session:
@@ -43,12 +37,11 @@ class Session:
         self._error = ""
         self._timer: Any = None
         self._frame_base: Any = None  # knots, weights, degrees for GUI frames (they do not change)
-        self._start_args: dict[str, Any] = {}
         self._airbrush: dict[str, Any] = {"map": None}
-        #: the newest pole snapshot the GUI received ((nu*nv, 3)), for overlays; None before one
-        self.latest_poles: np.ndarray | None = None
-        #: the newest snapshot of each map the airbrush sprayed this run ((rows, cols)), for overlays
-        self.latest_maps: dict[str, np.ndarray] = {}
+        self._latest_poles: np.ndarray | None = None  # the newest pole snapshot the GUI received
+        self._latest_maps: dict[str, np.ndarray] = {}  # the newest snapshot of each map sprayed this run
+        self._next_edit = 1
+        self._edits: dict[int, tuple[str, sculpt_state.SculptState | None]] = {}  # posted, not yet applied
 
     # --- life cycle -------------------------------------------------------------------------------
     def start(self, obj: Any, device: Any, tool: str = "rope", haptic_rate: float = 1000.0,
@@ -63,22 +56,19 @@ class Session:
             raise TypeError(f"obj: expected a HapticSculpt Sculpt object, got {getattr(obj, 'TypeId', type(obj).__name__)}")
         if tool not in core.TOOLS:
             raise ValueError(f"tool: unknown tool {tool!r} (one of {', '.join(core.TOOLS)})")
-        proxy = obj.Proxy
-        if getattr(proxy, "session", None) is not None and proxy.session.running:
-            raise RuntimeError(f"obj: {obj.Label} is already being sculpted by another session")
         native = native_device(device)
-        surface = proxy.surface
+        live = obj.Proxy.live
+        if live.session is not None:
+            raise RuntimeError(f"obj: {obj.Label} is already being sculpted by another session")
+        surface = live.surface
         if surface.tool.name != tool:
             surface.set_tool(tool)
         runtime = _core.HapticRuntime(surface, native, haptic_rate=haptic_rate, sim_dt=sim_dt, max_force=max_force,
                                       max_stiffness=max_stiffness, stale_limit=stale_limit, log_seconds=record_seconds,
                                       stop_when_finished=stop_when_finished, realtime=realtime)
+        live.attach(self)  # from here on the runtime steps the surface, starting at rest
         self._runtime, self._obj, self._device, self._error = runtime, obj, native, ""
-        self._start_args = dict(device=device, tool=tool, haptic_rate=haptic_rate, sim_dt=sim_dt, max_force=max_force,
-                                max_stiffness=max_stiffness, stale_limit=stale_limit, record_seconds=record_seconds,
-                                stop_when_finished=stop_when_finished, realtime=realtime)
-        proxy.session = self
-        self.latest_maps = {}
+        self._latest_poles, self._latest_maps, self._edits = None, {}, {}
         runtime.set_airbrush(**self._airbrush)
         runtime.start()
         _ACTIVE.add(self)
@@ -101,31 +91,40 @@ class Session:
         obj, self._obj = self._obj, None
         self._runtime = None
         _ACTIVE.discard(self)
-        if obj is not None:
-            obj.Proxy.session = None
-            if commit and _alive(obj):
+        if obj is not None and _alive(obj):
+            obj.Proxy.live.detach(runtime.surface)
+            if commit:
                 self._commit_strokes(runtime, obj)
                 self._commit_final(obj)
+            obj.Proxy.live.reset_shape()
         self._last_runtime = runtime  # logs stay readable (recording, force errors)
         return status
 
-    def edit(self, change: Any, title: str) -> Any:
-        """Applies ``change(surface)`` to the sculpted surface as one undo transaction. The
-        simulation owns the surface while the loops run, so they are stopped (strokes committed,
-        force to zero) for the edit and started again with the same device and settings."""
-        obj = self._obj
-        if obj is None:
+    # --- the live surface's link (see live_surface.SessionLink) -------------------------------------
+    def post_edit(self, prepared: Any, title: str, restore: bool, keep_maps: bool, keep_shape: bool,
+                  commit: bool) -> None:
+        """Queues an edit for the simulation thread (called by ``obj.Proxy.live``); when it has
+        applied, :meth:`poll` commits it as ``title`` with the state it produced (unless not
+        ``commit``: an Undo or Redo restoring the document's own state)."""
+        if self._runtime is None:
             raise RuntimeError("session: not running")
-        args = dict(self._start_args)
-        self.stop()
+        edit_id = self._next_edit
+        self._next_edit += 1
+        # The configuration the edit leaves, read before the simulation thread owns the surface.
+        self._edits[edit_id] = (title, sculpt_state.capture(prepared) if commit else None)
         try:
-            result = change(obj.Proxy.surface)
-            from .api import _commit
-            _commit(obj, title)
-        finally:
-            args["tool"] = obj.Proxy.surface.tool.name
-            self.start(obj, **args)
-        return result
+            self._runtime.post_edit(edit_id, prepared, restore=restore, keep_maps=keep_maps, keep_shape=keep_shape)
+        except BaseException:
+            del self._edits[edit_id]
+            raise
+
+    def latest_poles(self) -> np.ndarray | None:
+        """The newest pole snapshot ((nu*nv, 3)) the GUI received, None before the first."""
+        return self._latest_poles
+
+    def latest_map(self, name: str) -> np.ndarray | None:
+        """The newest snapshot of map ``name`` the airbrush sprayed this run, None if none."""
+        return self._latest_maps.get(name)
 
     def set_airbrush(self, map: str | None, radius: float = 0.08, factor: float = 3.0, strength: float = 0.25,
                      rate: float = 30.0) -> None:
@@ -147,6 +146,11 @@ class Session:
     def airbrush(self) -> str | None:
         """The map the airbrush sprays, None when it is off."""
         return self._airbrush["map"]
+
+    @property
+    def obj(self) -> Any:
+        """The Sculpt object being sculpted, None once stopped."""
+        return self._obj
 
     @property
     def running(self) -> bool:
@@ -214,12 +218,22 @@ class Session:
 
     # --- strokes -> undo transactions -------------------------------------------------------------
     def _commit_strokes(self, runtime: Any, obj: Any) -> int:
+        """Commits the runtime's events in order: strokes, sprays and applied edits, one undo
+        transaction each. Returns the number of strokes and sprays."""
         n = 0
-        while (stroke := runtime.take_stroke()) is not None:
-            painted = stroke["painted"]
+        live = obj.Proxy.live
+        while (event := runtime.take_stroke()) is not None:
+            live.reset_shape()  # (the transaction records the stored face as what Undo goes back to)
+            if event["edit"] is not None:
+                title, state = self._edits.pop(event["edit"], ("", None))
+                if state is not None:
+                    with transaction(obj.Document, title):
+                        live.write(_with_event(state, event))
+                        obj.purgeTouched()
+                continue
+            painted = event["painted"]
             with transaction(obj.Document, f"Paint {painted}" if painted else "Sculpt stroke"):
-                obj.Proxy.write_arrays(stroke["poles"], stroke["velocities"], stroke["rest_lengths"],
-                                       (painted, stroke["map_shape"], stroke["map_values"]) if painted else None)
+                live.write(_with_event(read_state(obj), event))
                 obj.Strokes = obj.Strokes + 1
                 obj.purgeTouched()
             n += 1
@@ -227,13 +241,14 @@ class Session:
 
     def _commit_final(self, obj: Any) -> None:
         """The state after the last stroke (the surface kept moving) as its own transaction."""
-        current = sculpt_state.capture(obj.Proxy.surface)
+        live = obj.Proxy.live
+        current = sculpt_state.capture(live.surface)
         stored = read_state(obj)
         if all(np.array_equal(current.arrays[k], stored.arrays[k]) for k in current.arrays) and \
                 current.settings_json() == obj.SculptSettings:
             return
-        from .api import _commit
-        _commit(obj, "Sculpt session end")
+        live.reset_shape()
+        live.commit("Sculpt session end")
 
     # --- GUI: shape at graphics rate, strokes as they end ----------------------------------------
     def _start_timer(self) -> None:
@@ -253,11 +268,11 @@ class Session:
             return
         poles = runtime.take_poles()
         if poles is not None and _alive(obj):
-            self.latest_poles = poles
-            obj.Proxy.show_poles(poles, self._frame_base)
+            self._latest_poles = poles
+            obj.Proxy.live.show_poles(poles, self._frame_base)
         painted = runtime.take_painted_map()
         if painted is not None:
-            self.latest_maps[painted["map"]] = painted["values"]
+            self._latest_maps[painted["map"]] = painted["values"]
         self.poll()
 
 
@@ -305,16 +320,30 @@ class _Observer:
             if session._obj is obj:
                 session.stop(commit=False)
 
+    def slotUndoDocument(self, doc: Any) -> None:
+        self._restore(doc)
 
-def edit_surface(obj: Any, change: Any, title: str) -> Any:
-    """Applies ``change(surface)`` to a sculpt object's surface as one undo transaction, through its
-    session when one runs (see :meth:`Session.edit`)."""
-    if not is_sculpt(obj):
-        raise TypeError(f"obj: expected a HapticSculpt Sculpt object, got {type(obj).__name__}")
-    session = getattr(obj.Proxy, "session", None)
-    if session is not None and session.running:
-        return session.edit(change, title)
-    result = change(obj.Proxy.surface)
-    from .api import _commit
-    _commit(obj, title)
-    return result
+    def slotRedoDocument(self, doc: Any) -> None:
+        self._restore(doc)
+
+    @staticmethod
+    def _restore(doc: Any) -> None:
+        """Undo or Redo changed a sculpt that a session steps: the session takes the restored state."""
+        for session in list(_ACTIVE):
+            obj = session._obj
+            if obj is not None and getattr(obj, "Document", None) is doc and session.running:
+                obj.Proxy.live.restore_into_session()
+
+
+def _with_event(state: sculpt_state.SculptState, event: dict[str, Any]) -> sculpt_state.SculptState:
+    """``state`` with the poles, velocities, rest lengths and maps a runtime event carries."""
+    arrays = dict(state.arrays)
+    settings = dict(state.settings, maps=dict(state.settings.get("maps", {})))
+    arrays["Poles"] = np.asarray(event["poles"], dtype=float).ravel()
+    arrays["Velocities"] = np.asarray(event["velocities"], dtype=float).ravel()
+    arrays["RestLengths"] = np.asarray(event["rest_lengths"], dtype=float).ravel()
+    for name, values in event["maps"].items():
+        prop = sculpt_state.map_property(name)
+        arrays[prop] = np.asarray(values, dtype=float).ravel()
+        settings["maps"][prop] = [int(values.shape[0]), int(values.shape[1])]
+    return sculpt_state.SculptState(arrays, settings)

@@ -11,7 +11,7 @@ import pytest
 
 from HapticSculpt import _core, core, devices
 from HapticSculpt.replay_device import ReplayDevice
-from HapticSculpt.session import native_device
+from HapticSculpt.devices import native_device
 
 FIXTURES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fixtures", "hid")
 

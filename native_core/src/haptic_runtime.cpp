@@ -126,6 +126,10 @@ bool HapticRuntime::takeEdits(double simTime) {
     }
     const bool any = !editsTaken_.empty();
     editsTaken_.clear();  // the replaced surfaces are freed here, on the simulation thread
+    if (any) {  // shown at once, even if the surface it left is at rest and takes no step
+        poles_.back() = surface_->poles();
+        poles_.publish();
+    }
     return any;
 }
 

@@ -1,0 +1,218 @@
+"""The one owner of a Sculpt object's core surface: ``obj.Proxy.live``.
+
+Readers call :meth:`LiveSurface.snapshot`, writers :meth:`LiveSurface.edit`, whether or not a
+sculpting session runs; nobody else touches the core surface or asks whether a session runs.
+
+- Without a session the core surface is a cache of the document properties (rebuilt when they
+  change under it: Undo, Redo, a file opened), an edit changes it and is committed as one undo
+  transaction at once.
+- While a session runs its simulation thread steps the surface, so an edit is applied to a private
+  copy configured from the document and holding the newest shape, and handed to the session
+  (:class:`SessionLink`), which swaps it in between two simulation steps without letting go of the
+  device and commits it as one undo transaction when its event comes back. Reads come from a
+  shadow copy holding the newest shape the session published.
+
+No FreeCAD import here beyond what the document layer needs; nothing from the runtime or the GUI.
+"""
+from __future__ import annotations
+
+from typing import Any, Callable, Protocol, TypeVar
+
+import numpy as np
+
+from . import core, sculpt_state
+from .sculpt_properties import face_of, read_state, set_error, write_state
+from .undo import transaction
+
+T = TypeVar("T")
+
+#: Settings whose change does not alter the Part face (no pole moves): the Shape is not rebuilt.
+_SHAPE_ARRAYS = ("Poles", "KnotsU", "KnotsV", "Weights")
+
+
+class SessionLink(Protocol):
+    """What a running session offers the live surface (implemented by the runtime layer)."""
+
+    def post_edit(self, prepared: core.DynamicSurface | None, title: str, restore: bool, keep_maps: bool,
+                  keep_shape: bool, commit: bool) -> None:
+        """Queues an edit for the simulation thread; commits it as ``title`` when it applied."""
+
+    def latest_poles(self) -> np.ndarray | None:
+        """The newest pole snapshot ((nu*nv, 3)) the session published, None before the first."""
+
+    def latest_map(self, name: str) -> np.ndarray | None:
+        """The newest snapshot of a map the session's airbrush sprayed, None if it sprayed none."""
+
+
+class LiveSurface:
+    """See the module docstring. One per Sculpt object; nothing of it is saved."""
+
+    def __init__(self, obj: Any) -> None:
+        self._obj = obj
+        self._surface: core.DynamicSurface | None = None
+        self._stale = True
+        self._session: SessionLink | None = None
+        self._shadow: core.DynamicSurface | None = None  # reads while a session runs
+        self._shadow_stale = True
+        #: True while this object writes the document properties (their change is no news then)
+        self.writing = False
+
+    # --- who owns the surface ---------------------------------------------------------------------
+    @property
+    def session(self) -> SessionLink | None:
+        """The running session that steps the surface, else None."""
+        return self._session
+
+    def attach(self, session: SessionLink) -> core.DynamicSurface:
+        """A session takes the surface over (its threads step it from now on); returns it, at rest."""
+        if self._session is not None:
+            raise RuntimeError(f"{self._obj.Label} is already being sculpted by another session")
+        surface = self.surface
+        surface.set_velocities(np.zeros_like(np.asarray(surface.velocities)))  # a session starts from rest
+        self._session = session
+        self._shadow_stale = True
+        return surface
+
+    def detach(self, surface: core.DynamicSurface) -> None:
+        """The session stopped: ``surface`` (the one its simulation stepped last) is the live one again."""
+        self._session = None
+        self._surface = surface
+        self._stale = False
+
+    # --- reads ------------------------------------------------------------------------------------
+    @property
+    def surface(self) -> core.DynamicSurface:
+        """The core surface itself, for stepping it synchronously (``api.run``). Raises
+        ``RuntimeError`` while a session steps it and ``ValueError`` with the reason when the stored
+        state is corrupt."""
+        if self._session is not None:
+            raise RuntimeError(f"{self._obj.Label}: a sculpting session is running on this surface; stop it first "
+                               "(read it with obj.Proxy.live.snapshot(), change it with obj.Proxy.live.edit())")
+        if self._surface is None or self._stale:
+            self._surface = self._from_document()
+            self._stale = False
+        return self._surface
+
+    def snapshot(self) -> core.DynamicSurface:
+        """The newest state to read (shape, mesh, maps, constraints, tool): the surface itself
+        without a session; during one a private copy holding the newest shape and sprayed maps the
+        session published. Treat it as read-only: change the surface with :meth:`edit`."""
+        if self._session is None:
+            return self.surface
+        if self._shadow is None or self._shadow_stale:
+            self._shadow = self._from_document()
+            self._shadow_stale = False
+        poles = self._session.latest_poles()
+        if poles is not None:
+            self._shadow.set_poles(np.asarray(poles, float).reshape(np.asarray(self._shadow.poles).shape))
+        return self._shadow
+
+    def map_values(self, name: str) -> np.ndarray:
+        """Material map ``name`` ("mass", "damping", "stiffness") as a (rows, cols) array, newest first
+        (a spray under way in a session included)."""
+        if self._session is not None:
+            sprayed = self._session.latest_map(name)
+            if sprayed is not None:
+                return np.asarray(sprayed)
+        return np.array(getattr(self.snapshot(), name + "_map").values)
+
+    # --- writes -----------------------------------------------------------------------------------
+    def edit(self, change: Callable[[core.DynamicSurface], T], title: str, keep_shape: bool = False) -> T:
+        """Applies ``change(surface)`` as one undo transaction named ``title`` and returns its result.
+
+        Without a session it changes the surface and commits at once. During one ``change`` runs on
+        a copy configured from the document with the newest shape, which the session swaps in
+        between two steps without letting go of the device (the transaction follows when the
+        simulation has applied it). ``keep_shape`` then makes the current shape the rest shape."""
+        if self._session is None:
+            surface = self.surface
+            result = change(surface)
+            if keep_shape:
+                surface.relax()
+            self.commit(title)
+            return result
+        prepared = self._from_document()
+        poles = self._session.latest_poles()
+        if poles is not None:
+            prepared.set_poles(np.asarray(poles, float).reshape(np.asarray(prepared.poles).shape))
+        before = _maps(prepared)
+        result = change(prepared)
+        after = _maps(prepared)
+        keep_maps = all(np.array_equal(before[k], after[k]) for k in before)
+        self._session.post_edit(prepared, title, restore=False, keep_maps=keep_maps, keep_shape=keep_shape, commit=True)
+        self._shadow_stale = True
+        return result
+
+    def commit(self, title: str, strokes: int = 0) -> None:
+        """Writes the surface's state to the document as one undo transaction (no session)."""
+        obj = self._obj
+        with transaction(obj.Document, title):
+            self.write(sculpt_state.capture(self.surface))
+            if strokes:
+                obj.Strokes = obj.Strokes + strokes
+            obj.purgeTouched()
+
+    def write(self, state: sculpt_state.SculptState) -> None:
+        """Stores ``state`` in the properties (those that changed) and rebuilds the Shape if its
+        geometry changed; the caller holds the transaction."""
+        obj = self._obj
+        stored = read_state(obj)
+        geometry = any(not np.array_equal(stored.arrays[k], state.arrays[k]) for k in _SHAPE_ARRAYS)
+        self.writing = True
+        try:
+            write_state(obj, state)
+            if geometry or obj.Shape.isNull():
+                obj.Shape = face_of(state)
+        finally:
+            self.writing = False
+        self._shadow_stale = True
+
+    def show_poles(self, poles: np.ndarray, base: sculpt_state.SculptState) -> None:
+        """Redraws the Shape from intermediate poles on the knots and weights of ``base`` (a GUI
+        frame during a session; not stored, not an undo step)."""
+        frame = sculpt_state.SculptState({**base.arrays, "Poles": np.asarray(poles, dtype=float).ravel()}, base.settings)
+        self.writing = True
+        try:
+            self._obj.Shape = face_of(frame)
+        finally:
+            self.writing = False
+
+    def reset_shape(self) -> None:
+        """Puts the Shape back to the stored state's face after a session's frames redrew it. Done
+        outside any transaction, before the next one opens, so Undo never restores a frame."""
+        self.writing = True
+        try:
+            self._obj.Shape = face_of(read_state(self._obj))
+        finally:
+            self.writing = False
+
+    def document_changed(self) -> None:
+        """The document properties changed from outside (Undo, Redo, a script): during a session the
+        surface is restored to them, as it is and at rest, without stopping the session (not a new
+        undo step); otherwise the cache is rebuilt on the next read."""
+        self._stale = True
+        self._shadow_stale = True
+
+    def restore_into_session(self) -> None:
+        """Hands the document's state (after Undo or Redo) to the running session, at rest."""
+        if self._session is None:
+            return
+        restored = self._from_document()
+        restored.set_velocities(np.zeros_like(np.asarray(restored.velocities)))
+        self._session.post_edit(restored, "", restore=True, keep_maps=False, keep_shape=False, commit=False)
+
+    # --- helpers ----------------------------------------------------------------------------------
+    def _from_document(self) -> core.DynamicSurface:
+        obj = self._obj
+        try:
+            surface = sculpt_state.restore(read_state(obj))
+        except ValueError as exc:
+            message = f"{obj.Label}: stored sculpt state is invalid: {exc}"
+            set_error(obj, message, self)
+            raise ValueError(message) from exc
+        set_error(obj, "", self)
+        return surface
+
+
+def _maps(surface: core.DynamicSurface) -> dict[str, np.ndarray]:
+    return {name: np.array(getattr(surface, name + "_map").values) for name in core.MAPS}

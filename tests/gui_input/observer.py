@@ -1,0 +1,69 @@
+# Started with FreeCAD's GUI by the real-input tests (`freecad observer.py`): every 100 ms it writes
+# what a test asserts on (documents, sculpts, undo lists, the workbench's state, where the 3D views
+# are) to $HS_OBSERVER_OUT as JSON. It only reads: every action in those tests is a real X event.
+import json
+import os
+
+import FreeCAD
+import FreeCADGui as Gui
+from pivy import coin
+
+OUT = os.environ["HS_OBSERVER_OUT"]
+
+
+def _sculpts(doc):
+    out = []
+    for o in doc.Objects:
+        if getattr(getattr(o, "Proxy", None), "Type", None) != "HapticSculpt::Sculpt":
+            continue
+        settings = json.loads(o.SculptSettings)
+        face = o.Shape.Faces[0].Surface if o.Shape.Faces else None
+        out.append({"name": o.Name, "poles": list(o.Poles), "strokes": o.Strokes,
+                    "shape_poles": [[p.x, p.y, p.z] for row in face.getPoles() for p in row] if face else [],
+                    "constraints": [[c["kind"], c["index"]] for c in settings.get("constraints", [])],
+                    "plasticity": settings.get("plasticity"), "tool": settings.get("tool", {}).get("name"),
+                    "stiffness_map": [min(o.StiffnessMap), max(o.StiffnessMap), len(o.StiffnessMap)],
+                    "session": o.Proxy.live.session is not None if getattr(o.Proxy, "live", None) else False,
+                    "selected": o in Gui.Selection.getSelection()})
+    return out
+
+
+def _views():
+    out = []
+    for name in FreeCAD.listDocuments():
+        gdoc = Gui.getDocument(name)
+        for v in gdoc.mdiViewsOfType("Gui::View3DInventor") if gdoc else []:
+            try:
+                out.append({"doc": name, "size": list(v.getSize()), "cursor": list(v.getCursorPos()),
+                            "active": v is getattr(Gui.ActiveDocument, "ActiveView", None),
+                            "redirect": bool(v.getViewer().isRedirectedToSceneGraph())})
+            except Exception:  # noqa: BLE001 - a view closing
+                pass
+    return out
+
+
+def write(*_):
+    state = {"workbench": Gui.activeWorkbench().name() if Gui.activeWorkbench() else "",
+             "active": FreeCAD.ActiveDocument.Name if FreeCAD.ActiveDocument else None, "docs": {}, "views": _views()}
+    for name, doc in FreeCAD.listDocuments().items():
+        state["docs"][name] = {"undo": list(doc.UndoNames), "redo": list(doc.RedoNames), "file": doc.FileName,
+                               "modified": bool(getattr(doc, "isTouched", lambda: False)()),
+                               "sculpts": _sculpts(doc), "objects": [o.Name for o in doc.Objects]}
+    try:
+        import HapticSculpt.gui as hg
+        ctl = hg.controller()
+        state["painting"] = ctl.painting
+        state["inputs"] = len(ctl.inputs)
+        state["mouse_point"] = None if ctl.mouse_point is None else [float(x) for x in ctl.mouse_point]
+        state["overlays"] = [{"display": ov.display, "frames": ov.frames} for ov in ctl.overlays.values()]
+    except Exception as exc:  # noqa: BLE001 - the workbench not loaded yet
+        state["controller_error"] = str(exc)
+    tmp = OUT + ".tmp"
+    with open(tmp, "w") as f:
+        json.dump(state, f)
+    os.replace(tmp, OUT)
+
+
+_sensor = coin.SoTimerSensor(write, None)
+_sensor.setInterval(coin.SbTime(0.1))
+_sensor.schedule()
