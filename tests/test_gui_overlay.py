@@ -50,7 +50,7 @@ try:
     view.fitAll()
     pump()
     ctl = controller()
-    ctl.attach()
+    ctl.sync_views()
     surface = obj.Proxy.surface
     mesh = np.array(surface.mesh)
     g, h = mesh.shape[:2]
@@ -71,10 +71,10 @@ try:
         def setHandled(self):
             self.handled = True
     ctl.mouse_point = mesh[3 * g // 4, 3 * h // 4]
-    ctl._on_key(FakeCallback(coin.SoKeyboardEvent.C))
+    ctl.on_key(view, FakeCallback(coin.SoKeyboardEvent.C))
     ctl.mouse_point = mesh[3 * g // 4, h // 4]
-    ctl._on_key(FakeCallback(coin.SoKeyboardEvent.P))
-    ctl._on_key(FakeCallback(coin.SoKeyboardEvent.P))  # again: removes it
+    ctl.on_key(view, FakeCallback(coin.SoKeyboardEvent.P))
+    ctl.on_key(view, FakeCallback(coin.SoKeyboardEvent.P))  # again: removes it
     out["constraints"] = sorted(c["kind"] for c in surface.constraints)
     # the airbrush: switched on by the command, a left-button stroke across the view, one undo step
     Gui.runCommand("HapticSculpt_PaintStiffness")
@@ -91,11 +91,11 @@ try:
         e.setButton(coin.SoMouseButtonEvent.BUTTON1)
         e.setState(state)
         e.setPosition(coin.SbVec2s(x, y))
-        ctl._on_button(FakeMouse(e))
+        ctl.on_button(view, FakeMouse(e))
     def move(x, y):
         e = coin.SoLocation2Event()
         e.setPosition(coin.SbVec2s(x, y))
-        ctl._on_move(FakeMouse(e))
+        ctl.on_move(view, FakeMouse(e))
     w, hgt = view.getSize()
     undo_before = doc.UndoCount
     button(coin.SoButtonEvent.DOWN, w // 2 - 60, hgt // 2)
@@ -137,7 +137,7 @@ try:
     ctl.start_session(hs.ReplayDevice.stroke((-30, 0, 1), (30, 0, 1), seconds=0.6))
     out["session_airbrush"] = ctl.session.airbrush
     pump(1.5)
-    out["live_map"] = sorted(ctl.session.latest_maps)
+    out["live_map"] = [m for m in ("mass", "damping", "stiffness") if ctl.session.latest_map(m) is not None]
     ctl.stop_session()
     out["session_spray_undo"] = doc.UndoNames[:doc.UndoCount - undo_before]
     out["damping_values"] = int(np.asarray(obj.Proxy.surface.damping_map.values).size)
@@ -204,9 +204,9 @@ try:
     out["undo_after_panel"] = doc.UndoNames[0]
     Gui.runCommand("HapticSculpt_Combs")
     Gui.runCommand("HapticSculpt_Panel")
-    ctl._on_key(FakeCallback(coin.SoKeyboardEvent.M))
+    ctl.on_key(view, FakeCallback(coin.SoKeyboardEvent.M))
     out["m_key"] = ov.display
-    ctl._on_key(FakeCallback(coin.SoKeyboardEvent.M))
+    ctl.on_key(view, FakeCallback(coin.SoKeyboardEvent.M))
     out["m_key_back"] = ov.display
     out["timer_after_off"] = ov._timer is not None
     Gui.activateWorkbench("PartWorkbench")

@@ -24,8 +24,21 @@ def _sculpts(doc):
                     "plasticity": settings.get("plasticity"), "tool": settings.get("tool", {}).get("name"),
                     "stiffness_map": [min(o.StiffnessMap), max(o.StiffnessMap), len(o.StiffnessMap)],
                     "session": o.Proxy.live.session is not None if getattr(o.Proxy, "live", None) else False,
-                    "selected": o in Gui.Selection.getSelection()})
+                    "selected": o in Gui.Selection.getSelection(), "screen": _on_screen(o)})
     return out
+
+
+def _on_screen(o):
+    """Where the sculpt's centre and corners are in the active 3D view's viewport (its pixels)."""
+    try:
+        view = Gui.ActiveDocument.ActiveView
+        bb = o.Shape.BoundBox
+        pts = [FreeCAD.Vector(bb.Center.x, bb.Center.y, bb.ZMax)]
+        pts += [FreeCAD.Vector(bb.Center.x + fx * bb.XLength / 2, bb.Center.y + fy * bb.YLength / 2, bb.ZMax)
+                for fx, fy in ((0.5, 0), (-0.5, 0), (0, 0.5), (0, -0.5))]
+        return [list(view.getPointOnScreen(p)) for p in pts]
+    except Exception:  # noqa: BLE001 - no active 3D view
+        return []
 
 
 def _views():

@@ -1,0 +1,188 @@
+"""The workbench as a designer uses it: FreeCAD's real GUI under Xvfb driven by real X11 events
+(xdotool), with the workbench chosen before any document (the README's order: FreeCAD starts with
+it, as with Preferences > General > Autoload module). A small observer script inside FreeCAD only
+reads document state (tests/gui_input/observer.py); every action is a real key or mouse event.
+Screenshots go to build/screenshots/real_*.png."""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import time
+
+import numpy as np
+import pytest
+
+from freecad_support import ROOT
+
+SHOTS = os.path.join(ROOT, "build", "screenshots")
+TOOLBAR_Y = 122  # the HapticSculpt toolbar's row at 1280 x 1024 (FreeCAD 0.20's default layout)
+BUTTON = {"NewPatch": 30, "Session": 98, "PaintStiffness": 546}  # x of each button on that row
+STYLES = {"CAD": "Gui::CADNavigationStyle", "OpenInventor": "Gui::InventorNavigationStyle",
+          "Blender": "Gui::BlenderNavigationStyle", "Gesture": "Gui::GestureNavigationStyle"}
+NEEDS = [shutil.which(t) for t in ("Xvfb", "xdotool", "import", "freecad")]
+
+USER_CFG = """<?xml version="1.0" encoding="UTF-8" standalone="no" ?>
+<FCParameters><FCParamGroup Name="Root"><FCParamGroup Name="BaseApp"><FCParamGroup Name="Preferences">
+<FCParamGroup Name="General"><FCText Name="AutoloadModule">HapticSculptWorkbench</FCText></FCParamGroup>
+<FCParamGroup Name="View"><FCBool Name="UseNavigationAnimations" Value="0"/>
+<FCText Name="NavigationStyle">{style}</FCText></FCParamGroup>
+</FCParamGroup></FCParamGroup></FCParamGroup></FCParameters>
+"""
+
+
+class Desktop:
+    """Xvfb, FreeCAD with the observer, and real input through xdotool."""
+
+    def __init__(self, tmp: str, style: str) -> None:
+        self.tmp = tmp
+        home = os.path.join(tmp, "home")
+        os.makedirs(os.path.join(home, "Mod"))
+        os.symlink(ROOT, os.path.join(home, "Mod", "HapticSculpt"))
+        with open(os.path.join(home, "user.cfg"), "w") as f:
+            f.write(USER_CFG.format(style=STYLES[style]))
+        self.state_file = os.path.join(tmp, "state.json")
+        self.xvfb = subprocess.Popen(["Xvfb", "-displayfd", "1", "-screen", "0", "1280x1024x24", "-nolisten", "tcp"],
+                                     stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+        self.display = ":" + self.xvfb.stdout.readline().decode().strip()
+        self.env = dict(os.environ, DISPLAY=self.display, QTWEBENGINE_DISABLE_SANDBOX="1", FREECAD_USER_HOME=home,
+                        HS_OBSERVER_OUT=self.state_file)
+        self.log = open(os.path.join(tmp, "freecad.log"), "w")
+        self.freecad = subprocess.Popen(["freecad", os.path.join(ROOT, "tests", "gui_input", "observer.py")],
+                                        env=self.env, stdout=self.log, stderr=subprocess.STDOUT)
+        self.wait(lambda s: s.get("workbench") == "HapticSculptWorkbench", "FreeCAD starting on the workbench", 120)
+        window = self.xdo("search", "--name", "FreeCAD").split()[-1]
+        self.xdo("windowfocus", "--sync", window)
+
+    def close(self) -> None:
+        for p in (self.freecad, self.xvfb):
+            p.kill()
+            p.wait()
+        self.log.close()
+
+    def xdo(self, *args: str) -> str:
+        return subprocess.run(["xdotool", *args], env=self.env, check=True, capture_output=True, text=True).stdout
+
+    def state(self) -> dict:
+        try:
+            with open(self.state_file) as f:
+                return json.load(f)
+        except (OSError, ValueError):
+            return {}
+
+    def wait(self, condition, what: str, timeout: float = 20.0) -> dict:
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            s = self.state()
+            try:
+                if s and condition(s):
+                    return s
+            except (KeyError, IndexError):
+                pass
+            time.sleep(0.05)
+        raise AssertionError(f"timed out waiting for {what}; last state: {json.dumps(self.state())[:2000]}")
+
+    def shot(self, name: str) -> np.ndarray:
+        import matplotlib.image as mpimg
+        path = os.path.join(SHOTS, f"real_{name}.png")
+        subprocess.run(["import", "-window", "root", path], env=self.env, check=True)
+        return mpimg.imread(path)[..., :3]
+
+    def to_screen(self, viewport: list[float]) -> tuple[int, int]:
+        """Screen pixel of a 3D view's viewport pixel, calibrated from the view's own cursor reports."""
+        pts = []
+        for sx, sy in ((400, 400), (800, 600)):
+            self.xdo("mousemove", str(sx), str(sy))
+            s = self.wait(lambda s: s["views"] and abs(s["views"][0]["cursor"][0] - s["views"][0]["cursor"][0]) == 0 and
+                          s.get("mouse_point") is not None, "the view to see the mouse")
+            time.sleep(0.3)
+            s = self.state()
+            pts.append(((sx, sy), s["views"][0]["cursor"]))
+        (s0, v0), (s1, v1) = pts
+        fx = (s1[0] - s0[0]) / (v1[0] - v0[0])
+        fy = (s1[1] - s0[1]) / (v1[1] - v0[1])
+        return int(round(s0[0] + fx * (viewport[0] - v0[0]))), int(round(s0[1] + fy * (viewport[1] - v0[1])))
+
+
+def sculpt(s: dict) -> dict:
+    return s["docs"][s["active"]]["sculpts"][0]
+
+
+def undo(s: dict) -> list[str]:
+    return s["docs"][s["active"]]["undo"]
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+@pytest.mark.parametrize("style", ["CAD", "Gesture"])  # OpenInventor, Blender: issue 13, open
+def test_workbench_first_keys_stroke_undo_redo_paint(tmp_path, style):
+    os.makedirs(SHOTS, exist_ok=True)
+    d = Desktop(str(tmp_path), style)
+    try:
+        d.xdo("mousemove", "640", "500")
+        d.xdo("key", "ctrl+n")  # a new document after the workbench was chosen
+        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
+        d.xdo("mousemove", str(BUTTON["NewPatch"]), str(TOOLBAR_Y), "click", "1")
+        s = d.wait(lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        assert sculpt(s)["plasticity"][0], "a GUI patch is clay"
+        centre, east, west, north, south = [d.to_screen(p) for p in sculpt(s)["screen"]]
+        # keys at the mouse: P at one point, N at another, C at a third, M shows the map
+        for key, at, kind in (("p", east, "point"), ("n", west, "normal"), ("c", north, "curvature")):
+            d.xdo("mousemove", str(at[0]), str(at[1]))
+            d.wait(lambda s: s["mouse_point"] is not None, "the mouse over the patch")
+            time.sleep(0.2)
+            d.xdo("key", key)
+            d.wait(lambda s: kind in [c[0] for c in sculpt(s)["constraints"]], f"{key.upper()}: a {kind} constraint")
+        d.xdo("key", "m")
+        d.wait(lambda s: any(o["display"] == "mass" for o in s["overlays"]), "M: the map display")
+        d.xdo("key", "m")
+        d.wait(lambda s: all(o["display"] == "shading" for o in s["overlays"]), "M again: shading")
+        assert undo(d.state())[:3] == ["Add curvature constraint", "Add normal constraint", "Add point constraint"]
+        # a mouse session: a left drag pulls the rope, in every navigation style (the view does not turn)
+        d.xdo("mousemove", str(BUTTON["Session"]), str(TOOLBAR_Y), "click", "1")
+        d.wait(lambda s: sculpt(s)["session"], "the session")
+        d.xdo("mousemove", str(south[0]), str(south[1]))
+        time.sleep(0.3)
+        d.xdo("mousedown", "1")
+        for k in range(1, 16):
+            d.xdo("mousemove", str(south[0]), str(south[1] - 10 * k))
+            time.sleep(0.04)
+        time.sleep(0.8)
+        d.xdo("mouseup", "1")
+        s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke's undo step")
+        stroke_poles = np.array(sculpt(s)["poles"])
+        lifted = np.abs(stroke_poles.reshape(-1, 3)[:, 2]).max()
+        assert lifted > 5.0, f"the rope did not pull ({lifted} mm) in {style}"
+        time.sleep(2.0)
+        after = np.abs(np.array(sculpt(d.state())["shape_poles"])[:, 2]).max()
+        assert after > 0.7 * lifted, f"the stroke sprang back: {lifted} -> {after} mm"
+        pulled = d.shot(f"{style}_stroke")
+        # ctrl+z: the view shows the shape before the stroke at once, the session keeps running
+        d.xdo("key", "ctrl+z")
+        s = d.wait(lambda s: undo(s)[0] == "Add curvature constraint" and
+                   np.abs(np.array(sculpt(s)["shape_poles"])[:, 2]).max() < 1e-9, "Undo to show")
+        assert sculpt(s)["session"]
+        undone = d.shot(f"{style}_undone")
+        assert np.mean(np.abs(pulled - undone) > 0.1) > 1e-3, "Undo did not change the picture"
+        d.xdo("key", "ctrl+shift+z")
+        s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "Redo")
+        assert np.array_equal(np.array(sculpt(s)["poles"]), stroke_poles), "Redo must restore the exact poles"
+        d.wait(lambda s: np.abs(np.array(sculpt(s)["shape_poles"])[:, 2]).max() > 0.5 * lifted, "Redo to show")
+        d.xdo("mousemove", str(BUTTON["Session"]), str(TOOLBAR_Y), "click", "1")
+        d.wait(lambda s: not sculpt(s)["session"], "the session to stop")
+        # the airbrush: a fast drag paints a continuous line, one undo step
+        d.xdo("mousemove", str(BUTTON["PaintStiffness"]), str(TOOLBAR_Y), "click", "1")
+        d.wait(lambda s: s["painting"] == "stiffness", "the airbrush")
+        d.xdo("mousemove", str(west[0]), str(west[1]))
+        time.sleep(0.3)
+        before = undo(d.state())[0]
+        d.xdo("mousedown", "1")
+        d.xdo("mousemove", str((west[0] + centre[0]) // 2), str((west[1] + centre[1]) // 2))
+        d.xdo("mousemove", str(east[0]), str(east[1]))
+        d.xdo("mouseup", "1")
+        s = d.wait(lambda s: undo(s)[0] == "Paint stiffness", f"one paint step (was {before})")
+        lo, hi, n = sculpt(s)["stiffness_map"]
+        assert n > 1 and hi > 2 * lo
+        assert undo(s)[1] == before
+    finally:
+        d.close()
