@@ -11,10 +11,12 @@ surface (or the view's focal plane off it), so constraints and paint dabs go to 
 nearest the mouse. Keys as in paper section 5: P, N, C toggle a point, normal or curvature
 constraint at the nearest point; M switches between shading and the map display.
 
-The left button: while the airbrush is on (without a session) or a mouse session runs, the left
-button belongs to the workbench in every navigation style, so events reach the scene graph before
-the navigation style (FreeCAD's redirect-to-scene-graph), and what the workbench does not take
-(middle and right buttons, the wheel) still navigates. Airbrush strokes lay dabs along the whole
+Events first: FreeCAD's navigation styles decide which events reach the scene graph, where the
+workbench listens, and some (OpenInventor) pass none but selection gestures. So while the
+workbench is active its views send events to the scene graph first (FreeCAD's redirect, as its
+Esc toggle does), and what nobody there takes goes on to the navigation style: the wheel, the
+middle and right buttons, and a left drag that starts off every object still navigate. While the
+airbrush is on (without a session) or a mouse session runs, the left button belongs to the workbench. Airbrush strokes lay dabs along the whole
 mouse path, however fast it moves, and each stroke is one undo step. With a session the device's
 button sprays instead (Session.set_airbrush).
 """
@@ -57,8 +59,8 @@ class ViewInput:
         except Exception:  # noqa: BLE001 - a closed view raises on any access
             return False
 
-    def take_left_button(self, take: bool) -> None:
-        """Events to the scene graph first (the workbench takes the left button), or back to normal."""
+    def events_first(self, take: bool) -> None:
+        """Events to the scene graph before the navigation style (see the module docstring), or back."""
         try:
             viewer = self.view.getViewer()
             if bool(viewer.isRedirectedToSceneGraph()) != take:
@@ -67,7 +69,7 @@ class ViewInput:
             pass
 
     def remove(self) -> None:
-        self.take_left_button(False)
+        self.events_first(False)
         for event, handle in self._callbacks:
             try:
                 self.view.removeEventCallbackPivy(event.getClassTypeId(), handle)
@@ -129,18 +131,16 @@ class Controller:
 
     def sync_views(self) -> None:
         """Attaches to views that opened and forgets closed ones."""
-        self.inputs = [i for i in self.inputs if i.alive() or i.remove()]
+        for closed in [i for i in self.inputs if not i.alive()]:
+            closed.remove()
+            self.inputs.remove(closed)
         for key in [k for k, ov in self.overlays.items() if not ov.alive()]:
             self.overlays.pop(key).remove()
         for view in all_3d_views():
             if not any(i.view is view for i in self.inputs):
                 self.inputs.append(ViewInput(self, view))
-        self._update_left_button()
-
-    def _update_left_button(self) -> None:
-        take = self.painting is not None or self.mouse is not None
         for i in self.inputs:
-            i.take_left_button(take)
+            i.events_first(True)  # (each time: FreeCAD's Esc toggles it)
 
     @staticmethod
     def active_view() -> Any:
@@ -269,7 +269,6 @@ class Controller:
             self.session.set_airbrush(self.painting, factor=AIRBRUSH_FACTOR)
         if self.painting is not None:
             self.set_display(self.painting)
-        self._update_left_button()
         return self.painting
 
     def begin_paint_stroke(self) -> None:
@@ -390,13 +389,12 @@ class Controller:
         session = Session()
         session.set_airbrush(self.painting, factor=AIRBRUSH_FACTOR)  # before the first tick can grab
         self.session = session.start(obj, device, tool=obj.Proxy.live.snapshot().tool.name)
-        self._update_left_button()
         self.refresh(obj)
         return self.session
 
     def stop_session(self) -> None:
         if self.session is not None:
-            obj = self.session_object()
+            obj = self.session.obj
             self.session.stop()
             self.session = None
             if obj is not None:
@@ -404,16 +402,15 @@ class Controller:
         if self.mouse is not None:
             self.mouse.detach()
             self.mouse = None
-        self._update_left_button()
-
-    def session_object(self) -> Any:
-        return getattr(self.session, "obj", None)
 
     def refresh(self, obj: Any | None = None) -> None:
+        """Redraws the sculpt's overlays (making the one in the current view if there is none yet)."""
         obj = obj or self.active_sculpt()
         if obj is None:
             return
-        for ov in self.overlays_of(obj) or [o for o in [self.overlay(obj)] if o is not None]:
+        if not self.overlays_of(obj):
+            self.overlay(obj)
+        for ov in self.overlays_of(obj):
             ov.refresh()
 
     def refresh_all(self) -> None:

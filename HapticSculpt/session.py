@@ -223,20 +223,21 @@ class Session:
         n = 0
         live = obj.Proxy.live
         while (event := runtime.take_stroke()) is not None:
-            live.reset_shape()  # (the transaction records the stored face as what Undo goes back to)
             if event["edit"] is not None:
                 title, state = self._edits.pop(event["edit"], ("", None))
-                if state is not None:
-                    with transaction(obj.Document, title):
-                        live.write(_with_event(state, event))
-                        obj.purgeTouched()
-                continue
-            painted = event["painted"]
-            with transaction(obj.Document, f"Paint {painted}" if painted else "Sculpt stroke"):
-                live.write(_with_event(read_state(obj), event))
-                obj.Strokes = obj.Strokes + 1
+                if state is None:
+                    continue  # an Undo or Redo the session took up: the document holds that state already
+                strokes = 0
+            else:
+                title = f"Paint {event['painted']}" if event["painted"] else "Sculpt stroke"
+                state, strokes = read_state(obj), 1
+            live.reset_shape()  # (so the transaction records the stored face as what Undo goes back to)
+            with transaction(obj.Document, title):
+                live.write(_with_event(state, event))
+                if strokes:
+                    obj.Strokes = obj.Strokes + strokes
                 obj.purgeTouched()
-            n += 1
+            n += strokes
         return n
 
     def _commit_final(self, obj: Any) -> None:

@@ -61,7 +61,7 @@ AirbrushSettings airbrushSettings(const py::object& map, double radius, double f
     if (!map.is_none()) {
         if (!py::isinstance<py::str>(map)) throw std::invalid_argument("map: one of 'mass', 'damping', 'stiffness', or None (off)");
         const std::string name = py::cast<std::string>(map);
-        for (auto m : {AirbrushSettings::Map::Mass, AirbrushSettings::Map::Damping, AirbrushSettings::Map::Stiffness})
+        for (auto m : kMaps)
             if (name == mapName(m)) a.map = m;
         if (a.map == AirbrushSettings::Map::Off)
             throw std::invalid_argument("map: one of 'mass', 'damping', 'stiffness', or None (off)");
@@ -338,13 +338,11 @@ void bindRuntime(py::module_& m) {
             d["painted"] = s.painted == AirbrushSettings::Map::Off ? py::object(py::none()) : py::str(mapName(s.painted));
             d["edit"] = s.edit == 0 ? py::object(py::none()) : py::int_(s.edit);
             py::dict maps;
-            const AirbrushSettings::Map all[3] = {AirbrushSettings::Map::Mass, AirbrushSettings::Map::Damping,
-                                                  AirbrushSettings::Map::Stiffness};
-            for (int k = 0; k < 3; ++k) {
-                if (s.edit == 0 && all[k] != s.painted) continue;
+            for (size_t k = 0; k < kMaps.size(); ++k) {
+                if (s.edit == 0 && kMaps[k] != s.painted) continue;
                 py::array_t<double> values({s.maps[k].rows, s.maps[k].cols});
                 std::copy(s.maps[k].values.data(), s.maps[k].values.data() + s.maps[k].values.size(), values.mutable_data());
-                maps[mapName(all[k])] = values;
+                maps[mapName(kMaps[k])] = values;
             }
             d["maps"] = maps;
             return d;

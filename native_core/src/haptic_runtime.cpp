@@ -176,11 +176,9 @@ void HapticRuntime::pushStroke(double simTime, AirbrushSettings::Map painted, st
         s.painted = painted;
         s.edit = edit;
         // (copying a map allocates only when its size changed: at a spray's end or an edit, not a step)
-        const AirbrushSettings::Map all[3] = {AirbrushSettings::Map::Mass, AirbrushSettings::Map::Damping,
-                                              AirbrushSettings::Map::Stiffness};
-        for (int k = 0; k < 3; ++k) {
-            if (edit == 0 && all[k] != painted) continue;
-            const MaterialMap& m = mapOf(all[k]);
+        for (size_t k = 0; k < kMaps.size(); ++k) {
+            if (edit == 0 && kMaps[k] != painted) continue;
+            const MaterialMap& m = mapOf(kMaps[k]);
             s.maps[k].rows = m.rows();
             s.maps[k].cols = m.cols();
             s.maps[k].values = m.values();

@@ -83,6 +83,9 @@ struct AirbrushSettings {
     void validate() const;
 };
 const char* mapName(AirbrushSettings::Map map);  ///< "mass", "damping", "stiffness" ("" when off)
+/// The three maps, in the order of StrokeSnapshot::maps.
+constexpr std::array<AirbrushSettings::Map, 3> kMaps = {AirbrushSettings::Map::Mass, AirbrushSettings::Map::Damping,
+                                                        AirbrushSettings::Map::Stiffness};
 
 /// A material map's values as a snapshot carries them.
 struct MapSnapshot {
@@ -114,7 +117,7 @@ struct StrokeSnapshot {
     std::vector<double> restLengths;
     AirbrushSettings::Map painted = AirbrushSettings::Map::Off;
     std::uint64_t edit = 0;
-    std::array<MapSnapshot, 3> maps;  ///< mass, damping, stiffness (those carried)
+    std::array<MapSnapshot, 3> maps;  ///< in kMaps order (those carried)
 };
 
 /// The map a spray is painting, as the GUI shows it while the spray goes on.

@@ -48,6 +48,7 @@ def _views():
         for v in gdoc.mdiViewsOfType("Gui::View3DInventor") if gdoc else []:
             try:
                 out.append({"doc": name, "size": list(v.getSize()), "cursor": list(v.getCursorPos()),
+                            "camera": v.getCamera(),
                             "active": v is getattr(Gui.ActiveDocument, "ActiveView", None),
                             "redirect": bool(v.getViewer().isRedirectedToSceneGraph())})
             except Exception:  # noqa: BLE001 - a view closing
