@@ -33,6 +33,13 @@ _SHAPE_ARRAYS = ("Poles", "KnotsU", "KnotsV", "Weights")
 class SessionLink(Protocol):
     """What a running session offers the live surface (implemented by the runtime layer)."""
 
+    @property
+    def running(self) -> bool:
+        """False once its loops ended (by stop() or by themselves)."""
+
+    def stop(self, commit: bool = True) -> Any:
+        """Ends the session and hands the surface back (see LiveSurface.detach)."""
+
     def post_edit(self, prepared: core.DynamicSurface | None, title: str, restore: bool, keep_maps: bool,
                   keep_shape: bool, commit: bool) -> None:
         """Queues an edit for the simulation thread; commits it as ``title`` when it applied."""

@@ -59,7 +59,9 @@ class Session:
         native = native_device(device)
         live = obj.Proxy.live
         if live.session is not None:
-            raise RuntimeError(f"obj: {obj.Label} is already being sculpted by another session")
+            if live.session.running:
+                raise RuntimeError(f"obj: {obj.Label} is already being sculpted by another session")
+            live.session.stop()  # its loops ended by themselves (a replay played out): commit and let go
         surface = live.surface
         if surface.tool.name != tool:
             surface.set_tool(tool)
