@@ -40,9 +40,10 @@ class SessionLink(Protocol):
     def stop(self, commit: bool = True) -> Any:
         """Ends the session and hands the surface back (see LiveSurface.detach)."""
 
-    def post_edit(self, prepared: core.DynamicSurface | None, title: str, restore: bool, keep_maps: bool,
-                  keep_shape: bool, commit: bool) -> None:
-        """Queues an edit for the simulation thread; commits it as ``title`` when it applied."""
+    def post_edit(self, prepared: core.DynamicSurface, state: sculpt_state.SculptState | None, title: str,
+                  restore: bool, keep_maps: bool, keep_shape: bool) -> None:
+        """Queues an edit for the simulation thread; when it applied, commits ``state`` (the
+        configuration it leaves) as ``title`` with the motion it took over (not if ``state`` is None)."""
 
     def latest_poles(self) -> np.ndarray | None:
         """The newest pole snapshot ((nu*nv, 3)) the session published, None before the first."""
@@ -61,6 +62,9 @@ class LiveSurface:
         self._session: SessionLink | None = None
         self._shadow: core.DynamicSurface | None = None  # reads while a session runs
         self._shadow_stale = True
+        # During a session: the configuration the last edit left, which the next one builds on (its
+        # commit may not have reached the document yet); None: the document's.
+        self._head: sculpt_state.SculptState | None = None
         #: True while this object writes the document properties (their change is no news then)
         self.writing = False
 
@@ -78,6 +82,7 @@ class LiveSurface:
         surface.set_velocities(np.zeros_like(np.asarray(surface.velocities)))  # a session starts from rest
         self._session = session
         self._shadow_stale = True
+        self._head = None
         return surface
 
     def detach(self, surface: core.DynamicSurface) -> None:
@@ -85,6 +90,7 @@ class LiveSurface:
         self._session = None
         self._surface = surface
         self._stale = False
+        self._head = None
 
     # --- reads ------------------------------------------------------------------------------------
     @property
@@ -107,7 +113,7 @@ class LiveSurface:
         if self._session is None:
             return self.surface
         if self._shadow is None or self._shadow_stale:
-            self._shadow = self._from_document()
+            self._shadow = self._configured()
             self._shadow_stale = False
         poles = self._session.latest_poles()
         if poles is not None:
@@ -138,7 +144,7 @@ class LiveSurface:
                 surface.relax()
             self.commit(title)
             return result
-        prepared = self._from_document()
+        prepared = self._configured()
         poles = self._session.latest_poles()
         if poles is not None:
             prepared.set_poles(np.asarray(poles, float).reshape(np.asarray(prepared.poles).shape))
@@ -146,7 +152,9 @@ class LiveSurface:
         result = change(prepared)
         after = _maps(prepared)
         keep_maps = all(np.array_equal(before[k], after[k]) for k in before)
-        self._session.post_edit(prepared, title, restore=False, keep_maps=keep_maps, keep_shape=keep_shape, commit=True)
+        head = sculpt_state.capture(prepared)  # (before the simulation thread owns it)
+        self._session.post_edit(prepared, head, title, restore=False, keep_maps=keep_maps, keep_shape=keep_shape)
+        self._head = head
         self._shadow_stale = True
         return result
 
@@ -199,6 +207,7 @@ class LiveSurface:
         undo step); otherwise the cache is rebuilt on the next read."""
         self._stale = True
         self._shadow_stale = True
+        self._head = None
 
     def restore_into_session(self) -> None:
         """Hands the document's state (after Undo or Redo) to the running session, at rest."""
@@ -206,9 +215,13 @@ class LiveSurface:
             return
         restored = self._from_document()
         restored.set_velocities(np.zeros_like(np.asarray(restored.velocities)))
-        self._session.post_edit(restored, "", restore=True, keep_maps=False, keep_shape=False, commit=False)
+        self._session.post_edit(restored, None, "", restore=True, keep_maps=False, keep_shape=False)
 
     # --- helpers ----------------------------------------------------------------------------------
+    def _configured(self) -> core.DynamicSurface:
+        """A new surface configured as the last edit left it (the document's, before any)."""
+        return sculpt_state.restore(self._head) if self._head is not None else self._from_document()
+
     def _from_document(self) -> core.DynamicSurface:
         obj = self._obj
         try:

@@ -41,7 +41,11 @@ class Session:
         self._latest_poles: np.ndarray | None = None  # the newest pole snapshot the GUI received
         self._latest_maps: dict[str, np.ndarray] = {}  # the newest snapshot of each map sprayed this run
         self._next_edit = 1
-        self._edits: dict[int, tuple[str, sculpt_state.SculptState | None]] = {}  # posted, not yet applied
+        self._edits: dict[int, tuple[str, sculpt_state.SculptState | None, int]] = {}  # posted, not yet applied
+        #: each edit the simulation applied this run: its title, the simulation steps taken when it
+        #: was posted and when it applied (it applies between two steps, so these differ by 0 to 2),
+        #: and the simulated time it applied at (s since the start)
+        self.applied_edits: list[dict[str, Any]] = []
 
     # --- life cycle -------------------------------------------------------------------------------
     def start(self, obj: Any, device: Any, tool: str = "rope", haptic_rate: float = 1000.0,
@@ -70,7 +74,7 @@ class Session:
                                       stop_when_finished=stop_when_finished, realtime=realtime)
         live.attach(self)  # from here on the runtime steps the surface, starting at rest
         self._runtime, self._obj, self._device, self._error = runtime, obj, native, ""
-        self._latest_poles, self._latest_maps, self._edits = None, {}, {}
+        self._latest_poles, self._latest_maps, self._edits, self.applied_edits = None, {}, {}, []
         runtime.set_airbrush(**self._airbrush)
         runtime.start()
         _ACTIVE.add(self)
@@ -103,22 +107,23 @@ class Session:
         return status
 
     # --- the live surface's link (see live_surface.SessionLink) -------------------------------------
-    def post_edit(self, prepared: Any, title: str, restore: bool, keep_maps: bool, keep_shape: bool,
-                  commit: bool) -> None:
+    def post_edit(self, prepared: Any, state: sculpt_state.SculptState | None, title: str, restore: bool,
+                  keep_maps: bool, keep_shape: bool) -> None:
         """Queues an edit for the simulation thread (called by ``obj.Proxy.live``); when it has
-        applied, :meth:`poll` commits it as ``title`` with the state it produced (unless not
-        ``commit``: an Undo or Redo restoring the document's own state)."""
+        applied, :meth:`poll` commits ``state`` as ``title`` with the motion it took over (not for
+        None: an Undo or Redo restoring the document's own state)."""
         if self._runtime is None:
             raise RuntimeError("session: not running")
         edit_id = self._next_edit
         self._next_edit += 1
-        # The configuration the edit leaves, read before the simulation thread owns the surface.
-        self._edits[edit_id] = (title, sculpt_state.capture(prepared) if commit else None)
+        self._edits[edit_id] = (title, state, 0)
         try:
-            self._runtime.post_edit(edit_id, prepared, restore=restore, keep_maps=keep_maps, keep_shape=keep_shape)
+            posted = self._runtime.post_edit(edit_id, prepared, restore=restore, keep_maps=keep_maps,
+                                             keep_shape=keep_shape)
         except BaseException:
             del self._edits[edit_id]
             raise
+        self._edits[edit_id] = (title, state, int(posted))
 
     def latest_poles(self) -> np.ndarray | None:
         """The newest pole snapshot ((nu*nv, 3)) the GUI received, None before the first."""
@@ -204,6 +209,15 @@ class Session:
             raise RuntimeError("session: nothing recorded (start it with record_seconds > 0)")
         return ReplayDevice(ticks["t"], ticks["position"], ticks["orientation"], ticks["buttons"].astype(np.int64))
 
+    def rendered_forces(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each logged haptic tick's time (s since the start) and the force sent to the device
+        ((n, 3)); needs ``record_seconds``."""
+        runtime = self._runtime or getattr(self, "_last_runtime", None)
+        if runtime is None or runtime.running:
+            raise RuntimeError("session: stop it before analysing it")
+        ticks = runtime.ticks()
+        return np.asarray(ticks["t"]), np.asarray(ticks["rendered_force"])
+
     def force_errors(self, floor: float = 0.05) -> np.ndarray:
         """Relative error of each logged haptic force against the exact surface (see the core)."""
         runtime = self._runtime or getattr(self, "_last_runtime", None)
@@ -226,7 +240,9 @@ class Session:
         live = obj.Proxy.live
         while (event := runtime.take_stroke()) is not None:
             if event["edit"] is not None:
-                title, state = self._edits.pop(event["edit"], ("", None))
+                title, state, posted = self._edits.pop(event["edit"], ("", None, 0))
+                self.applied_edits.append({"title": title or "restore", "posted_step": posted,
+                                           "applied_step": int(event["step"]), "time": float(event["time"])})
                 if state is None:
                     continue  # an Undo or Redo the session took up: the document holds that state already
                 strokes = 0

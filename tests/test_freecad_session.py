@@ -150,3 +150,67 @@ class TestSession(DocumentTestCase):
             hs.Session().start(obj, two_strokes(), haptic_rate=50000)
         with self.assertRaisesRegex(TypeError, "obj"):
             hs.Session().start(self.doc, two_strokes())
+
+
+class TestEditsDuringASession(DocumentTestCase):
+    """Edits reach a running session through its edit queue: no stop, no restart, the rope held."""
+
+    def test_slider_constraint_paint_and_tool_apply_within_two_steps_and_keep_the_force(self):
+        obj = hs.make_sculpt(self.doc, material="clay")
+        live = obj.Proxy.live
+        hold = hs.ReplayDevice.stroke((0, 0, 0), (0, 0, 20.0), seconds=0.5, hold=30.0)
+        session = hs.Session().start(obj, hold, record_seconds=20.0)
+        try:
+            end = time.monotonic() + 20
+            while np.linalg.norm(session.status()["force"]) < 1.0 or session.status()["elapsed"] < 1.0:
+                self.assertLess(time.monotonic(), end, "the rope never pulled")
+                time.sleep(0.01)
+            undo_before = self.doc.UndoCount
+            t_first = session.status()["elapsed"]
+            live.edit(lambda s: s.stiffness_map.set_uniform(150.0), "Set stiffness")  # the slider's edit
+            cid = hs.add_constraint(obj, "point", uv=(0.0, 0.0))
+            live.edit(lambda s: s.stiffness_map.dab((0.8, 0.8), 0.1, 300.0, "spherical", 0.5), "Paint stiffness")
+            hs.keep_shape(obj)
+            time.sleep(0.3)
+            t_last = session.status()["elapsed"]
+            live.edit(lambda s: s.set_tool("magnet"), "Tool: magnet")  # a new tool lets go of the rope
+            while len(session.applied_edits) < 5:
+                self.assertLess(time.monotonic(), end, "the edits never applied")
+                session.poll()
+                time.sleep(0.01)
+            self.assertTrue(session.running)
+        finally:
+            session.stop()
+        applied = session.applied_edits
+        self.assertEqual([e["title"] for e in applied],
+                         ["Set stiffness", "Add point constraint", "Paint stiffness", "Keep shape", "Tool: magnet"])
+        for e in applied:  # taken up between two steps
+            self.assertLessEqual(e["applied_step"] - e["posted_step"], 2, e)
+        names = self.doc.UndoNames[:self.doc.UndoCount - undo_before]
+        for title in ("Set stiffness", "Add point constraint", "Paint stiffness", "Keep shape", "Tool: magnet"):
+            self.assertEqual(names.count(title), 1, names)
+        self.assertNotIn("Sculpt session end", names[names.index("Tool: magnet"):])  # no stop/restart in between
+        # the state each produced is in the document
+        surface = obj.Proxy.surface
+        self.assertEqual(surface.tool.name, "magnet")
+        self.assertIn(cid, [c["id"] for c in surface.constraints])
+        self.assertGreater(float(np.max(surface.stiffness_map.values)), 150.0)
+        # the rendered force never dropped out over the material, constraint, paint and keep-shape edits:
+        # no step down where one applied (the stiffer material and the kept shape ease the pull
+        # over the following second, as the surface follows the rope)
+        t, force = session.rendered_forces()
+        magnitude = np.linalg.norm(force, axis=1)
+        held = magnitude[(t > t_first - 0.2) & (t < t_first)].mean()
+        self.assertGreater(magnitude[(t >= t_first) & (t <= t_last)].min(), 0.2 * held)
+        for e in applied[:4]:
+            before = magnitude[(t > e["time"] - 0.02) & (t < e["time"])].mean()
+            after = magnitude[(t >= e["time"]) & (t < e["time"] + 0.02)].min()
+            self.assertGreater(after, 0.9 * before, e)
+        # undo steps back one edit at a time (past the session's end: the surface moved on after the last)
+        while self.doc.UndoNames[0] != "Tool: magnet":
+            self.doc.undo()
+        self.doc.undo()
+        self.assertEqual(obj.Proxy.surface.tool.name, "rope")
+        self.doc.undo()  # keep shape
+        self.doc.undo()  # the paint
+        self.assertEqual(float(np.max(obj.Proxy.surface.stiffness_map.values)), 150.0)

@@ -332,6 +332,7 @@ void bindRuntime(py::module_& m) {
             if (!r.takeStroke(s)) return py::none();
             py::dict d;
             d["time"] = s.time;
+            d["step"] = s.step;
             d["poles"] = py::cast(s.poles);
             d["velocities"] = py::cast(s.velocities);
             d["rest_lengths"] = py::cast(s.restLengths);
@@ -346,8 +347,8 @@ void bindRuntime(py::module_& m) {
             }
             d["maps"] = maps;
             return d;
-        }, "The oldest uncollected event, else None: a stroke's end, a spray's end or an applied edit, each with the "
-           "poles, velocities and rest lengths it left. 'painted' names a spray's map, 'edit' an edit's id; 'maps' "
+        }, "The oldest uncollected event, else None: a stroke's end, a spray's end or an applied edit, each with its "
+           "simulation time and step count and the poles, velocities and rest lengths it left. 'painted' names a spray's map, 'edit' an edit's id; 'maps' "
            "holds the maps it carries ((rows, cols) arrays by name: the painted one, or all three after an edit).")
         .def("post_edit", [](HapticRuntime& r, std::uint64_t id, std::shared_ptr<DynamicSurface> next, bool restore,
                              bool keepMaps, bool keepShape) {
@@ -358,13 +359,13 @@ void bindRuntime(py::module_& m) {
             e.keepMaps = keepMaps;
             e.keepShape = keepShape;
             py::gil_scoped_release release;  // preparing `next` factors its system
-            r.postEdit(std::move(e));
+            return r.postEdit(std::move(e));
         }, py::arg("id"), py::arg("next") = nullptr, py::arg("restore") = false, py::arg("keep_maps") = true,
            py::arg("keep_shape") = false,
            "Queues an edit for the simulation thread to take up between two steps: `next` (a configured surface of the "
            "same sampling; None: none) continues from the live surface's motion, or with restore=True replaces it as "
            "it is; keep_maps carries the live maps over; keep_shape then makes the current shape the rest shape. Its "
-           "event (take_stroke, 'edit' = id) follows.")
+           "event (take_stroke, 'edit' = id) follows. Returns the simulation steps taken when it was queued.")
         .def_property_readonly("surface", [](const HapticRuntime& r) {
             if (!r.joined()) throw std::runtime_error("session: the simulation owns its surface until stop()");
             return r.surface();

@@ -91,7 +91,7 @@ void HapticRuntime::setAirbrush(const AirbrushSettings& a) {
     airbrushChanged_.store(true, std::memory_order_release);
 }
 
-void HapticRuntime::postEdit(SurfaceEdit edit) {
+std::uint64_t HapticRuntime::postEdit(SurfaceEdit edit) {
     if (edit.id == 0) throw std::invalid_argument("edit: id must be > 0");
     if (edit.next) {
         if (edit.next.get() == liveSurface_.load(std::memory_order_acquire) || edit.next->g() != sampling_[0] ||
@@ -102,6 +102,7 @@ void HapticRuntime::postEdit(SurfaceEdit edit) {
     std::lock_guard<std::mutex> lock(editMutex_);
     editsPending_.push_back(std::move(edit));
     editsQueued_.store(true, std::memory_order_release);
+    return simSteps_.load(std::memory_order_relaxed);
 }
 
 bool HapticRuntime::takeEdits(double simTime) {
@@ -169,6 +170,7 @@ void HapticRuntime::pushStroke(double simTime, AirbrushSettings::Map painted, st
     if (head - strokeTail_.load(std::memory_order_acquire) < kStrokeSlots) {
         StrokeSnapshot& s = strokes_[head % kStrokeSlots];
         s.time = simTime;
+        s.step = simSteps_.load(std::memory_order_relaxed);
         s.poles = surface_->poles();
         s.velocities = surface_->velocities();
         const auto& rest = static_cast<const DynamicSurface&>(*surface_).springs().rest();

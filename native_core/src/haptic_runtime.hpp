@@ -113,6 +113,7 @@ struct SurfaceEdit {
 /// (`edit` > 0) carries all three maps.
 struct StrokeSnapshot {
     double time = 0;
+    std::uint64_t step = 0;  ///< simulation steps taken when it happened
     Points poles, velocities;
     std::vector<double> restLengths;
     AirbrushSettings::Map painted = AirbrushSettings::Map::Off;
@@ -154,8 +155,9 @@ public:
     /// Queues an edit (any thread; see SurfaceEdit): its surface is prepared for the session's
     /// step here, the simulation thread swaps it in between two steps and reports it as an event
     /// (takeStroke, `edit` = its id). The haptic thread never sees the queue. Throws
-    /// std::invalid_argument for an edit that cannot apply (another sampling, id 0).
-    void postEdit(SurfaceEdit edit);
+    /// std::invalid_argument for an edit that cannot apply (another sampling, id 0). Returns the
+    /// simulation steps taken when it entered the queue.
+    std::uint64_t postEdit(SurfaceEdit edit);
     /// The surface the simulation steps (it changes with each edit); read its state only while
     /// stopped.
     std::shared_ptr<DynamicSurface> surface() const { return surface_; }
