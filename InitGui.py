@@ -16,8 +16,9 @@ class HapticSculptWorkbench(Gui.Workbench):
                                            "HapticSculpt.svg")
 
     def Initialize(self):
+        import HapticSculptGui
         from HapticSculpt import commands
-        commands.register()
+        HapticSculptGui.register()
         self.appendToolbar("HapticSculpt", commands.TOOLBAR)
         self.appendMenu("HapticSculpt", commands.TOOLBAR)
 

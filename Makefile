@@ -10,7 +10,7 @@ SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
 PHONY_LONG := stress fuzz bench-peers
-.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-cpp test-asan test-python test-freecad ocp-venv demo bench install install-udev uninstall clean
+.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-gui-repeat test-cpp test-asan test-python test-freecad ocp-venv demo bench install install-udev uninstall clean
 # A private FreeCAD user folder whose Mod/HapticSculpt links this checkout (tests, demo render).
 FC_HOME     := $(BUILD)/freecad-home
 # cadquery (with its own OCCT, OCP) in its own virtual environment: its numpy must not shadow Debian's.
@@ -74,6 +74,15 @@ test-freecad: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
 	  freecadcmd -t TestHapticSculpt
 
 test: test-cpp test-asan test-tsan test-python test-freecad
+
+# The GUI and runtime tests GUI_REPEAT times in a row (a test that fails one run in three fails CI).
+GUI_REPEAT ?= 10
+test-gui-repeat: build ocp-venv
+	set -eo pipefail; for i in $$(seq $(GUI_REPEAT)); do echo "== run $$i of $(GUI_REPEAT)"; \
+	  ctest --test-dir $(BUILD)/release --output-on-failure -R "HapticRuntime" | tail -1; \
+	  HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) -m pytest -q -p no:cacheprovider \
+	    tests/test_gui_real_input.py tests/test_gui_overlay.py tests/test_gui_workbench.py tests/test_freecad_session.py | tail -1; \
+	done
 
 # libFuzzer on the HID parsers (clang; FUZZ_SECONDS per harness), seeded with the recorded
 # fixtures' descriptors and reports. A crash or sanitizer report fails the target and leaves the

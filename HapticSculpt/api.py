@@ -161,6 +161,85 @@ def keep_shape(obj: Any) -> None:
     obj.Proxy.live.edit(lambda s: None, "Keep shape", keep_shape=True)
 
 
+def set_tool(obj: Any, tool: str, falloff: str | None = None) -> None:
+    """Selects the sculpting tool ("rope", "magnet", "orientation", "smooth"); ``falloff`` sets the
+    magnet's or smooth tool's ("constant", "spherical", "cylindrical", "conical"). One undo step; a
+    running session takes it at once."""
+    _sculpt(obj)
+    if tool not in core.TOOLS:
+        raise ValueError(f"tool: unknown tool {tool!r} (one of {', '.join(core.TOOLS)})")
+    if falloff is not None and falloff not in core.FALLOFFS:
+        raise ValueError(f"falloff: one of {', '.join(core.FALLOFFS)}, got {falloff!r}")
+    if falloff is not None and tool not in ("magnet", "smooth"):
+        raise ValueError(f"falloff: only the magnet and the smooth tool have one, not {tool}")
+
+    def change(s: core.DynamicSurface) -> None:
+        s.set_tool(tool)
+        if falloff is not None:
+            s.tool.falloff = falloff
+    obj.Proxy.live.edit(change, f"Tool: {tool}")
+
+
+def set_uniform(obj: Any, map: str, value: float) -> None:
+    """Sets material map ``map`` ("mass", "damping", "stiffness") to ``value`` everywhere (the
+    slider panel's edit). One undo step; a running session takes it at once."""
+    _sculpt(obj)
+    sculpt_state.map_property(map)  # validates the name
+    value = _finite(value, "value", nonnegative=map == "damping", positive=map != "damping")
+    obj.Proxy.live.edit(lambda s: getattr(s, map + "_map").set_uniform(value), f"Set {map}")
+
+
+def set_curvature_target(obj: Any, u: float | None = None, v: float | None = None) -> None:
+    """Sets the target curvature along u and/or v (1/mm) of the newest curvature constraint (the
+    slider panel's edit). One undo step; a running session takes it at once."""
+    _sculpt(obj)
+    curv = [c for c in obj.Proxy.live.snapshot().constraints if c["kind"] == "curvature"]
+    if not curv:
+        raise ValueError("obj: has no curvature constraint to set")
+    ku, kv = curv[-1]["curvature"]
+    ku = ku if u is None else _finite(u, "u")
+    kv = kv if v is None else _finite(v, "v")
+    obj.Proxy.live.edit(lambda s: s.set_constraint_curvature(curv[-1]["id"], ku, kv), "Set curvature")
+
+
+def paint_dabs(material: Any, start: tuple[float, float] | None, end: tuple[float, float], radius: float,
+               target: float, strength: float) -> None:
+    """Airbrush dabs on a core material map from ``start`` to ``end`` (map coordinates), half a
+    radius apart, so any drag speed paints a continuous line (only at ``end`` when ``start`` is None)."""
+    b = np.asarray(end, float)
+    a = b if start is None else np.asarray(start, float)
+    n = max(1, int(np.ceil(np.linalg.norm(b - a) / (0.5 * radius))))
+    for t in np.linspace(0.0, 1.0, n + 1)[1 if start is not None else n:]:
+        u, v = a + t * (b - a)
+        material.dab((float(u), float(v)), radius, target, "spherical", strength)
+
+
+def paint(obj: Any, map: str, path: Sequence[Sequence[float]], radius: float = 0.08, factor: float = 3.0,
+          strength: float = 0.25) -> None:
+    """An airbrush stroke on material map ``map`` along ``path`` ((u, v) points in map coordinates,
+    the unit square): dabs half a radius apart move the map toward ``factor`` times its mean at the
+    stroke's start. One undo step ("Paint <map>"); the GUI's airbrush records its strokes so."""
+    _sculpt(obj)
+    sculpt_state.map_property(map)
+    points = np.asarray(path, dtype=float)
+    if points.ndim != 2 or points.shape[1] != 2 or len(points) == 0:
+        raise ValueError("path: expected a non-empty list of (u, v) pairs")
+    if not np.all(np.isfinite(points)) or points.min() < 0 or points.max() > 1:
+        raise ValueError("path: (u, v) must be finite and within the unit square")
+    radius = _finite(radius, "radius", positive=True)
+    factor = _finite(factor, "factor", positive=True)
+    strength = _finite(strength, "strength", positive=True)
+
+    def change(s: core.DynamicSurface) -> None:
+        material = getattr(s, map + "_map")
+        target = factor * float(np.mean(material.values))
+        previous = None
+        for p in points:
+            paint_dabs(material, previous, (p[0], p[1]), radius, target, strength)
+            previous = (p[0], p[1])
+    obj.Proxy.live.edit(change, f"Paint {map}")
+
+
 @dataclass(frozen=True)
 class RunReport:
     """What :func:`run` did."""

@@ -6,7 +6,6 @@ from typing import Any
 import FreeCAD
 import FreeCADGui as Gui
 
-from .undo import transaction
 from .view_provider import icon
 
 TOOLBAR = ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Session", "HapticSculpt_Material",
@@ -35,8 +34,9 @@ class NewPatch:
         return FreeCAD.ActiveDocument is not None
 
     def Activated(self) -> None:
-        from .api import make_sculpt
-        make_sculpt(FreeCAD.ActiveDocument, material="clay")  # designers expect what they pull to stay
+        from .echo import run_echoed
+        # clay: designers expect what they pull to stay
+        run_echoed(f"HapticSculpt.make_sculpt(App.getDocument({FreeCAD.ActiveDocument.Name!r}), material='clay')")
         FreeCAD.ActiveDocument.recompute()
         Gui.SendMsgToActiveView("ViewFit")
 
@@ -53,10 +53,13 @@ class SculptFace:
         return len(sel) == 1 and any(n.startswith("Face") for n in sel[0].SubElementNames)
 
     def Activated(self) -> None:
-        from .api import make_sculpt
+        from .echo import ref, run_echoed
         sel = Gui.Selection.getSelectionEx()[0]
         face = next(n for n in sel.SubElementNames if n.startswith("Face"))
-        obj = make_sculpt(sel.Object.Document, source=(sel.Object, face), material="clay")
+        doc = sel.Object.Document
+        run_echoed(f"HapticSculpt.make_sculpt(App.getDocument({doc.Name!r}), source=({ref(sel.Object)}, {face!r}), "
+                   "material='clay')")
+        obj = doc.Objects[-1]
         FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label} from {obj.SourceDescription}, "
                                      f"{obj.ConversionMethod}, error {obj.ConversionError:.3g} mm\n")
 
@@ -72,11 +75,17 @@ class Thicken:
         return bool(_selected_sculpts())
 
     def Activated(self) -> None:
-        import Part
-        from .api import thicken
+        from .echo import ref, run_echoed
         for obj in _selected_sculpts():
-            with transaction(obj.Document, "Thicken"):
-                Part.show(thicken(obj, 2.0), obj.Name + "_Solid")
+            doc = f"App.getDocument({obj.Document.Name!r})"
+            run_echoed(f"{doc}.openTransaction('Thicken')", modules=())
+            try:
+                run_echoed(f"Part.show(HapticSculpt.thicken({ref(obj)}, 2.0), {obj.Name + '_Solid'!r})",
+                           modules=("Part", "HapticSculpt"))
+            except Exception:
+                obj.Document.abortTransaction()
+                raise
+            run_echoed(f"{doc}.commitTransaction()", modules=())
 
 
 class ExportStep:
@@ -141,10 +150,11 @@ class Material(_SculptCommand):
            "unless held by constraints)")
 
     def Activated(self) -> None:
-        from .api import material_of, set_material
+        from .api import material_of
+        from .echo import ref, run_echoed
         obj = _ctl().active_sculpt()
         new = "elastic" if material_of(obj) == "clay" else "clay"
-        set_material(obj, new)
+        run_echoed(f"HapticSculpt.set_material({ref(obj)}, {new!r})")
         FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label} is {new} now\n")
 
 
@@ -153,8 +163,8 @@ class KeepShape(_SculptCommand):
     tip = "Make the current shape the rest shape: an elastic sculpt stays as it is now (also while sculpting)"
 
     def Activated(self) -> None:
-        from .api import keep_shape
-        keep_shape(_ctl().active_sculpt())
+        from .echo import ref, run_echoed
+        run_echoed(f"HapticSculpt.keep_shape({ref(_ctl().active_sculpt())})")
 
 
 class _Tool(_SculptCommand):
@@ -307,9 +317,3 @@ COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_SculptFace": Sculpt
             "HapticSculpt_PaintStiffness": PaintStiffness, "HapticSculpt_ShowMap": ShowMap,
             "HapticSculpt_ShowCurvature": ShowCurvature, "HapticSculpt_Combs": Combs, "HapticSculpt_Zebra": Zebra,
             "HapticSculpt_Panel": Panel, "HapticSculpt_Thicken": Thicken, "HapticSculpt_ExportStep": ExportStep}
-
-
-def register() -> None:
-    """Adds every command to FreeCAD (called once from the workbench's Initialize)."""
-    for name, cls in COMMANDS.items():
-        Gui.addCommand(name, cls())

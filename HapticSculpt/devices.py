@@ -65,7 +65,7 @@ class MouseDevice:
 
     def __init__(self, name: str = "mouse") -> None:
         self.native = _core.ExternalDevice(name)
-        self._callbacks: list[tuple[Any, Any, Any]] = []
+        self._callbacks: list[Any] = []
         self._buttons = 0
         self._position = (0.0, 0.0, 0.0)
 
@@ -76,19 +76,18 @@ class MouseDevice:
     def attach_all(self, views: Sequence[Any]) -> None:
         """Follows the mouse in each of ``views``, wherever it is, until :meth:`detach`."""
         from pivy import coin
+
+        from .coin_events import FrontCallbacks
         self.detach()
         for view in views:
-            for event, handler in ((coin.SoLocation2Event, self._on_move), (coin.SoMouseButtonEvent, self._on_button)):
-                bound = (lambda h, v: lambda cb: h(v, cb))(handler, view)
-                self._callbacks.append((view, event, view.addEventCallbackPivy(event.getClassTypeId(), bound)))
+            self._callbacks.append(FrontCallbacks(view, [
+                (coin.SoLocation2Event, (lambda v: lambda cb: self._on_move(v, cb))(view)),
+                (coin.SoMouseButtonEvent, (lambda v: lambda cb: self._on_button(v, cb))(view))]))
 
     def detach(self) -> None:
         """Stops following the mouse (the device stays usable; its cursor stays where it was)."""
-        for view, event, handle in self._callbacks:
-            try:
-                view.removeEventCallbackPivy(event.getClassTypeId(), handle)
-            except Exception:  # noqa: BLE001 - the view may be closed
-                pass
+        for callbacks in self._callbacks:
+            callbacks.remove()
         self._callbacks = []
 
     def move_to(self, view: Any, pixel: Sequence[int]) -> tuple[float, float, float]:

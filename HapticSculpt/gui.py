@@ -27,6 +27,8 @@ from typing import Any
 import numpy as np
 
 from . import core
+from .coin_events import FrontCallbacks
+from .echo import ref, run_echoed
 from .overlay import Overlay
 
 MAP_CYCLE = ("mass", "damping", "stiffness")
@@ -34,6 +36,7 @@ CURVATURE_CYCLE = ("curvature", "mean", "gauss")
 KEYS = {"p": "point", "n": "normal", "c": "curvature"}
 AIRBRUSH_FACTOR = 3.0  # a stroke moves the map toward this times its mean when the stroke began
 AIRBRUSH_RADIUS = 0.08  # map coordinates (the unit square)
+AIRBRUSH_STRENGTH = 0.25  # per dab, at its centre
 VIEW_SCAN_SECONDS = 0.25  # how often new and closed 3D views are looked for
 #: Shown in the status bar when the workbench is chosen (the workbench selector keeps the keys).
 HELLO = ("HapticSculpt: click in the 3D view, then P / N / C toggle point, normal, curvature constraints at the "
@@ -46,11 +49,10 @@ class ViewInput:
     def __init__(self, ctl: "Controller", view: Any) -> None:
         from pivy import coin
         self.view = view
-        self._callbacks: list[tuple[Any, Any]] = []
-        for event, handler in ((coin.SoLocation2Event, ctl.on_move), (coin.SoKeyboardEvent, ctl.on_key),
-                               (coin.SoMouseButtonEvent, ctl.on_button)):
-            bound = (lambda h: lambda cb: h(view, cb))(handler)
-            self._callbacks.append((event, view.addEventCallbackPivy(event.getClassTypeId(), bound)))
+        self._callbacks = FrontCallbacks(view, [(event, (lambda h: lambda cb: h(view, cb))(handler))
+                                                for event, handler in ((coin.SoLocation2Event, ctl.on_move),
+                                                                       (coin.SoKeyboardEvent, ctl.on_key),
+                                                                       (coin.SoMouseButtonEvent, ctl.on_button))])
 
     def alive(self) -> bool:
         try:
@@ -70,12 +72,7 @@ class ViewInput:
 
     def remove(self) -> None:
         self.events_first(False)
-        for event, handle in self._callbacks:
-            try:
-                self.view.removeEventCallbackPivy(event.getClassTypeId(), handle)
-            except Exception:  # noqa: BLE001 - the view may already be closed
-                pass
-        self._callbacks = []
+        self._callbacks.remove()
 
 
 def all_3d_views() -> list[Any]:
@@ -110,7 +107,7 @@ class Controller:
         self.painting: str | None = None  # the map the airbrush paints, None when off
         self._paint_stroke: Any = None  # the sculpt being painted while the button is held
         self._paint_target = 0.0
-        self._last_dab: tuple[float, float] | None = None
+        self._paint_path: list[tuple[float, float]] = []  # where the stroke's dabs went (map coordinates)
         self.tool = "rope"
         self.falloff = "spherical"
 
@@ -280,28 +277,30 @@ class Controller:
         surface = obj.Proxy.live.surface
         # One target for the whole stroke (as the session's airbrush), so dabs saturate at it.
         self._paint_target = AIRBRUSH_FACTOR * float(np.mean(getattr(surface, self.painting + "_map").values))
-        self._last_dab = None
+        self._paint_path = []
         self._dab_to(obj, self.mouse_point)
 
     def end_paint_stroke(self) -> None:
-        """Button up: the stroke's dabs become one undo step."""
+        """Button up: the stroke becomes one undo step, as the scripting call that paints it (the
+        dabs shown while dragging are dropped and laid again by that call, identically)."""
         obj, self._paint_stroke = self._paint_stroke, None
-        if obj is not None and _alive(obj):
-            obj.Proxy.live.commit(f"Paint {self.painting}")
+        if obj is not None and _alive(obj) and self._paint_path:
+            obj.Proxy.live.revert_map(self.painting)  # (the call below lays the same dabs again)
+            run_echoed(f"HapticSculpt.paint({ref(obj)}, {self.painting!r}, {self._paint_path!r}, radius={AIRBRUSH_RADIUS!r}, "
+                       f"factor={AIRBRUSH_FACTOR!r}, strength={AIRBRUSH_STRENGTH!r})")
             self.refresh(obj)
 
-    def _dab_to(self, obj: Any, at: np.ndarray, strength: float = 0.25) -> None:
-        """Dabs from the last dab to the mass point nearest `at`, half a radius apart, so a fast
-        drag paints a continuous line (no session runs while the mouse paints)."""
-        surface = obj.Proxy.live.surface
-        m = getattr(surface, self.painting + "_map")  # (a uniform map gets a paint resolution on its first dab)
-        end = np.array(self._map_uv(obj, at))
-        start = end if self._last_dab is None else np.array(self._last_dab)
-        n = max(1, int(np.ceil(np.linalg.norm(end - start) / (0.5 * AIRBRUSH_RADIUS))))
-        for t in np.linspace(0.0, 1.0, n + 1)[1 if self._last_dab is not None else n:]:
-            u, v = start + t * (end - start)
-            m.dab((float(u), float(v)), AIRBRUSH_RADIUS, self._paint_target, "spherical", strength)
-        self._last_dab = (float(end[0]), float(end[1]))
+    def _dab_to(self, obj: Any, at: np.ndarray) -> None:
+        """Dabs from the last dab to the mass point nearest `at`, shown at once (no session runs
+        while the mouse paints)."""
+        from .api import paint_dabs
+        end = self._map_uv(obj, at)
+        if self._paint_path and end == self._paint_path[-1]:
+            return
+        material = getattr(obj.Proxy.live.surface, self.painting + "_map")
+        paint_dabs(material, self._paint_path[-1] if self._paint_path else None, end, AIRBRUSH_RADIUS,
+                   self._paint_target, AIRBRUSH_STRENGTH)
+        self._paint_path.append(end)
         for ov in self.overlays_of(obj):
             ov.frame()
 
@@ -311,14 +310,15 @@ class Controller:
         obj, at = self.active_sculpt(), self.cursor()
         if obj is None or at is None:
             raise RuntimeError("no sculpt or no cursor: move the mouse over a sculpt first")
-        live = obj.Proxy.live
-        index = int(live.snapshot().nearest_mesh_index(list(at)))
-        existing = [c for c in live.snapshot().constraints if c["kind"] == kind and c["index"] == index]
+        snapshot = obj.Proxy.live.snapshot()
+        index = int(snapshot.nearest_mesh_index(list(at)))
+        existing = [c for c in snapshot.constraints if c["kind"] == kind and c["index"] == index]
         if existing:
-            live.edit(lambda s: s.remove_constraint(existing[0]["id"]), f"Remove {kind} constraint")
+            run_echoed(f"HapticSculpt.remove_constraint({ref(obj)}, {existing[0]['id']})")
             result = "removed"
         else:
-            live.edit(lambda s: s.add_constraint(kind, index=index), f"Add {kind} constraint")
+            point = tuple(float(x) for x in np.asarray(snapshot.mesh).reshape(-1, 3)[index])
+            run_echoed(f"HapticSculpt.add_constraint({ref(obj)}, {kind!r}, near={point!r})")
             result = "added"
         self.refresh(obj)
         return result
@@ -328,7 +328,7 @@ class Controller:
         s = obj.Proxy.live.snapshot()
         u, v = s.mesh_parameters(int(s.nearest_mesh_index(list(at))))
         (u0, u1), (v0, v1) = s.surface.domain
-        return (u - u0) / (u1 - u0), (v - v0) / (v1 - v0)
+        return float((u - u0) / (u1 - u0)), float((v - v0) / (v1 - v0))
 
     def set_display(self, display: str) -> None:
         ov = self.overlay()
@@ -364,12 +364,8 @@ class Controller:
         obj = self.active_sculpt()
         if obj is None:
             return
-
-        def change(s: Any) -> None:
-            s.set_tool(tool)
-            if tool == "magnet":
-                s.tool.falloff = self.falloff
-        obj.Proxy.live.edit(change, f"Tool: {tool}")
+        falloff = f", falloff={self.falloff!r}" if tool == "magnet" else ""
+        run_echoed(f"HapticSculpt.set_tool({ref(obj)}, {tool!r}{falloff})")
 
     def start_session(self, device: Any = None) -> Any:
         """Starts sculpting the active sculpt with `device`, else the first attached device, else the mouse."""

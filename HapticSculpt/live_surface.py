@@ -201,6 +201,14 @@ class LiveSurface:
         finally:
             self.writing = False
 
+    def revert_map(self, name: str) -> None:
+        """Puts material map ``name`` back to its stored values, dropping a preview painted on the
+        surface (the GUI's airbrush shows its dabs before the stroke is committed; no session)."""
+        state = read_state(self._obj)
+        prop = sculpt_state.map_property(name)
+        rows, cols = state.settings["maps"][prop]
+        getattr(self.surface, name + "_map").set_values(state.arrays[prop].reshape(int(rows), int(cols)))
+
     def document_changed(self) -> None:
         """The document properties changed from outside (Undo, Redo, a script): during a session the
         surface is restored to them, as it is and at rest, without stopping the session (not a new

@@ -42,17 +42,13 @@ class SliderPanel:
 
     @staticmethod
     def apply(obj: Any, name: str, value: float) -> None:
-        """Sets slider ``name`` to ``value`` as one undo step (a running session takes it at once)."""
-        def change(s: Any) -> None:
-            if name in ("mass", "damping", "stiffness"):
-                getattr(s, name + "_map").set_uniform(value)
-                return
-            curv = [c for c in s.constraints if c["kind"] == "curvature"]
-            if curv:
-                ku, kv = curv[-1]["curvature"]
-                s.set_constraint_curvature(curv[-1]["id"], value if name == "curvature_u" else ku,
-                                           value if name == "curvature_v" else kv)
-        obj.Proxy.live.edit(change, f"Set {name.replace('_', ' ')}")
+        """Sets slider ``name`` to ``value`` as one undo step through the scripting call (echoed to
+        the Python console and a recorded macro); a running session takes it at once."""
+        from .echo import ref, run_echoed
+        if name in ("mass", "damping", "stiffness"):
+            run_echoed(f"HapticSculpt.set_uniform({ref(obj)}, {name!r}, {float(value)!r})")
+        elif [c for c in obj.Proxy.live.snapshot().constraints if c["kind"] == "curvature"]:
+            run_echoed(f"HapticSculpt.set_curvature_target({ref(obj)}, {name[-1]}={float(value)!r})")
 
     # --- geometry ---------------------------------------------------------------------------------
     def layout(self, mesh: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]:

@@ -14,11 +14,13 @@ import time
 import numpy as np
 import pytest
 
-from freecad_support import ROOT
+from freecad_support import ROOT, run_freecadcmd
 
 SHOTS = os.path.join(ROOT, "build", "screenshots")
 TOOLBAR_Y = 122  # the HapticSculpt toolbar's row at 1280 x 1024 (FreeCAD 0.20's default layout)
-BUTTON = {"NewPatch": 30, "Session": 98, "PaintStiffness": 546}  # x of each button on that row
+BUTTON = {"NewPatch": 30, "Session": 98, "Material": 133, "KeepShape": 167, "ToolMagnet": 235,
+          "PaintStiffness": 546}  # x of each button on that row
+RECORD_BUTTON = (536, 552)  # the Record button of FreeCAD's macro recording dialog
 STYLES = {"CAD": "Gui::CADNavigationStyle", "OpenInventor": "Gui::InventorNavigationStyle",
           "Blender": "Gui::BlenderNavigationStyle", "Gesture": "Gui::GestureNavigationStyle"}
 NEEDS = [shutil.which(t) for t in ("Xvfb", "xdotool", "import", "freecad")]
@@ -42,6 +44,7 @@ class Desktop:
         os.symlink(ROOT, os.path.join(home, "Mod", "HapticSculpt"))
         with open(os.path.join(home, "user.cfg"), "w") as f:
             f.write(USER_CFG.format(style=STYLES[style]))
+        self.home = home
         self.state_file = os.path.join(tmp, "state.json")
         self.xvfb = subprocess.Popen(["Xvfb", "-displayfd", "1", "-screen", "0", "1280x1024x24", "-nolisten", "tcp"],
                                      stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
@@ -81,6 +84,7 @@ class Desktop:
             except (KeyError, IndexError):
                 pass
             time.sleep(0.05)
+        self.shot("timeout")  # what the screen showed (the Python console has any traceback)
         s = self.state()
         brief = {k: v for k, v in s.items() if k != "docs"}
         for name, doc in s.get("docs", {}).items():
@@ -96,6 +100,18 @@ class Desktop:
         path = os.path.join(SHOTS, f"real_{name}.png")
         subprocess.run(["import", "-window", "root", path], env=self.env, check=True)
         return mpimg.imread(path)[..., :3]
+
+    def drag(self, points: list[tuple[int, int]], seconds: float = 0.3) -> None:
+        """A left drag through ``points`` taking ``seconds``, as a hand makes one (a drag of no
+        duration, which xdotool can send and no hand can, may lose its release under Xvfb)."""
+        self.xdo("mousemove", str(points[0][0]), str(points[0][1]))
+        time.sleep(0.2)
+        self.xdo("mousedown", "1")
+        for x, y in points[1:]:
+            time.sleep(seconds / len(points))
+            self.xdo("mousemove", str(x), str(y))
+        time.sleep(seconds / len(points))
+        self.xdo("mouseup", "1")
 
     def calibrate(self) -> None:
         """Maps the active 3D view's viewport pixels to screen pixels, from where the view itself
@@ -190,16 +206,69 @@ def test_workbench_first_keys_stroke_undo_redo_paint(tmp_path, style):
         # the airbrush: a fast drag paints a continuous line, one undo step
         d.xdo("mousemove", str(BUTTON["PaintStiffness"]), str(TOOLBAR_Y), "click", "1")
         d.wait(lambda s: s["painting"] == "stiffness", "the airbrush")
-        d.xdo("mousemove", str(west[0]), str(west[1]))
-        time.sleep(0.3)
         before = undo(d.state())[0]
-        d.xdo("mousedown", "1")
-        d.xdo("mousemove", str((west[0] + centre[0]) // 2), str((west[1] + centre[1]) // 2))
-        d.xdo("mousemove", str(east[0]), str(east[1]))
-        d.xdo("mouseup", "1")
+        d.drag([west, ((west[0] + centre[0]) // 2, (west[1] + centre[1]) // 2), east], seconds=0.1)
         s = d.wait(lambda s: undo(s)[0] == "Paint stiffness", f"one paint step (was {before})")
         lo, hi, n = sculpt(s)["stiffness_map"]
         assert n > 1 and hi > 2 * lo
         assert undo(s)[1] == before
     finally:
         d.close()
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
+    """Every command and key echoes its scripting call (FreeCADGui.doCommand): FreeCAD's own macro
+    recorder, started from its menu with real keys, records a session that freecadcmd replays to
+    the bit-identical sculpt state."""
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        d.xdo("key", "alt+m")  # Macro > Macro recording...
+        d.xdo("key", "m")
+        time.sleep(1.0)  # (the dialog has no state the observer can see)
+        d.xdo("key", "ctrl+a")
+        d.xdo("type", "session")
+        d.xdo("mousemove", str(RECORD_BUTTON[0]), str(RECORD_BUTTON[1]), "click", "1")
+        d.xdo("mousemove", "640", "500", "click", "1")
+        d.xdo("key", "ctrl+n")
+        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view")
+        d.xdo("mousemove", str(BUTTON["NewPatch"]), str(TOOLBAR_Y), "click", "1")
+        s = d.wait(lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        d.calibrate()
+        centre, east, west, north, south = [d.to_screen(p) for p in sculpt(s)["screen"]]
+        for key, at, kind in (("p", east, "point"), ("n", west, "normal"), ("c", north, "curvature")):
+            d.xdo("mousemove", str(at[0]), str(at[1]))
+            d.wait(lambda s: s["mouse_point"] is not None, "the mouse over the patch")
+            time.sleep(0.2)
+            d.xdo("key", key)
+            d.wait(lambda s: kind in [c[0] for c in sculpt(s)["constraints"]], f"a {kind} constraint")
+        d.xdo("mousemove", str(BUTTON["PaintStiffness"]), str(TOOLBAR_Y), "click", "1")
+        d.wait(lambda s: s["painting"] == "stiffness", "the airbrush")
+        d.drag([west, ((west[0] + centre[0]) // 2, (west[1] + centre[1]) // 2), east], seconds=0.1)
+        d.wait(lambda s: undo(s)[0] == "Paint stiffness", "the paint stroke")
+        d.xdo("mousemove", str(BUTTON["PaintStiffness"]), str(TOOLBAR_Y), "click", "1")  # airbrush off
+        for button, title in (("ToolMagnet", "Tool: magnet"), ("Material", "Material: elastic")):
+            d.xdo("mousemove", str(BUTTON[button]), str(TOOLBAR_Y), "click", "1")
+            s = d.wait(lambda s: undo(s)[0] == title, title)
+        gui_digest = sculpt(s)["digest"]
+        d.xdo("mousemove", "640", "500")
+        d.xdo("key", "alt+m")  # Macro > Stop macro recording
+        d.xdo("key", "t")
+        macro = os.path.join(d.home, "session.FCMacro")
+        end, text = time.monotonic() + 20, ""
+        while "# Macro End" not in text and time.monotonic() < end:  # (written when the recording stops)
+            time.sleep(0.05)
+            text = open(macro).read() if os.path.exists(macro) else ""
+    finally:
+        d.close()
+    for call in ("make_sculpt", "add_constraint", "paint", "set_tool", "set_material"):
+        assert f"HapticSculpt.{call}(" in text, text
+    out = run_freecadcmd(f"""
+        import sys
+        sys.path.insert(0, {os.path.join(ROOT, "tests", "gui_input")!r})
+        exec(open({macro!r}).read())
+        import FreeCAD, observer_digest
+        obj = FreeCAD.ActiveDocument.getObject("Sculpt")
+        answer({{"digest": observer_digest.digest(obj), "undo": FreeCAD.ActiveDocument.UndoNames}})
+        """, str(tmp_path / "replay"))
+    assert out["digest"] == gui_digest, (out["undo"], text)

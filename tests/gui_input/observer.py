@@ -4,9 +4,15 @@
 import json
 import os
 
+import sys
+
 import FreeCAD
 import FreeCADGui as Gui
+import HapticSculpt
 from pivy import coin
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(HapticSculpt.__file__)), "tests", "gui_input"))
+from observer_digest import digest  # noqa: E402
 
 OUT = os.environ["HS_OBSERVER_OUT"]
 
@@ -24,7 +30,7 @@ def _sculpts(doc):
                     "plasticity": settings.get("plasticity"), "tool": settings.get("tool", {}).get("name"),
                     "stiffness_map": [min(o.StiffnessMap), max(o.StiffnessMap), len(o.StiffnessMap)],
                     "session": o.Proxy.live.session is not None if getattr(o.Proxy, "live", None) else False,
-                    "selected": o in Gui.Selection.getSelection(), "screen": _on_screen(o)})
+                    "selected": o in Gui.Selection.getSelection(), "screen": _on_screen(o), "digest": digest(o)})
     return out
 
 
