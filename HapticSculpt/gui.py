@@ -176,6 +176,7 @@ class Controller:
         key = (id(view), obj.Document.Name + "/" + obj.Name)
         if key not in self.overlays:
             self.overlays[key] = Overlay(view, obj)
+            self.overlays[key].mode = f"airbrush: {self.painting}" if self.painting else ""
         return self.overlays[key]
 
     def overlays_of(self, obj: Any) -> list[Overlay]:
@@ -264,6 +265,8 @@ class Controller:
         self.painting = None if which is None or which == self.painting else which
         if self.session is not None and self.session.running:
             self.session.set_airbrush(self.painting, factor=AIRBRUSH_FACTOR)
+        for ov in self.overlays.values():
+            ov.mode = f"airbrush: {self.painting}" if self.painting else ""
         if self.painting is not None:
             self.set_display(self.painting)
         return self.painting

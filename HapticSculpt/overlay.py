@@ -5,8 +5,9 @@ is on) the overlay throws its previous scene away and draws a new one from the c
 surface coloured by the active display (shading, a material map, curvature in the paper's green/blue
 channels, mean or Gaussian curvature, zebra stripes), curvature combs, the constraint jacks (point:
 red cross, normal: blue line, curvature: white circle), the cursor with its axes, the nearest surface
-point with its axes, the rope, the legend of the display's range and the slider panel. Nothing is
-retained between frames but the Coin root it draws into; nothing is computed for a display that is
+point with its axes, the rope and the slider panel's tracks; its screen-space layer (:mod:`hud`)
+shows the legend of the display's range, the sliders' values, the tool and the mode. Nothing is
+retained between frames but the Coin roots it draws into; nothing is computed for a display that is
 off. No Qt: everything is pivy.
 """
 from __future__ import annotations
@@ -17,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from . import analysis, coin_shapes as shapes, core
+from .hud import Hud
 from .panel import SliderPanel
 
 DISPLAYS = ("shading", "mass", "damping", "stiffness", "curvature", "mean", "gauss", "zebra")
@@ -37,6 +39,8 @@ class Overlay:
         self.contact: np.ndarray | None = None
         self.frame_ms = 0.0  # cost of the last frame
         self.frames = 0
+        self.mode = ""  # what the workbench is doing besides (the airbrush), shown in the HUD
+        self.hud: Hud | None = None  # the screen-space layer, made when the overlay first draws
         self._root = coin.SoSeparator()
         self._root.setName("HapticSculptOverlay")
         self._timer: Any = None
@@ -63,6 +67,8 @@ class Overlay:
             self._timer.unschedule()
             self._timer = None
         self._root.removeAllChildren()
+        if self.hud is not None:
+            self.hud.clear()
 
     def alive(self) -> bool:
         """False once its view is closed or its object deleted."""
@@ -74,6 +80,9 @@ class Overlay:
 
     def remove(self) -> None:
         self.stop()
+        if self.hud is not None:
+            self.hud.remove()
+            self.hud = None
         try:
             graph = self.view.getSceneGraph()
         except Exception:  # noqa: BLE001 - the view is closed: its scene went with it
@@ -116,10 +125,11 @@ class Overlay:
         scene = coin.SoSeparator()
         light = coin.SoLightModel()
         light.model = coin.SoLightModel.BASE_COLOR
+        legend = None
         if self.display != "shading":
             colours, rng = self._colours(s, mesh)
             scene.addChild(shapes.coloured_mesh(mesh, colours))
-            scene.addChild(_legend(mesh, self.display, rng))
+            legend = (self.display, rng)
         decor = coin.SoSeparator()
         decor.addChild(light)
         if self.combs:
@@ -136,8 +146,21 @@ class Overlay:
         scene.addChild(decor)
         self._root.removeAllChildren()
         self._root.addChild(scene)
+        if self.hud is None:
+            self.hud = Hud(self.view)
+        sliders = self.panel.values(self.obj) if self.panel_visible else []
+        self.hud.update(legend, sliders, self._status(s))
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
+
+    def _status(self, s: core.DynamicSurface) -> str:
+        """The tool, the material and what goes on, for the HUD's status line."""
+        parts = [f"tool: {s.tool.name}", "clay" if s.plasticity[0] else "elastic"]
+        if self._session() is not None:
+            parts.append("sculpting")
+        if self.mode:
+            parts.append(self.mode)
+        return "  |  ".join(parts)
 
     def _colours(self, s: core.DynamicSurface, mesh: np.ndarray) -> tuple[np.ndarray, tuple[float, float]]:
         g, h = mesh.shape[:2]
@@ -192,57 +215,3 @@ class Overlay:
         if self.contact is not None and grab:
             sep.addChild(shapes.lines(np.array([[pos, self.contact]]), (1.0, 0.85, 0.0), 2.0))
         return sep
-
-
-def _legend(mesh: np.ndarray, display: str, rng: tuple[float, float]) -> Any:
-    """A colour bar beside the patch (+x side) with the display's name and range."""
-    from pivy import coin
-    flat = mesh.reshape(-1, 3)
-    lo, hi = flat.min(0), flat.max(0)
-    size = float(np.linalg.norm(hi - lo)) or 1.0
-    x0, y0, z0 = hi[0] + 0.08 * size, lo[1], hi[2]
-    steps = 16
-    t = np.linspace(0, 1, steps + 1)
-    if display == "curvature":
-        colours = np.stack([np.zeros_like(t), t, t[::-1] * 0 + t], axis=1)
-    elif display == "zebra":
-        colours = np.repeat((np.floor(t * 8) % 2)[:, None], 3, axis=1)
-    else:
-        colours, _ = analysis.pseudo_colour(t, 0.0, 1.0)
-    w = 0.04 * size
-    ys = y0 + t * (hi[1] - lo[1])
-    quads = np.array([[[x0, ys[k], z0], [x0 + w, ys[k], z0], [x0 + w, ys[k + 1], z0], [x0, ys[k + 1], z0]]
-                      for k in range(steps)])
-    sep = coin.SoSeparator()
-    light = coin.SoLightModel()
-    light.model = coin.SoLightModel.BASE_COLOR
-    sep.addChild(light)
-    mat = coin.SoMaterial()
-    mat.diffuseColor.setValues(0, steps, colours[:steps].tolist())
-    sep.addChild(mat)
-    binding = coin.SoMaterialBinding()
-    binding.value = coin.SoMaterialBinding.PER_FACE
-    sep.addChild(binding)
-    coords = coin.SoCoordinate3()
-    coords.point.setValues(0, 4 * steps, quads.reshape(-1, 3).tolist())
-    sep.addChild(coords)
-    faces = coin.SoFaceSet()
-    faces.numVertices.setValues(0, steps, [4] * steps)
-    sep.addChild(faces)
-    units = {"mass": "", "damping": "", "stiffness": "", "curvature": " 1/mm", "mean": " 1/mm",
-             "gauss": " 1/mm^2", "zebra": ""}[display]
-    for y, text in ((ys[0], f"{rng[0]:.3g}{units}"), (ys[-1], f"{rng[1]:.3g}{units}"),
-                    (ys[-1] + 0.15 * size, display)):
-        label = coin.SoSeparator()
-        label.addChild(shapes.material((1.0, 1.0, 1.0)))
-        tr = coin.SoTranslation()
-        tr.translation = (float(x0 + 1.3 * w), float(y), float(z0))
-        label.addChild(tr)
-        font = coin.SoFont()
-        font.size = 18.0  # screen points: Coin's default bitmap font is hard to read beside a patch
-        label.addChild(font)
-        txt = coin.SoText2()
-        txt.string = text
-        label.addChild(txt)
-        sep.addChild(label)
-    return sep

@@ -95,26 +95,35 @@ class SliderPanel:
                 self.held, self.pending = None, None
                 self.apply(obj, name, value)
 
+    def shown_value(self, obj: Any, name: str) -> float:
+        """The value a slider shows: the one being dragged, else the sculpt's."""
+        return self.pending if self.held == name and self.pending is not None else self.value(obj, name)
+
+    def values(self, obj: Any) -> list[tuple[str, float, bool]]:
+        """(label, shown value, held) of each slider in track order, for the HUD."""
+        return [(label, self.shown_value(obj, name), self.held == name) for name, label, _, _ in SLIDERS]
+
     def draw(self, obj: Any, mesh: np.ndarray) -> Any:
+        """The tracks and knobs in the scene, each numbered at its foot (its label and value are in
+        the HUD under the same number, where they never leave the view)."""
         from pivy import coin
         sep = coin.SoSeparator()
         tracks = self.layout(mesh)
         size = float(np.linalg.norm(mesh.reshape(-1, 3).max(0) - mesh.reshape(-1, 3).min(0))) or 1.0
-        for name, label, _, _ in SLIDERS:
+        for k, (name, _, _, _) in enumerate(SLIDERS):
             a, b = tracks[name]
-            value = self.pending if self.held == name and self.pending is not None else self.value(obj, name)
-            knob = a + self.fraction(name, value) * (b - a)
+            knob = a + self.fraction(name, self.shown_value(obj, name)) * (b - a)
             sep.addChild(shapes.lines(np.array([[a, b]]), (0.7, 0.7, 0.7), 2.0))
             sep.addChild(shapes.sphere(knob, 0.015 * size, (1.0, 0.6, 0.0) if self.held == name else (0.3, 0.8, 1.0)))
-            text = coin.SoSeparator()
-            text.addChild(shapes.material((1.0, 1.0, 1.0)))
+            number = coin.SoSeparator()
+            number.addChild(shapes.material((1.0, 1.0, 1.0)))
             tr = coin.SoTranslation()
-            tr.translation = tuple(float(x) for x in b + [0.0, 0.0, 0.03 * size])
-            text.addChild(tr)
+            tr.translation = tuple(float(x) for x in a - [0.0, 0.0, 0.03 * size])
+            number.addChild(tr)
             t2 = coin.SoText2()
-            t2.string = f"{label} {value:.3g}"
-            text.addChild(t2)
-            sep.addChild(text)
+            t2.string = str(k + 1)
+            number.addChild(t2)
+            sep.addChild(number)
         return sep
 
 

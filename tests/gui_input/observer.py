@@ -75,7 +75,9 @@ def write(*_):
         state["painting"] = ctl.painting
         state["inputs"] = len(ctl.inputs)
         state["mouse_point"] = None if ctl.mouse_point is None else [float(x) for x in ctl.mouse_point]
-        state["overlays"] = [{"display": ov.display, "frames": ov.frames} for ov in ctl.overlays.values()]
+        state["overlays"] = [{"display": ov.display, "frames": ov.frames, "view_size": list(ov.view.getSize()),
+                              "hud": ov.hud.boxes() if ov.hud is not None else {}}
+                             for ov in ctl.overlays.values()]
     except Exception as exc:  # noqa: BLE001 - the workbench not loaded yet
         state["controller_error"] = str(exc)
     tmp = OUT + ".tmp"
