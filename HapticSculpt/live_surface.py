@@ -75,11 +75,15 @@ class LiveSurface:
         return self._session
 
     def attach(self, session: SessionLink) -> core.DynamicSurface:
-        """A session takes the surface over (its threads step it from now on); returns it, at rest."""
+        """A session takes the surface over (its threads step it from now on); returns it, at rest
+        (and a clay surface relaxed in the shape it has: a stored stroke may hold elastic strain
+        below the yield, which would otherwise spring back with no input)."""
         if self._session is not None:
             raise RuntimeError(f"{self._obj.Label} is already being sculpted by another session")
         surface = self.surface
         surface.set_velocities(np.zeros_like(np.asarray(surface.velocities)))  # a session starts from rest
+        if surface.plasticity[0]:
+            surface.relax()  # clay: its rest shape is the shape it has, so it stays until touched
         self._session = session
         self._shadow_stale = True
         self._head = None

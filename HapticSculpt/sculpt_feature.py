@@ -65,12 +65,15 @@ class SculptFeature:
         """Opening a file: add properties older files lack, then load the state (errors are reported
         on this object only; the rest of the document is unaffected)."""
         self._attach(obj)
-        ensure_properties(obj)
+        migrated = ensure_properties(obj)
         try:
             self.live.surface  # noqa: B018 - loads and validates
         except ValueError as exc:
             import FreeCAD
             FreeCAD.Console.PrintError(f"HapticSculpt: {exc}\n")
+            return
+        if not migrated:
+            obj.purgeTouched()  # opening a file of this version changes nothing in it
 
     # --- serialisation: no state in the proxy itself ----------------------------------------------
     def dumps(self) -> dict[str, Any]:

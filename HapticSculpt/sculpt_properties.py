@@ -14,26 +14,30 @@ GROUP = "Sculpt"
 STATE_PROPERTIES = (*sculpt_state.ARRAY_NAMES, "SculptSettings")
 
 
-def _add_property(obj: Any, kind: str, name: str, doc: str, mode: int) -> None:
-    """Adds a property unless an older file already has it; mode 1 read-only, 2 hidden."""
-    if name not in obj.PropertiesList:
+def _add_property(obj: Any, kind: str, name: str, doc: str, mode: int) -> bool:
+    """Adds a property unless an older file already has it; mode 1 read-only, 2 hidden. True if added."""
+    added = name not in obj.PropertiesList
+    if added:
         obj.addProperty(kind, name, GROUP, doc)
     obj.setEditorMode(name, mode)
+    return added
 
 
-def ensure_properties(obj: Any) -> None:
-    """All properties this version uses (files from older versions gain the missing ones)."""
-    for name in sculpt_state.ARRAY_NAMES:
-        _add_property(obj, "App::PropertyFloatList", name, f"Sculpt state: {name} (flat, binary-exact)", 2)
-    _add_property(obj, "App::PropertyString", "SculptSettings", "Sculpt state: sampling, maps, constraints, "
-                  "tool and integrator settings (JSON)", 2)
-    _add_property(obj, "App::PropertyString", "SourceDescription", "What the surface was made from", 1)
-    _add_property(obj, "App::PropertyString", "ConversionMethod", "plane, exact or approximated", 1)
-    _add_property(obj, "App::PropertyFloat", "ConversionError",
-                  "Largest distance (mm) between the source and the surface it was converted to", 1)
-    _add_property(obj, "App::PropertyInteger", "Strokes", "Strokes applied so far", 1)
-    _add_property(obj, "App::PropertyString", "SculptError", "Why the stored sculpt state could not be "
-                  "loaded (empty when it loads)", 1)
+def ensure_properties(obj: Any) -> bool:
+    """All properties this version uses (files from older versions gain the missing ones); True if
+    any was missing."""
+    added = [_add_property(obj, "App::PropertyFloatList", name, f"Sculpt state: {name} (flat, binary-exact)", 2)
+             for name in sculpt_state.ARRAY_NAMES]
+    added.append(_add_property(obj, "App::PropertyString", "SculptSettings", "Sculpt state: sampling, maps, "
+                               "constraints, tool and integrator settings (JSON)", 2))
+    added.append(_add_property(obj, "App::PropertyString", "SourceDescription", "What the surface was made from", 1))
+    added.append(_add_property(obj, "App::PropertyString", "ConversionMethod", "plane, exact or approximated", 1))
+    added.append(_add_property(obj, "App::PropertyFloat", "ConversionError",
+                               "Largest distance (mm) between the source and the surface it was converted to", 1))
+    added.append(_add_property(obj, "App::PropertyInteger", "Strokes", "Strokes applied so far", 1))
+    added.append(_add_property(obj, "App::PropertyString", "SculptError", "Why the stored sculpt state could not "
+                               "be loaded (empty when it loads)", 1))
+    return any(added)
 
 
 def read_state(obj: Any) -> sculpt_state.SculptState:

@@ -261,15 +261,15 @@ class Session:
     def _commit_final(self, obj: Any) -> None:
         """The state after the last stroke as its own transaction, if the surface moved on after it
         (an elastic patch springing back, a swing settling). Round-off drift of a resting patch
-        (below a nanometre) is no edit: the document keeps its state and the surface is reloaded."""
+        (below a nanometre), and a clay patch's rest lengths relaxed at the start, are no edit: the
+        document keeps its state and the surface is reloaded."""
         live = obj.Proxy.live
         current = sculpt_state.capture(live.surface)
         stored = read_state(obj)
         drift = float(np.max(np.abs(current.arrays["Poles"] - stored.arrays["Poles"]), initial=0.0))
         same = current.settings_json() == obj.SculptSettings and all(
             np.array_equal(current.arrays[k], stored.arrays[k])
-            for k in current.arrays if k not in ("Poles", "Velocities", "RestLengths")) and \
-            np.allclose(current.arrays["RestLengths"], stored.arrays["RestLengths"], rtol=1e-12, atol=0.0)
+            for k in current.arrays if k not in ("Poles", "Velocities", "RestLengths"))
         if same and drift <= 1e-9:
             live.document_changed()  # the stored state stays the truth
             return

@@ -37,13 +37,14 @@ USER_CFG = """<?xml version="1.0" encoding="UTF-8" standalone="no" ?>
 class Desktop:
     """Xvfb, FreeCAD with the observer, and real input through xdotool."""
 
-    def __init__(self, tmp: str, style: str) -> None:
+    def __init__(self, tmp: str, style: str, open_file: str | None = None) -> None:
         self.tmp = tmp
         home = os.path.join(tmp, "home")
-        os.makedirs(os.path.join(home, "Mod"))
-        os.symlink(ROOT, os.path.join(home, "Mod", "HapticSculpt"))
-        with open(os.path.join(home, "user.cfg"), "w") as f:
-            f.write(USER_CFG.format(style=STYLES[style]))
+        if not os.path.isdir(home):  # (a restart keeps the home, as a user's does)
+            os.makedirs(os.path.join(home, "Mod"))
+            os.symlink(ROOT, os.path.join(home, "Mod", "HapticSculpt"))
+            with open(os.path.join(home, "user.cfg"), "w") as f:
+                f.write(USER_CFG.format(style=STYLES[style]))
         self.home = home
         self.state_file = os.path.join(tmp, "state.json")
         self.xvfb = subprocess.Popen(["Xvfb", "-displayfd", "1", "-screen", "0", "1280x1024x24", "-nolisten", "tcp"],
@@ -51,16 +52,22 @@ class Desktop:
         self.display = ":" + self.xvfb.stdout.readline().decode().strip()
         self.env = dict(os.environ, DISPLAY=self.display, QTWEBENGINE_DISABLE_SANDBOX="1", FREECAD_USER_HOME=home,
                         HS_OBSERVER_OUT=self.state_file)
-        self.log = open(os.path.join(tmp, "freecad.log"), "w")
-        self.freecad = subprocess.Popen(["freecad", os.path.join(ROOT, "tests", "gui_input", "observer.py")],
+        self.log = open(os.path.join(tmp, "freecad.log"), "a")
+        files = [open_file] if open_file else []
+        self.freecad = subprocess.Popen(["freecad", os.path.join(ROOT, "tests", "gui_input", "observer.py"), *files],
                                         env=self.env, stdout=self.log, stderr=subprocess.STDOUT)
         self.wait(lambda s: s.get("workbench") == "HapticSculptWorkbench", "FreeCAD starting on the workbench", 120)
+        self.focus()
+
+    def focus(self) -> None:
+        """Keyboard focus to FreeCAD's main window (what clicking its title bar does on a desktop)."""
         window = self.xdo("search", "--name", "FreeCAD").split()[-1]
         self.xdo("windowfocus", "--sync", window)
 
     def close(self) -> None:
         for p in (self.freecad, self.xvfb):
-            p.kill()
+            if p.poll() is None:
+                p.kill()
             p.wait()
         self.log.close()
 
@@ -313,5 +320,57 @@ def test_the_hud_stays_inside_the_view_at_every_zoom_and_window_size(tmp_path, w
             right = img[:window[1], int(0.6 * window[0]):window[0]]  # the window's right part
             assert np.sum((right[..., 1] > 0.6) & (right[..., 0] < 0.3) & (right[..., 2] < 0.3)) > 100  # u bar
             assert np.sum((right[..., 2] > 0.7) & (right[..., 0] < 0.3)) > 100  # v bar
+    finally:
+        d.close()
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_save_quit_reopen_and_a_restarted_session_stays_still(tmp_path):
+    """ctrl+s into FreeCAD's save dialog, ctrl+q, FreeCAD started again on the file: the same state,
+    bit for bit; a session started on the reopened sculpt does not move it without input."""
+    path = str(tmp_path / "sculpted.FCStd")
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        d.xdo("mousemove", "640", "500")
+        d.xdo("key", "ctrl+n")
+        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view")
+        d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        s = d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
+        d.calibrate()
+        centre, east, west, north, south = [d.to_screen(p) for p in sculpt(s)["screen"]]
+        d.drag([south] + [(south[0], south[1] - 10 * k) for k in range(1, 16)], seconds=0.8)
+        s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
+        d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
+        time.sleep(0.5)
+        saved = sculpt(d.state())["digest"]
+        d.xdo("key", "ctrl+s")  # FreeCAD's save dialog: the file name, then Enter
+        time.sleep(1.5)
+        d.xdo("type", path)
+        d.xdo("key", "Return")
+        d.wait(lambda s: s["docs"][s["active"]]["file"] == path, "the document saved")
+        d.focus()  # (no window manager gives the keys back to the main window after a dialog)
+        d.xdo("key", "ctrl+q")
+        end = time.monotonic() + 30
+        while d.freecad.poll() is None and time.monotonic() < end:
+            time.sleep(0.1)
+        if d.freecad.poll() is None:
+            d.shot("quit")
+        assert d.freecad.poll() is not None, "ctrl+q did not quit FreeCAD"
+    finally:
+        d.close()
+    os.remove(os.path.join(str(tmp_path), "state.json"))
+    d = Desktop(str(tmp_path), "CAD", open_file=path)
+    try:
+        s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["sculpts"], "the file to open")
+        assert sculpt(s)["digest"] == saved, "the reopened sculpt differs from the saved one"
+        assert not s["docs"][s["active"]]["modified"]
+        d.xdo("mousemove", "640", "500", "click", "1")  # (the view has the keys and the mouse)
+        s = d.press_button("Session", lambda s: sculpt(s)["session"], "a session on the reopened sculpt")
+        time.sleep(2.0)  # (no input: nothing may happen, so there is no condition to wait for)
+        s = d.state()
+        poles = np.array(sculpt(s)["shape_poles"])
+        stored = np.array(sculpt(s)["poles"]).reshape(-1, 3)
+        assert np.abs(poles - stored).max() < 1e-6, "the reopened sculpt moved by itself"
+        assert undo(s) == [], undo(s)
     finally:
         d.close()
