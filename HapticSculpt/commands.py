@@ -14,7 +14,8 @@ TOOLBAR = ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Ses
            "HapticSculpt_ToolSmooth", "HapticSculpt_PointConstraint", "HapticSculpt_NormalConstraint",
            "HapticSculpt_CurvatureConstraint", "HapticSculpt_PaintMass", "HapticSculpt_PaintDamping",
            "HapticSculpt_PaintStiffness", "HapticSculpt_ShowMap", "HapticSculpt_ShowCurvature",
-           "HapticSculpt_Combs", "HapticSculpt_Zebra", "HapticSculpt_Panel", "HapticSculpt_Thicken",
+           "HapticSculpt_Combs", "HapticSculpt_Zebra", "HapticSculpt_ZebraMode", "HapticSculpt_ZebraStripes",
+           "HapticSculpt_Panel", "HapticSculpt_Thicken",
            "HapticSculpt_ExportStep"]
 
 
@@ -296,6 +297,30 @@ class Zebra(_SculptCommand):
             _ctl().set_display("shading" if ov.display == "zebra" else "zebra")
 
 
+class ZebraMode(_SculptCommand):
+    icon_name, menu = "Zebra", "Zebra: reflection / isophote"
+    tip = ("Switch the zebra stripes between reflection lines (view-dependent: the eye ray mirrored in the "
+           "surface) and isophotes (world-fixed: bands of equal angle to the z axis)")
+
+    def Activated(self) -> None:
+        from .stripes import MODES
+        ov = _ctl().overlay()
+        if ov is not None:
+            ov.stripe_mode = MODES[(MODES.index(ov.stripe_mode) + 1) % len(MODES)]
+            _ctl().set_display("zebra")
+
+
+class ZebraStripes(_SculptCommand):
+    icon_name, menu = "Zebra", "Zebra: stripe count"
+    tip = "Cycle the number of zebra stripes over a half turn: 6, 12, 24"
+
+    def Activated(self) -> None:
+        ov = _ctl().overlay()
+        if ov is not None:
+            ov.stripes = {6.0: 12.0, 12.0: 24.0}.get(ov.stripes, 6.0)
+            _ctl().set_display("zebra")
+
+
 class Panel(_SculptCommand):
     icon_name, menu = "Panel", "Slider panel"
     tip = "Toggle the 3D slider panel (mass, damping, stiffness, curvature targets), operated with the cursor"
@@ -316,4 +341,5 @@ COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_SculptFace": Sculpt
             "HapticSculpt_PaintMass": PaintMass, "HapticSculpt_PaintDamping": PaintDamping,
             "HapticSculpt_PaintStiffness": PaintStiffness, "HapticSculpt_ShowMap": ShowMap,
             "HapticSculpt_ShowCurvature": ShowCurvature, "HapticSculpt_Combs": Combs, "HapticSculpt_Zebra": Zebra,
+            "HapticSculpt_ZebraMode": ZebraMode, "HapticSculpt_ZebraStripes": ZebraStripes,
             "HapticSculpt_Panel": Panel, "HapticSculpt_Thicken": Thicken, "HapticSculpt_ExportStep": ExportStep}

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from . import analysis, coin_shapes as shapes, core
+from . import stripes as stripe_shading
 from .hud import Hud
 from .panel import SliderPanel
 
@@ -40,6 +41,11 @@ class Overlay:
         self.frame_ms = 0.0  # cost of the last frame
         self.frames = 0
         self.mode = ""  # what the workbench is doing besides (the airbrush), shown in the HUD
+        self.stripe_mode = "reflection"  # zebra: "reflection" (view-dependent) or "isophote" (world-fixed)
+        self.stripes = 12.0  # zebra: bands over a half turn
+        self.stripe_direction = (0.0, 0.0, 1.0)  # isophote: the direction the bands' angle is taken to
+        self.per_pixel = True  # zebra per pixel where the driver runs GLSL (False: per mesh vertex)
+        self._sampled: tuple[bytes, np.ndarray, tuple[bytes, bytes], int] | None = None  # poles, points, texture, size
         self.hud: Hud | None = None  # the screen-space layer, made when the overlay first draws
         self._root = coin.SoSeparator()
         self._root.setName("HapticSculptOverlay")
@@ -126,7 +132,13 @@ class Overlay:
         light = coin.SoLightModel()
         light.model = coin.SoLightModel.BASE_COLOR
         legend = None
-        if self.display != "shading":
+        glsl = stripe_shading.shaders_work() if self.per_pixel else False
+        if self.display == "zebra" and glsl is None:
+            scene.addChild(stripe_shading.probe())  # (per vertex this frame; the answer comes with its render)
+        if self.display == "zebra" and glsl:
+            scene.addChild(self._stripes(s))
+            legend = (self.display, (0.0, 1.0))
+        elif self.display != "shading":
             colours, rng = self._colours(s, mesh)
             scene.addChild(shapes.coloured_mesh(mesh, colours))
             legend = (self.display, rng)
@@ -153,11 +165,25 @@ class Overlay:
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
 
+    def _stripes(self, s: core.DynamicSurface) -> Any:
+        """Zebra stripes per pixel on the exact surface (sampled again only when the poles moved)."""
+        size = stripe_shading.TEXTURE // (2 if self._session() is not None else 1)
+        key = np.asarray(s.poles).tobytes()
+        if self._sampled is None or self._sampled[0] != key or self._sampled[3] != size:
+            points, texture = stripe_shading.sample(s.surface, size)
+            self._sampled = (key, points, texture, size)
+        _, points, texture, size = self._sampled
+        g, h = points.shape[:2]
+        return stripe_shading.stripe_mesh(points, texture, size, self.stripe_mode, self.stripes,
+                                          self.stripe_direction, shapes.quad_indices(g, h))
+
     def _status(self, s: core.DynamicSurface) -> str:
         """The tool, the material and what goes on, for the HUD's status line."""
         parts = [f"tool: {s.tool.name}", "clay" if s.plasticity[0] else "elastic"]
         if self._session() is not None:
             parts.append("sculpting")
+        if self.display == "zebra":
+            parts.append(f"zebra: {self.stripe_mode}, {self.stripes:g} stripes")
         if self.mode:
             parts.append(self.mode)
         return "  |  ".join(parts)

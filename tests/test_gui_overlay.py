@@ -175,6 +175,25 @@ try:
             frames.append(ov.frame_ms)
         out["frame_ms_" + name] = float(np.median(frames))
         shot(name)
+    # zebra per pixel against per vertex, on the sculpted patch at 1x and 4x zoom
+    from HapticSculpt import stripes as stripe_shading
+    out["glsl"] = stripe_shading.shaders_work()
+    ctl.set_display("zebra")
+    for per_pixel in (True, False):
+        ov.per_pixel = per_pixel
+        for zoom in (1, 4):
+            ov.frame()
+            view.fitAll()
+            if zoom > 1:
+                cam = view.getCameraNode()
+                cam.height.setValue(cam.height.getValue() / zoom)
+            pump()
+            view.saveImage(os.path.join(shots, f"overlay_zebra_{{'pixel' if per_pixel else 'vertex'}}_{{zoom}}x.png"),
+                           800, 600, "Black")
+    ov.per_pixel = True
+    ov.stripe_mode, ov.stripes = "isophote", 48.0  # (bands of 3.75 degrees: the bump is gentle)
+    shot("isophote")
+    ov.stripe_mode, ov.stripes = "reflection", 12.0
     # graphics against simulation: the same held stroke with the overlay drawing the curvature
     # display at 60 Hz and with it off (recorded, not asserted: timing belongs to benchmarks)
     rates = {{}}
@@ -215,6 +234,14 @@ except Exception:
 json.dump(out, open({answer}, "w"))
 os._exit(0)
 """
+
+
+def grey_share(grey: np.ndarray) -> float:
+    """Of a zebra picture (grey levels, black background): the share of the surface's pixels that
+    are neither black nor white, i.e. in a soft or stepped band between stripes instead of on a
+    sharp edge (per-vertex colours blend across whole mesh cells, in steps along the triangles)."""
+    surface = grey > 0.02
+    return float((surface & (grey > 0.15) & (grey < 0.85)).sum() / max(surface.sum(), 1))
 
 
 def colour_fraction(img: np.ndarray, test) -> float:
@@ -269,6 +296,22 @@ def test_overlay_commands_keys_and_pictures(tmp_path):
     assert colour_fraction(painted, lambda r, g, b: (b > 0.8) & (r < 0.2)) > 1e-3  # cold elsewhere
     zebra = load("zebra")
     assert colour_fraction(zebra, lambda r, g, b: (r > 0.9) & (g > 0.9) & (b > 0.9)) > 1e-2  # white bands
+    # Per-pixel stripes against per-vertex colours: the share of the surface in soft or stepped
+    # bands between stripes (build/screenshots/zebra_quality.json).
+    assert out["glsl"], "the GLSL probe found no shaders under Xvfb's Mesa"
+    measures = {}
+    for kind in ("pixel", "vertex"):
+        for zoom in (1, 4):
+            img = mpimg.imread(os.path.join(SHOTS, f"overlay_zebra_{kind}_{zoom}x.png"))[..., :3].mean(axis=2)
+            measures[f"{kind}_{zoom}x"] = grey_share(img)
+    with open(os.path.join(SHOTS, "zebra_quality.json"), "w") as f:
+        json.dump(measures, f, indent=1)
+    for zoom in (1, 4):
+        assert measures[f"pixel_{zoom}x"] < 0.5 * measures[f"vertex_{zoom}x"], measures
+    isophote = load("isophote")
+    assert colour_fraction(isophote, lambda r, g, b: (r > 0.9) & (g > 0.9) & (b > 0.9)) > 1e-2  # white bands
+    surface = isophote.mean(axis=2) > 0.02
+    assert colour_fraction(isophote, lambda r, g, b: (r > 0.9) & (g > 0.9) & (b > 0.9)) < 0.9 * surface.mean()
     for name in ("mean", "gauss", "panel"):
         img = load(name)
         assert img.std() > 0.02, f"{name} picture is blank"

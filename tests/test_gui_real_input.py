@@ -19,7 +19,8 @@ from freecad_support import ROOT, run_freecadcmd
 SHOTS = os.path.join(ROOT, "build", "screenshots")
 TOOLBAR_Y = 122  # the HapticSculpt toolbar's row at 1280 x 1024 (FreeCAD 0.20's default layout)
 BUTTON = {"NewPatch": 30, "Session": 98, "Material": 133, "KeepShape": 167, "ToolMagnet": 235,
-          "PaintStiffness": 546, "ShowCurvature": 617, "Panel": 717}  # x of each button on that row
+          "PaintStiffness": 546, "ShowCurvature": 617, "Zebra": 683, "ZebraMode": 717,
+          "Panel": 786}  # x of each button on that row
 RECORD_BUTTON = (536, 552)  # the Record button of FreeCAD's macro recording dialog
 STYLES = {"CAD": "Gui::CADNavigationStyle", "OpenInventor": "Gui::InventorNavigationStyle",
           "Blender": "Gui::BlenderNavigationStyle", "Gesture": "Gui::GestureNavigationStyle"}

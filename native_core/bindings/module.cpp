@@ -187,6 +187,30 @@ PYBIND11_MODULE(_core, m) {
         .def("evaluate", [](const BSplineSurface& s, double u, double v) { return derivativesDict(s.evaluate(u, v, 2)); },
              py::arg("u"), py::arg("v"), "Point and first and second partial derivatives at (u, v).")
         .def("normal", &BSplineSurface::normal, py::arg("u"), py::arg("v"), "Unit normal du x dv / |du x dv|.")
+        .def("grid", [](const BSplineSurface& s, int nu, int nv) {
+            if (nu < 2 || nv < 2 || nu > 4096 || nv > 4096) throw std::invalid_argument("nu, nv: each must be in [2, 4096]");
+            const double u0 = s.knotsU().domainStart(), u1 = s.knotsU().domainEnd();
+            const double v0 = s.knotsV().domainStart(), v1 = s.knotsV().domainEnd();
+            py::array_t<double> points({nu, nv, 3}), normals({nu, nv, 3});
+            auto p = points.mutable_unchecked<3>();
+            auto n = normals.mutable_unchecked<3>();
+            {
+                py::gil_scoped_release release;
+                for (int i = 0; i < nu; ++i)
+                    for (int j = 0; j < nv; ++j) {
+                        const double u = u0 + (u1 - u0) * i / (nu - 1), v = v0 + (v1 - v0) * j / (nv - 1);
+                        const SurfaceDerivatives d = s.evaluate(u, v, 1);
+                        const Vec3 normal = s.normal(u, v);
+                        for (int k = 0; k < 3; ++k) {
+                            p(i, j, k) = d.s[k];
+                            n(i, j, k) = normal[k];
+                        }
+                    }
+            }
+            return py::make_tuple(points, normals);
+        }, py::arg("nu"), py::arg("nv"),
+           "Exact points and unit normals on an nu x nv grid evenly spaced over the domain (two (nu, nv, 3) "
+           "arrays), for displays that shade per pixel.")
         .def("curvature", [](const BSplineSurface& s, double u, double v) { return curvatureDict(s.curvature(u, v)); },
              py::arg("u"), py::arg("v"), "Normal curvature along u and v, principal (min, max), mean and Gaussian.");
 
