@@ -273,6 +273,8 @@ class Controller:
 
     def begin_paint_stroke(self) -> None:
         """Button down with the airbrush on: the first dab at the cursor."""
+        if self._paint_stroke is not None:
+            self.end_paint_stroke()  # a release that never reached the view still ends its stroke
         obj = self.active_sculpt()
         if obj is None or self.painting is None or self.mouse_point is None:
             return

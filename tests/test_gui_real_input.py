@@ -152,6 +152,24 @@ class Desktop:
         return x, y
 
 
+def patch_with_keyed_constraints(d: Desktop) -> tuple[dict, list[tuple[int, int]]]:
+    """ctrl+n, New patch, then P, N and C with the mouse over three points of it. Returns the state
+    and the screen pixels of the patch's centre, east, west, north and south points."""
+    d.xdo("key", "ctrl+n")  # a new document after the workbench was chosen
+    d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
+    s = d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+    d.calibrate()
+    points = [d.to_screen(p) for p in sculpt(s)["screen"]]
+    _, east, west, north, _ = points
+    for key, at, kind in (("p", east, "point"), ("n", west, "normal"), ("c", north, "curvature")):
+        d.xdo("mousemove", str(at[0]), str(at[1]))
+        d.wait(lambda s: s["mouse_point"] is not None, "the mouse over the patch")
+        time.sleep(0.2)
+        d.xdo("key", key)
+        d.wait(lambda s: kind in [c[0] for c in sculpt(s)["constraints"]], f"{key.upper()}: a {kind} constraint")
+    return d.state(), points
+
+
 def sculpt(s: dict) -> dict:
     return s["docs"][s["active"]]["sculpts"][0]
 
@@ -167,19 +185,8 @@ def test_workbench_first_keys_stroke_undo_redo_paint(tmp_path, style):
     d = Desktop(str(tmp_path), style)
     try:
         d.xdo("mousemove", "640", "500")
-        d.xdo("key", "ctrl+n")  # a new document after the workbench was chosen
-        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
-        s = d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        s, (centre, east, west, north, south) = patch_with_keyed_constraints(d)
         assert sculpt(s)["plasticity"][0], "a GUI patch is clay"
-        d.calibrate()
-        centre, east, west, north, south = [d.to_screen(p) for p in sculpt(s)["screen"]]
-        # keys at the mouse: P at one point, N at another, C at a third, M shows the map
-        for key, at, kind in (("p", east, "point"), ("n", west, "normal"), ("c", north, "curvature")):
-            d.xdo("mousemove", str(at[0]), str(at[1]))
-            d.wait(lambda s: s["mouse_point"] is not None, "the mouse over the patch")
-            time.sleep(0.2)
-            d.xdo("key", key)
-            d.wait(lambda s: kind in [c[0] for c in sculpt(s)["constraints"]], f"{key.upper()}: a {kind} constraint")
         d.xdo("key", "m")
         d.wait(lambda s: any(o["display"] == "mass" for o in s["overlays"]), "M: the map display")
         d.xdo("key", "m")
@@ -247,17 +254,7 @@ def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
         d.xdo("type", "session")
         d.xdo("mousemove", str(RECORD_BUTTON[0]), str(RECORD_BUTTON[1]), "click", "1")
         d.xdo("mousemove", "640", "500", "click", "1")
-        d.xdo("key", "ctrl+n")
-        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view")
-        s = d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
-        d.calibrate()
-        centre, east, west, north, south = [d.to_screen(p) for p in sculpt(s)["screen"]]
-        for key, at, kind in (("p", east, "point"), ("n", west, "normal"), ("c", north, "curvature")):
-            d.xdo("mousemove", str(at[0]), str(at[1]))
-            d.wait(lambda s: s["mouse_point"] is not None, "the mouse over the patch")
-            time.sleep(0.2)
-            d.xdo("key", key)
-            d.wait(lambda s: kind in [c[0] for c in sculpt(s)["constraints"]], f"a {kind} constraint")
+        s, (centre, east, west, north, south) = patch_with_keyed_constraints(d)
         d.press_button("PaintStiffness", lambda s: s["painting"] == "stiffness", "the airbrush")
         d.drag([west, ((west[0] + centre[0]) // 2, (west[1] + centre[1]) // 2), east], seconds=0.1)
         d.wait(lambda s: undo(s)[0] == "Paint stiffness", "the paint stroke")
