@@ -79,17 +79,18 @@ def zebra_colours(mesh: np.ndarray, view_direction: np.ndarray, stripes: float =
     return np.repeat(band[..., None], 3, axis=-1), (0.0, 1.0)
 
 
-def curvature_combs(mesh: np.ndarray, curv: np.ndarray, every: int = 4, scale: float | None = None) -> tuple[np.ndarray, float]:
+def curvature_combs(mesh: np.ndarray, curv: np.ndarray, every: int = 4, scale: float | None = None,
+                    gain: float = 1.0) -> tuple[np.ndarray, float]:
     """Curvature combs along the u and v iso-lines (every `every`-th line): for each mesh point on
     those lines a tooth from the point along the normal, of length scale * normal curvature along the
-    line. Returns segments (n, 2, 3) and the scale used (mm per 1/mm), chosen so the longest tooth
-    is a tenth of the patch size."""
+    line. Returns segments (n, 2, 3) and the scale used (mm per 1/mm): ``scale``, else one that makes
+    the longest tooth ``gain`` tenths of the patch size."""
     n = vertex_normals(mesh)
     g, h = mesh.shape[:2]
     size = float(np.linalg.norm(mesh.reshape(-1, 3).max(0) - mesh.reshape(-1, 3).min(0)))
     k_max = float(np.abs(curv[..., :2]).max()) if curv.size else 0.0
     if scale is None:
-        scale = 0.1 * size / k_max if k_max > 0 else 0.0
+        scale = 0.1 * gain * size / k_max if k_max > 0 else 0.0
     segs = []
     for i in range(0, g, every):  # iso-u lines: curvature along v
         tip = mesh[i] + n[i] * (scale * curv[i, :, 1])[:, None]

@@ -15,7 +15,7 @@ TOOLBAR = ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Ses
            "HapticSculpt_CurvatureConstraint", "HapticSculpt_PaintMass", "HapticSculpt_PaintDamping",
            "HapticSculpt_PaintStiffness", "HapticSculpt_ShowMap", "HapticSculpt_ShowCurvature",
            "HapticSculpt_Combs", "HapticSculpt_Zebra", "HapticSculpt_ZebraMode", "HapticSculpt_ZebraStripes",
-           "HapticSculpt_Panel", "HapticSculpt_Thicken",
+           "HapticSculpt_Panel", "HapticSculpt_CombDensity", "HapticSculpt_CombScale", "HapticSculpt_Thicken",
            "HapticSculpt_ExportStep"]
 
 
@@ -287,6 +287,30 @@ class Combs(_SculptCommand):
             ov.refresh()
 
 
+class CombDensity(_SculptCommand):
+    icon_name, menu = "Combs", "Combs: density"
+    tip = "Cycle how many iso-lines carry a curvature comb: every 2nd, 4th or 8th"
+
+    def Activated(self) -> None:
+        ov = _ctl().overlay()
+        if ov is not None:
+            ov.comb_every = {2: 4, 4: 8}.get(ov.comb_every, 2)
+            ov.combs = True
+            ov.refresh()
+
+
+class CombScale(_SculptCommand):
+    icon_name, menu = "Combs", "Combs: scale"
+    tip = "Cycle the combs' length: the longest tooth 0.5, 1 or 2 tenths of the patch size"
+
+    def Activated(self) -> None:
+        ov = _ctl().overlay()
+        if ov is not None:
+            ov.comb_gain = {0.5: 1.0, 1.0: 2.0}.get(ov.comb_gain, 0.5)
+            ov.combs = True
+            ov.refresh()
+
+
 class Zebra(_SculptCommand):
     icon_name, menu = "Zebra", "Zebra stripes"
     tip = "Toggle zebra stripes (reflection lines) for class-A continuity inspection"
@@ -342,4 +366,5 @@ COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_SculptFace": Sculpt
             "HapticSculpt_PaintStiffness": PaintStiffness, "HapticSculpt_ShowMap": ShowMap,
             "HapticSculpt_ShowCurvature": ShowCurvature, "HapticSculpt_Combs": Combs, "HapticSculpt_Zebra": Zebra,
             "HapticSculpt_ZebraMode": ZebraMode, "HapticSculpt_ZebraStripes": ZebraStripes,
+            "HapticSculpt_CombDensity": CombDensity, "HapticSculpt_CombScale": CombScale,
             "HapticSculpt_Panel": Panel, "HapticSculpt_Thicken": Thicken, "HapticSculpt_ExportStep": ExportStep}

@@ -34,6 +34,8 @@ class Overlay:
         self.view, self.obj = view, obj
         self.display = "shading"
         self.combs = False
+        self.comb_every = 4  # a comb on every n-th iso-line of the mesh (density)
+        self.comb_gain = 1.0  # the longest tooth is this many tenths of the patch size (scale)
         self.panel_visible = False
         self.panel = SliderPanel()
         self.cursor: tuple[np.ndarray, np.ndarray, bool] | None = None  # position, quaternion (w, x, y, z), grab
@@ -145,7 +147,8 @@ class Overlay:
         decor = coin.SoSeparator()
         decor.addChild(light)
         if self.combs:
-            segments, _ = analysis.curvature_combs(mesh, s.curvature_grid().reshape(mesh.shape[:2] + (6,)))
+            segments, _ = analysis.curvature_combs(mesh, s.curvature_grid().reshape(mesh.shape[:2] + (6,)),
+                                                   every=self.comb_every, gain=self.comb_gain)
             decor.addChild(shapes.lines(segments, (1.0, 0.0, 1.0), 1.0))
         decor.addChild(self._jacks(s, mesh))
         if self.cursor is not None:
@@ -184,6 +187,8 @@ class Overlay:
             parts.append("sculpting")
         if self.display == "zebra":
             parts.append(f"zebra: {self.stripe_mode}, {self.stripes:g} stripes")
+        if self.combs:
+            parts.append(f"combs: every {self.comb_every}, x{self.comb_gain:g}")
         if self.mode:
             parts.append(self.mode)
         return "  |  ".join(parts)

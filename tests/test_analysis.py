@@ -51,6 +51,11 @@ def test_combs_point_along_the_normal_and_scale_with_curvature():
     teeth = np.linalg.norm(segs[:, 1] - segs[:, 0], axis=1)
     size = np.linalg.norm(mesh.reshape(-1, 3).max(0) - mesh.reshape(-1, 3).min(0))
     assert np.isclose(teeth.max(), 0.1 * size, rtol=1e-6)
+    # the GUI's scale (gain) and density (every) controls
+    longer, doubled = analysis.curvature_combs(mesh, curv, every=5, gain=2.0)
+    assert np.isclose(doubled, 2 * scale) and len(longer) == len(segs)
+    denser, _ = analysis.curvature_combs(mesh, curv, every=2)
+    assert len(denser) > 2 * len(segs)
 
 
 def test_map_colours_resample_a_painted_map():

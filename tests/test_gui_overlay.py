@@ -210,6 +210,10 @@ try:
         sess.stop(commit=False)
     out["sim_hz_overlay_off"], out["sim_hz_overlay_on"] = rates[False], rates[True]
     ctl.set_display("shading")
+    Gui.runCommand("HapticSculpt_CombDensity")
+    Gui.runCommand("HapticSculpt_CombScale")
+    out["combs_controls"] = [ov.combs, ov.comb_every, ov.comb_gain]
+    Gui.runCommand("HapticSculpt_Combs")  # (off: the density command switched them on)
     Gui.runCommand("HapticSculpt_Combs")
     Gui.runCommand("HapticSculpt_Panel")
     ov.cursor = (np.array(ov.panel.layout(np.array(surface.mesh))["stiffness"][0]), np.array([1.0, 0, 0, 0]), False)
@@ -278,6 +282,7 @@ def test_overlay_commands_keys_and_pictures(tmp_path):
     assert out["strokes"] >= 1
     assert out["panel_stiffness"] > 5e4 and out["undo_after_panel"] == "Set stiffness"
     assert out["displays"] == ["curvature", "mean", "gauss", "mass", "damping", "stiffness", "zebra"]
+    assert out["combs_controls"] == [True, 8, 2.0]
     assert out["m_key"] == "stiffness" and out["m_key_back"] == "shading" and not out["timer_after_off"]
     import matplotlib.image as mpimg
 
