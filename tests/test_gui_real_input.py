@@ -372,3 +372,47 @@ def test_save_quit_reopen_and_a_restarted_session_stays_still(tmp_path):
         assert undo(s) == [], undo(s)
     finally:
         d.close()
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_keys_follow_the_view_across_documents_opened_switched_and_closed(tmp_path):
+    """Two documents opened after the workbench was chosen, switched with ctrl+tab, one closed:
+    the keys act in whichever view has the mouse, on that view's sculpt."""
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        d.xdo("mousemove", "640", "500")
+        first, _ = patch_with_keyed_constraints(d)
+        first_doc = first["active"]
+        d.xdo("key", "ctrl+n")  # a second document and view, the workbench still active
+        d.wait(lambda s: len(s["docs"]) == 2 and s["inputs"] == 2, "the second view to be attached")
+        s = d.press_button("NewPatch", lambda s: s["active"] != first_doc and s["docs"][s["active"]]["sculpts"],
+                           "a patch in the second document")
+        d.calibrate()
+        _, east, _, _, _ = [d.to_screen(p) for p in sculpt(s)["screen"]]
+        d.xdo("mousemove", str(east[0]), str(east[1]))
+        d.wait(lambda s: s["mouse_point"] is not None, "the mouse over the second patch")
+        time.sleep(0.2)
+        d.xdo("key", "p")
+        s = d.wait(lambda s: sculpt(s)["constraints"] == [["point", sculpt(s)["constraints"][0][1]]],
+                   "P in the second document")
+        assert len(s["docs"][first_doc]["sculpts"][0]["constraints"]) == 3  # the first one untouched
+        d.xdo("key", "ctrl+Tab")  # back to the first document's view
+        d.wait(lambda s: s["active"] == first_doc, "ctrl+tab to the first document")
+        d.xdo("mousemove", "640", "520")
+        time.sleep(0.3)
+        d.xdo("key", "m")
+        d.wait(lambda s: any(o["display"] == "mass" for o in s["overlays"]), "M in the first document")
+        d.xdo("key", "ctrl+Tab")
+        second = d.wait(lambda s: s["active"] != first_doc, "ctrl+tab to the second document")["active"]
+        d.xdo("key", "ctrl+w")  # close the second document's window; FreeCAD asks whether to save it
+        time.sleep(1.0)
+        d.shot("close_question")
+        d.xdo("key", "alt+d")  # "Discard"
+        d.wait(lambda s: second not in s["docs"] and s["inputs"] == 1, "the closed view forgotten")
+        d.focus()
+        d.xdo("mousemove", "640", "520")
+        time.sleep(0.3)
+        d.xdo("key", "m")
+        d.wait(lambda s: all(o["display"] == "shading" for o in s["overlays"]), "M still works after the close")
+    finally:
+        d.close()
