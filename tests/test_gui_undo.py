@@ -1,0 +1,71 @@
+"""Every GUI command that edits a sculpt is one undo step, named for what it did: undo gives back
+the state before it and redo the state after it, bit for bit (FreeCAD's GUI under Xvfb; the real
+X-event tests cover the keys, strokes and paint, this covers each command)."""
+from __future__ import annotations
+
+import pytest
+
+from freecad_support import GUI_AVAILABLE, run_freecad_gui
+
+GUI_SCRIPT = """
+import json, os, sys, traceback
+import FreeCAD, FreeCADGui as Gui
+out = {"steps": []}
+try:
+    Gui.activateWorkbench("HapticSculptWorkbench")
+    import HapticSculpt
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(HapticSculpt.__file__)), "tests", "gui_input"))
+    from observer_digest import digest
+    doc = FreeCAD.newDocument("Undo")
+    Gui.runCommand("HapticSculpt_NewPatch")
+    obj = doc.getObject("Sculpt")
+    Gui.Selection.addSelection(obj)
+    from HapticSculpt.gui import controller
+    from HapticSculpt.panel import SliderPanel
+    import numpy as np
+    ctl = controller()
+    ctl.mouse_point = np.array(obj.Proxy.live.snapshot().mesh)[10, 10]
+    steps = [("HapticSculpt_Material", None), ("HapticSculpt_Material", None), ("HapticSculpt_ToolMagnet", None),
+             ("HapticSculpt_MagnetFalloff", None), ("HapticSculpt_ToolOrientation", None),
+             ("HapticSculpt_ToolSmooth", None), ("HapticSculpt_ToolRope", None),
+             ("HapticSculpt_PointConstraint", None), ("HapticSculpt_NormalConstraint", None),
+             ("HapticSculpt_CurvatureConstraint", None), ("HapticSculpt_PointConstraint", None),
+             ("slider", ("stiffness", 250.0)), ("slider", ("curvature_u", 0.01)), ("HapticSculpt_KeepShape", None)]
+    for command, arg in steps:
+        if command == "HapticSculpt_KeepShape":  # (a pulled shape to keep: a flat one is kept already)
+            HapticSculpt.run(obj, 0.6, device=HapticSculpt.ReplayDevice.stroke((0, 0, 0), (0, 0, 20.0), seconds=0.5))
+        before, count = digest(obj), doc.UndoCount
+        if command == "slider":
+            SliderPanel.apply(obj, *arg)
+        else:
+            Gui.runCommand(command)
+        after = digest(obj)
+        name = doc.UndoNames[0] if doc.UndoCount > count else None
+        doc.undo()
+        undone = digest(obj)
+        doc.redo()
+        redone = digest(obj)
+        out["steps"].append({"command": command if command != "slider" else "slider " + arg[0],
+                             "new_steps": doc.UndoCount - count, "name": name, "changed": after != before,
+                             "undo_exact": undone == before, "redo_exact": redone == after})
+except Exception:
+    out["error"] = traceback.format_exc()
+json.dump(out, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+def test_every_editing_command_is_one_exact_undo_step(tmp_path):
+    out = run_freecad_gui(GUI_SCRIPT, str(tmp_path))
+    names = {"HapticSculpt_Material": "Material: ", "HapticSculpt_ToolMagnet": "Tool: magnet",
+             "HapticSculpt_MagnetFalloff": "Tool: magnet", "HapticSculpt_ToolOrientation": "Tool: orientation",
+             "HapticSculpt_ToolSmooth": "Tool: smooth", "HapticSculpt_ToolRope": "Tool: rope",
+             "HapticSculpt_PointConstraint": "constraint", "HapticSculpt_NormalConstraint": "Add normal constraint",
+             "HapticSculpt_CurvatureConstraint": "Add curvature constraint", "slider stiffness": "Set stiffness",
+             "slider curvature_u": "Set curvature", "HapticSculpt_KeepShape": "Keep shape"}
+    for step in out["steps"]:
+        assert step["new_steps"] == 1 and step["changed"], step
+        assert names[step["command"]] in step["name"], step
+        assert step["undo_exact"] and step["redo_exact"], step
+    assert len(out["steps"]) == 14
