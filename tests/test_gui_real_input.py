@@ -236,6 +236,12 @@ def test_workbench_first_keys_stroke_undo_redo_paint(tmp_path, style):
         lo, hi, n = sculpt(s)["stiffness_map"]
         assert n > 1 and hi > 2 * lo
         assert undo(s)[1] == before
+        # one continuous line, not separate blobs: the painted part of the map is one connected region
+        from scipy import ndimage
+        values = np.array(sculpt(s)["stiffness_values"])
+        side = int(round(np.sqrt(values.size)))
+        _, regions = ndimage.label(values.reshape(side, side) > 1.05 * lo)
+        assert regions == 1, f"the stroke left {regions} separate blobs"
     finally:
         d.close()
 

@@ -29,6 +29,7 @@ def _sculpts(doc):
                     "constraints": [[c["kind"], c["index"]] for c in settings.get("constraints", [])],
                     "plasticity": settings.get("plasticity"), "tool": settings.get("tool", {}).get("name"),
                     "stiffness_map": [min(o.StiffnessMap), max(o.StiffnessMap), len(o.StiffnessMap)],
+                    "stiffness_values": list(o.StiffnessMap),
                     "session": o.Proxy.live.session is not None if getattr(o.Proxy, "live", None) else False,
                     "selected": o in Gui.Selection.getSelection(), "screen": _on_screen(o), "digest": digest(o)})
     return out
