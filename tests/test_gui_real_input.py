@@ -60,6 +60,18 @@ class Desktop:
         self.wait(lambda s: s.get("workbench") == "HapticSculptWorkbench", "FreeCAD starting on the workbench", 120)
         self.focus()
 
+    def wait_window(self, title: str, timeout: float = 20.0) -> None:
+        """Waits until a window whose title contains ``title`` is shown (a dialog FreeCAD opened)."""
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            found = subprocess.run(["xdotool", "search", "--onlyvisible", "--name", title], env=self.env,
+                                   capture_output=True, text=True).stdout.split()
+            if found:
+                return
+            time.sleep(0.05)
+        self.shot("timeout")
+        raise AssertionError(f"timed out waiting for the window {title!r}")
+
     def focus(self) -> None:
         """Keyboard focus to FreeCAD's main window (what clicking its title bar does on a desktop)."""
         window = self.xdo("search", "--name", "FreeCAD").split()[-1]
@@ -255,7 +267,7 @@ def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
     try:
         d.xdo("key", "alt+m")  # Macro > Macro recording...
         d.xdo("key", "m")
-        time.sleep(1.0)  # (the dialog has no state the observer can see)
+        d.wait_window("Macro recording")
         d.xdo("key", "ctrl+a")
         d.xdo("type", "session")
         d.xdo("mousemove", str(RECORD_BUTTON[0]), str(RECORD_BUTTON[1]), "click", "1")
@@ -348,7 +360,7 @@ def test_save_quit_reopen_and_a_restarted_session_stays_still(tmp_path):
         time.sleep(0.5)
         saved = sculpt(d.state())["digest"]
         d.xdo("key", "ctrl+s")  # FreeCAD's save dialog: the file name, then Enter
-        time.sleep(1.5)
+        d.wait_window("Save FreeCAD Document")
         d.xdo("type", path)
         d.xdo("key", "Return")
         d.wait(lambda s: s["docs"][s["active"]]["file"] == path, "the document saved")
@@ -411,7 +423,7 @@ def test_keys_follow_the_view_across_documents_opened_switched_and_closed(tmp_pa
         d.xdo("key", "ctrl+Tab")
         second = d.wait(lambda s: s["active"] != first_doc, "ctrl+tab to the second document")["active"]
         d.xdo("key", "ctrl+w")  # close the second document's window; FreeCAD asks whether to save it
-        time.sleep(1.0)
+        d.wait_window("Unsaved document")  # FreeCAD's question
         d.shot("close_question")
         d.xdo("key", "alt+d")  # "Discard"
         d.wait(lambda s: second not in s["docs"] and s["inputs"] == 1, "the closed view forgotten")
