@@ -81,7 +81,8 @@ test-gui-repeat: build ocp-venv
 	set -eo pipefail; for i in $$(seq $(GUI_REPEAT)); do echo "== run $$i of $(GUI_REPEAT)"; \
 	  ctest --test-dir $(BUILD)/release --output-on-failure -R "HapticRuntime" | tail -1; \
 	  HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) -m pytest -q -p no:cacheprovider \
-	    tests/test_gui_real_input.py tests/test_gui_overlay.py tests/test_gui_workbench.py tests/test_freecad_session.py | tail -1; \
+	    tests/test_gui_real_input.py tests/test_gui_overlay.py tests/test_gui_workbench.py tests/test_gui_undo.py \
+	    tests/test_freecad_session.py | tail -1; \
 	done
 
 # libFuzzer on the HID parsers (clang; FUZZ_SECONDS per harness), seeded with the recorded
