@@ -141,6 +141,8 @@ class LiveSurface:
         a copy configured from the document with the newest shape, which the session swaps in
         between two steps without letting go of the device (the transaction follows when the
         simulation has applied it). ``keep_shape`` then makes the current shape the rest shape."""
+        if self._session is not None and not self._session.running:
+            self._session.stop()  # its loops ended by themselves: commit its strokes, take the surface back
         if self._session is None:
             surface = self.surface
             result = change(surface)

@@ -214,3 +214,17 @@ class TestEditsDuringASession(DocumentTestCase):
         self.doc.undo()  # keep shape
         self.doc.undo()  # the paint
         self.assertEqual(float(np.max(obj.Proxy.surface.stiffness_map.values)), 150.0)
+
+    def test_an_edit_after_the_loops_ended_by_themselves_is_not_lost(self):
+        obj = hs.make_sculpt(self.doc)
+        session = hs.Session().start(obj, hs.ReplayDevice.stroke((0, 0, 0), (0, 0, 10.0), seconds=0.3),
+                                     stop_when_finished=True)
+        end = time.monotonic() + 20
+        while session.running:  # (nobody polls: the replay plays out and the loops stop by themselves)
+            self.assertLess(time.monotonic(), end)
+            time.sleep(0.01)
+        cid = hs.add_constraint(obj, "point", uv=(0.0, 0.0))
+        self.assertIsNone(obj.Proxy.live.session)  # the ended session was stopped, its stroke committed
+        self.assertEqual(self.doc.UndoNames[0], "Add point constraint")
+        self.assertIn("Sculpt stroke", self.doc.UndoNames)
+        self.assertIn(cid, [c["id"] for c in obj.Proxy.surface.constraints])
