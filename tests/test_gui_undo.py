@@ -69,3 +69,59 @@ def test_every_editing_command_is_one_exact_undo_step(tmp_path):
         assert names[step["command"]] in step["name"], step
         assert step["undo_exact"] and step["redo_exact"], step
     assert len(out["steps"]) == 14
+
+
+EDIT_SCRIPT = """
+import json, time, traceback
+import numpy as np
+import FreeCAD, FreeCADGui as Gui
+out = {}
+try:
+    Gui.activateWorkbench("HapticSculptWorkbench")
+    import HapticSculpt as hs
+    from HapticSculpt.gui import controller
+    from HapticSculpt.panel import SliderPanel
+    doc = FreeCAD.newDocument("Edits")
+    Gui.runCommand("HapticSculpt_NewPatch")
+    obj = doc.getObject("Sculpt")
+    Gui.Selection.addSelection(obj)
+    ctl = controller()
+    held = hs.ReplayDevice.stroke((0, 0, 0), (0, 0, 20.0), seconds=0.5, hold=30.0)
+    session = ctl.start_session(held)  # polled by the GUI's own timer from here on
+
+    def pump_until(condition, seconds=20.0):
+        end = time.monotonic() + seconds
+        while not condition() and time.monotonic() < end:
+            Gui.updateGui()
+            time.sleep(0.01)
+        return condition()
+    out["pulled"] = pump_until(lambda: np.linalg.norm(session.status()["force"]) > 1.0 and
+                               session.status()["elapsed"] > 1.0)
+    undo_before = doc.UndoCount
+    SliderPanel.apply(obj, "stiffness", 250.0)                 # the slider, released
+    Gui.runCommand("HapticSculpt_ToolMagnet")                   # a tool switch
+    ctl.mouse_point = np.array(obj.Proxy.live.snapshot().mesh)[5, 5]
+    Gui.runCommand("HapticSculpt_PointConstraint")              # a constraint at the mouse
+    out["applied"] = pump_until(lambda: len(session.applied_edits) >= 3)
+    out["still_running"] = session.running
+    out["edits"] = session.applied_edits
+    out["undo"] = doc.UndoNames[:doc.UndoCount - undo_before]
+    doc.undo()  # the constraint, while the session runs
+    out["undo_restored"] = pump_until(lambda: not obj.Proxy.live.snapshot().constraints)
+    ctl.stop_session()
+except Exception:
+    out["error"] = traceback.format_exc()
+json.dump(out, open({answer}, "w"))
+import os
+os._exit(0)
+"""
+
+
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+def test_gui_edits_reach_a_running_session_and_undo_restores_it_in_place(tmp_path):
+    out = run_freecad_gui(EDIT_SCRIPT, str(tmp_path))
+    assert out["pulled"] and out["applied"] and out["still_running"], out
+    assert [e["title"] for e in out["edits"]] == ["Set stiffness", "Tool: magnet", "Add point constraint"], out
+    assert all(e["applied_step"] - e["posted_step"] <= 2 for e in out["edits"]), out["edits"]
+    assert out["undo"] == ["Add point constraint", "Tool: magnet", "Set stiffness"], out["undo"]
+    assert out["undo_restored"]
