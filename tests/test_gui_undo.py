@@ -104,7 +104,7 @@ try:
     Gui.runCommand("HapticSculpt_PointConstraint")              # a constraint at the mouse
     out["applied"] = pump_until(lambda: len(session.applied_edits) >= 3)
     out["still_running"] = session.running
-    out["edits"] = session.applied_edits
+    out["edits"] = list(session.applied_edits)  # (a copy: the undo below adds its restore)
     out["undo"] = doc.UndoNames[:doc.UndoCount - undo_before]
     doc.undo()  # the constraint, while the session runs
     out["undo_restored"] = pump_until(lambda: not obj.Proxy.live.snapshot().constraints)
