@@ -61,16 +61,19 @@ class Desktop:
         self.focus()
 
     def wait_window(self, title: str, timeout: float = 20.0) -> None:
-        """Waits until a window whose title contains ``title`` is shown (a dialog FreeCAD opened)."""
+        """Waits until a window whose title contains ``title`` is shown (a dialog FreeCAD opened) and
+        has the keyboard (keys typed before that go elsewhere: a path lost its leading '/')."""
         end = time.monotonic() + timeout
         while time.monotonic() < end:
             found = subprocess.run(["xdotool", "search", "--onlyvisible", "--name", title], env=self.env,
                                    capture_output=True, text=True).stdout.split()
-            if found:
+            focus = subprocess.run(["xdotool", "getwindowfocus", "-f"], env=self.env, capture_output=True,
+                                   text=True).stdout.strip()
+            if found and focus in found:
                 return
             time.sleep(0.05)
         self.shot("timeout")
-        raise AssertionError(f"timed out waiting for the window {title!r}")
+        raise AssertionError(f"timed out waiting for the window {title!r} to have the keyboard")
 
     def focus(self) -> None:
         """Keyboard focus to FreeCAD's main window (what clicking its title bar does on a desktop)."""
