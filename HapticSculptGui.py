@@ -11,6 +11,6 @@ def register() -> None:
     """Adds every HapticSculpt command to FreeCAD (once, from the workbench's Initialize)."""
     import FreeCADGui as Gui
 
-    from HapticSculpt import commands
+    from HapticSculpt.gui import commands
     for name, cls in commands.COMMANDS.items():
         Gui.addCommand(name, cls())

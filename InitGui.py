@@ -1,5 +1,6 @@
-# HapticSculpt workbench (GUI start-up). Imports are lazy: nothing loads until the workbench is
-# activated. No Qt/PySide import anywhere in the project.
+# HapticSculpt workbench (GUI start-up). At start-up only the package and its GUI layer's hooks
+# load (so sculpts made or opened from a script show as they should); commands, overlay and input
+# load when the workbench is activated. No Qt/PySide import anywhere in the project.
 import FreeCADGui as Gui
 
 
@@ -11,24 +12,25 @@ class HapticSculptWorkbench(Gui.Workbench):
 
     def __init__(self):
         import os
+
         import HapticSculpt
         self.__class__.Icon = os.path.join(os.path.dirname(HapticSculpt.__file__), "resources", "icons",
                                            "HapticSculpt.svg")
 
     def Initialize(self):
         import HapticSculptGui
-        from HapticSculpt import commands
+        from HapticSculpt.gui import commands
         HapticSculptGui.register()
         self.appendToolbar("HapticSculpt", commands.TOOLBAR)
         self.appendMenu("HapticSculpt", commands.TOOLBAR)
 
     def Activated(self):
-        from HapticSculpt.gui import controller
+        from HapticSculpt.gui.workbench import controller
         controller().activate()  # the mouse and the keys P, N, C, M in every 3D view, now and later
 
     def Deactivated(self):
         import HapticSculpt
-        from HapticSculpt.gui import controller
+        from HapticSculpt.gui.workbench import controller
         controller().shutdown()
         HapticSculpt.stop_all()  # leaving the workbench ends every sculpting session
 

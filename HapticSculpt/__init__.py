@@ -1,17 +1,39 @@
 """HapticSculpt: sculpt dynamic B-spline surfaces in FreeCAD (Dachille, Qin, Kaufman, El-Sana).
 
-The dynamics core is :mod:`HapticSculpt.core`; the scripting API below imports FreeCAD only when a
-function that needs it is called, so importing this package never imports FreeCAD or a GUI.
+Layers, each importing only those before it: :mod:`HapticSculpt.core` (the C++ dynamics core),
+:mod:`HapticSculpt.app` (the document layer and the scripting API), :mod:`HapticSculpt.runtime`
+(threaded sessions and devices) and :mod:`HapticSculpt.gui` (the workbench, imported only while
+FreeCAD's GUI runs). The scripting API below imports FreeCAD only when a function that needs it is
+called, so importing this package never imports FreeCAD or a GUI.
 """
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
-from .api import (RunReport, add_constraint, export_step, keep_shape, make_sculpt, material_of, paint,
-                  remove_constraint, run, set_curvature_target, set_material, set_tool, set_uniform, thicken,
-                  to_cadquery)
-from .replay_device import CursorSample, ReplayDevice
-from .session import Session, stop_all
+from . import legacy_paths
+from .app.api import (
+                      CursorSource,
+                      RunReport,
+                      add_constraint,
+                      export_step,
+                      keep_shape,
+                      make_sculpt,
+                      material_of,
+                      paint,
+                      remove_constraint,
+                      run,
+                      set_curvature_target,
+                      set_material,
+                      set_tool,
+                      set_uniform,
+                      thicken,
+                      to_cadquery,
+)
+from .runtime.replay_device import CursorSample, ReplayDevice
+from .runtime.session import Session, stop_all
+
+legacy_paths.install()
 
 __all__ = ["make_sculpt", "run", "add_constraint", "remove_constraint", "set_material", "material_of", "keep_shape",
            "set_tool", "set_uniform", "set_curvature_target", "paint",
            "export_step", "thicken",
-           "to_cadquery", "ReplayDevice", "CursorSample", "RunReport", "Session", "stop_all", "__version__"]
+           "to_cadquery", "ReplayDevice", "CursorSample", "CursorSource", "RunReport", "Session", "stop_all",
+           "__version__"]

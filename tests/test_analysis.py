@@ -1,7 +1,8 @@
 """Class-A analysis colours and geometry (HapticSculpt/analysis.py), in console mode."""
 import numpy as np
 
-from HapticSculpt import analysis, core
+from HapticSculpt import core
+from HapticSculpt.app import analysis
 
 
 def dome(n=30):

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from HapticSculpt import core
-from HapticSculpt.part_surface import part_bspline
+from HapticSculpt.app.part_surface import part_bspline
 
 import FreeCAD  # noqa: E402  (FreeCAD is a hard test dependency: `make test` installs it; import it before Part)
 import Part  # noqa: E402

@@ -9,9 +9,10 @@ import time
 import numpy as np
 import pytest
 
-from HapticSculpt import _core, core, devices
-from HapticSculpt.replay_device import ReplayDevice
-from HapticSculpt.devices import native_device
+from HapticSculpt import _core, core
+from HapticSculpt.runtime import devices
+from HapticSculpt.runtime.replay_device import ReplayDevice
+from HapticSculpt.runtime.devices import native_device
 
 FIXTURES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fixtures", "hid")
 

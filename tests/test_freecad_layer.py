@@ -13,7 +13,7 @@ import Part
 
 import HapticSculpt as hs
 from HapticSculpt import core
-from HapticSculpt.part_surface import compress_knots
+from HapticSculpt.app.part_surface import compress_knots
 
 if "/usr/share/freecad/Mod/Part" not in sys.path:
     sys.path.append("/usr/share/freecad/Mod/Part")  # BOPTools, on FreeCAD's own path in freecadcmd

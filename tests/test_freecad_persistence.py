@@ -3,19 +3,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from freecad_support import DocumentTestCase, run_freecadcmd
+from freecad_support import ROOT, DocumentTestCase, run_freecadcmd
 
 import FreeCAD
 
 import HapticSculpt as hs
-from HapticSculpt import sculpt_state
-from HapticSculpt.sculpt_feature import read_state
+from HapticSculpt.app import sculpt_state
+from HapticSculpt.app.sculpt_properties import read_state
 
 # Run in the new process: open the file, rebuild every sculpt, step each the same way, report all
 # state as float.hex so the comparison is bit for bit.
 REPORT_SCRIPT = """
 import FreeCAD, HapticSculpt
-from HapticSculpt import sculpt_state
+from HapticSculpt.app import sculpt_state
 doc = FreeCAD.openDocument(PATH)
 out = {}
 for obj in doc.Objects:
@@ -99,6 +99,26 @@ class TestPersistence(DocumentTestCase):
         for prop in ("Strokes", "SculptError", "ConversionMethod"):
             self.assertIn(prop, got["properties"])
 
+
+    def test_a_document_saved_by_version_0_1_opens_with_its_shape(self):
+        """0.1 stored its proxies as HapticSculpt.sculpt_feature / .view_provider, before the
+        package was split into layers (the fixture was saved by 0.1's GUI)."""
+        fixtures = f"{ROOT}/tests/fixtures/documents"
+        got = run_freecadcmd(f"""
+import numpy as np
+import FreeCAD, HapticSculpt
+doc = FreeCAD.openDocument({fixtures + '/sculpt_0_1.FCStd'!r})
+obj = doc.getObject("Sculpt")
+poles = np.asarray(obj.Proxy.live.snapshot().poles)
+HapticSculpt.set_material(obj, "clay")
+doc.recompute()
+answer({{"module": type(obj.Proxy).__module__, "poles": poles.ravel().tolist(),
+         "valid": obj.Shape.isValid(), "error": obj.SculptError, "material": HapticSculpt.material_of(obj)}})
+""", self.tmp)
+        self.assertEqual(got["module"], "HapticSculpt.app.sculpt_feature")
+        np.testing.assert_array_equal(got["poles"], np.load(f"{fixtures}/sculpt_0_1_poles.npy").ravel())
+        self.assertTrue(got["valid"])
+        self.assertEqual((got["error"], got["material"]), ("", "clay"))
     def test_corrupt_properties_give_a_clear_error_on_that_object_only(self):
         box = self.doc.addObject("Part::Box", "Box")
         good = hs.make_sculpt(self.doc, name="Good")

@@ -7,7 +7,7 @@ import numpy as np
 from freecad_support import ROOT, DocumentTestCase, run_ocp
 
 import HapticSculpt as hs
-from HapticSculpt.part_surface import compress_knots
+from HapticSculpt.app.part_surface import compress_knots
 
 READ_STEP = """
 import json

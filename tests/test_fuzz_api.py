@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from HapticSculpt import _core, core
-from HapticSculpt.replay_device import ReplayDevice
+from HapticSculpt.runtime.replay_device import ReplayDevice
 
 SETTINGS = settings(max_examples=1000, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])

@@ -37,8 +37,8 @@ def shot(name):
 
 try:
     Gui.activateWorkbench("HapticSculptWorkbench")
-    from HapticSculpt import commands
-    from HapticSculpt.gui import controller
+    from HapticSculpt.gui import commands
+    from HapticSculpt.gui.workbench import controller
     import HapticSculpt as hs
     for name, cls in commands.COMMANDS.items():
         out["inactive"][name] = bool(cls().IsActive())  # no document yet
@@ -144,7 +144,7 @@ try:
     Gui.runCommand("HapticSculpt_PaintDamping")  # off again
     # the SpaceMouse path: with one listed, the Start command takes it over the mouse (a recorded
     # SpaceMouse stands in for the hardware, whose reports issue 4's device tests replay)
-    from HapticSculpt import devices as hsdev
+    from HapticSculpt.runtime import devices as hsdev
     listed, opener = hsdev.list_devices, hsdev.spacemouse
     hsdev.list_devices = lambda: [{{"spacemouse": True, "kind": "spacemouse", "path": "/dev/hidraw-recorded"}}]
     hsdev.spacemouse = lambda path=None, **kw: opener(recording={recording!r}, **kw)  # the defaults: rate control
@@ -176,7 +176,7 @@ try:
         out["frame_ms_" + name] = float(np.median(frames))
         shot(name)
     # zebra per pixel against per vertex, on the sculpted patch at 1x and 4x zoom
-    from HapticSculpt import stripes as stripe_shading
+    from HapticSculpt.gui import stripes as stripe_shading
     out["glsl"] = stripe_shading.shaders_work()
     ctl.set_display("zebra")
     for per_pixel in (True, False):

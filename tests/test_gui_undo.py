@@ -20,8 +20,8 @@ try:
     Gui.runCommand("HapticSculpt_NewPatch")
     obj = doc.getObject("Sculpt")
     Gui.Selection.addSelection(obj)
-    from HapticSculpt.gui import controller
-    from HapticSculpt.panel import SliderPanel
+    from HapticSculpt.gui.workbench import controller
+    from HapticSculpt.gui.panel import SliderPanel
     import numpy as np
     ctl = controller()
     ctl.mouse_point = np.array(obj.Proxy.live.snapshot().mesh)[10, 10]
@@ -79,8 +79,8 @@ out = {}
 try:
     Gui.activateWorkbench("HapticSculptWorkbench")
     import HapticSculpt as hs
-    from HapticSculpt.gui import controller
-    from HapticSculpt.panel import SliderPanel
+    from HapticSculpt.gui.workbench import controller
+    from HapticSculpt.gui.panel import SliderPanel
     doc = FreeCAD.newDocument("Edits")
     Gui.runCommand("HapticSculpt_NewPatch")
     obj = doc.getObject("Sculpt")

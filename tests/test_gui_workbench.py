@@ -40,7 +40,7 @@ try:
     for _ in range(5):
         Gui.updateGui()
     view.saveImage({png!r}, 800, 600, "White")
-    from HapticSculpt.devices import MouseDevice
+    from HapticSculpt.gui.mouse_device import MouseDevice
     mouse = MouseDevice()
     mouse.attach(view)
     size = view.getSize()
@@ -71,6 +71,10 @@ try:
     Gui.activateWorkbench("PartWorkbench")
     Gui.updateGui()
     out["workbench_stop"] = [running_before, session2.running]
+    # A document saved by 0.1 (module paths from before the layer split) opens with its view provider.
+    old = FreeCAD.openDocument({legacy!r})
+    vp = old.getObject("Sculpt").ViewObject.Proxy
+    out["legacy_view_provider"] = [type(vp).__module__, os.path.basename(vp.getIcon())]
 except Exception:
     out["error"] = traceback.format_exc()
 json.dump(out, open({answer}, "w"))
@@ -84,7 +88,9 @@ def test_workbench_loads_and_commands_run(tmp_path):
     png = os.path.join(ROOT, "build", "screenshots", "gui_workbench.png")
     if os.path.exists(png):
         os.remove(png)
-    out = run_freecad_gui(GUI_SCRIPT.format(png=png, answer="{answer}"), str(tmp_path))
+    legacy = os.path.join(ROOT, "tests", "fixtures", "documents", "sculpt_0_1.FCStd")
+    out = run_freecad_gui(GUI_SCRIPT.format(png=png, legacy=legacy, answer="{answer}"), str(tmp_path))
+    assert "error" not in out, out["error"]
     assert out["workbench"] == "HapticSculptWorkbench"
     assert set(out["commands"]) >= {"HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Thicken",
                                     "HapticSculpt_ExportStep"}
@@ -95,6 +101,7 @@ def test_workbench_loads_and_commands_run(tmp_path):
     assert len(out["live_heights"]) > 5, out["live_heights"]  # the shape moved while the threads ran
     assert out["live_strokes"] == 1 and "Sculpt stroke" in out["live_undo"]
     assert out["workbench_stop"] == [True, False]
+    assert out["legacy_view_provider"] == ["HapticSculpt.gui.view_provider", "HapticSculpt.svg"]
     assert out["icon"].endswith("HapticSculpt.svg") and os.path.exists(out["icon"])
     import matplotlib.image as mpimg
     img = mpimg.imread(png)[..., :3]

@@ -71,7 +71,7 @@ def write(*_):
                                "modified": bool(getattr(doc, "isTouched", lambda: False)()),
                                "sculpts": _sculpts(doc), "objects": [o.Name for o in doc.Objects]}
     try:
-        import HapticSculpt.gui as hg
+        import HapticSculpt.gui.workbench as hg
         ctl = hg.controller()
         state["painting"] = ctl.painting
         state["inputs"] = len(ctl.inputs)

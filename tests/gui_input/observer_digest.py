@@ -2,7 +2,7 @@
 import hashlib
 import struct
 
-from HapticSculpt.sculpt_state import ARRAY_NAMES
+from HapticSculpt.app.sculpt_state import ARRAY_NAMES
 
 
 def digest(o):

@@ -17,7 +17,9 @@ from typing import Any
 
 import numpy as np
 
-from . import analysis, coin_shapes as shapes, core
+from .. import core
+from ..app import analysis
+from . import coin_shapes as shapes
 from . import stripes as stripe_shading
 from .hud import Hud
 from .panel import SliderPanel

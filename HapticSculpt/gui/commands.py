@@ -20,7 +20,7 @@ TOOLBAR = ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Ses
 
 
 def _selected_sculpts() -> list[Any]:
-    from .sculpt_feature import is_sculpt
+    from ..app.sculpt_feature import is_sculpt
     return [o for o in Gui.Selection.getSelection() if is_sculpt(o)]
 
 
@@ -104,7 +104,7 @@ class ExportStep:
 
 
 def _ctl() -> Any:
-    from .gui import controller
+    from .workbench import controller
     return controller()
 
 
@@ -151,7 +151,7 @@ class Material(_SculptCommand):
            "unless held by constraints)")
 
     def Activated(self) -> None:
-        from .api import material_of
+        from ..app.api import material_of
         from .echo import ref, run_echoed
         obj = _ctl().active_sculpt()
         new = "elastic" if material_of(obj) == "clay" else "clay"
@@ -200,7 +200,7 @@ class MagnetFalloff(_SculptCommand):
     tip = "Cycle the magnet's falloff: constant, spherical, cylindrical (about the cursor axis), conical"
 
     def Activated(self) -> None:
-        from .core import FALLOFFS
+        from ..core import FALLOFFS
         ctl = _ctl()
         nxt = FALLOFFS[(FALLOFFS.index(ctl.falloff) + 1) % len(FALLOFFS)]
         ctl.set_tool("magnet", nxt)
@@ -263,7 +263,7 @@ class ShowMap(_SculptCommand):
     tip = "Cycle the material map display in pseudo-colour: mass, damping, stiffness, off (key M toggles)"
 
     def Activated(self) -> None:
-        from .gui import MAP_CYCLE
+        from .workbench import MAP_CYCLE
         _ctl().cycle(MAP_CYCLE)
 
 
@@ -272,7 +272,7 @@ class ShowCurvature(_SculptCommand):
     tip = "Cycle curvature displays: u green / v blue (as in the paper), mean, Gaussian, off"
 
     def Activated(self) -> None:
-        from .gui import CURVATURE_CYCLE
+        from .workbench import CURVATURE_CYCLE
         _ctl().cycle(CURVATURE_CYCLE)
 
 

@@ -12,19 +12,31 @@ from __future__ import annotations
 
 import time
 import weakref
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
-from . import _core, core, sculpt_state
+from .. import _core, core
+from ..app import sculpt_state
+from ..app.sculpt_feature import is_sculpt
+from ..app.sculpt_properties import read_state
+from ..app.undo import transaction
 from .devices import native_device
 from .replay_device import ReplayDevice
-from .sculpt_feature import is_sculpt
-from .sculpt_properties import read_state
-from .undo import transaction
 
 #: Sessions that may still run, so a document close or a workbench change can stop them all.
 _ACTIVE: "weakref.WeakSet[Session]" = weakref.WeakSet()
+
+#: Calls a function at graphics rate until the returned function is called: installed by the GUI
+#: layer when it loads (see HapticSculpt.gui), so a running session shows its shape and commits
+#: its strokes as they end, and this layer never imports a GUI module.
+FrameClock = Callable[[Callable[[], None]], Callable[[], None]]
+_frame_clocks: list[FrameClock] = []
+
+
+def set_frame_clock(clock: FrameClock) -> None:
+    """Installs the clock sessions use while FreeCAD's GUI runs."""
+    _frame_clocks[:] = [clock]
 
 
 class Session:
@@ -278,14 +290,12 @@ class Session:
 
     # --- GUI: shape at graphics rate, strokes as they end ----------------------------------------
     def _start_timer(self) -> None:
-        from pivy import coin
-        self._timer = coin.SoTimerSensor(lambda *_: self._on_frame(), None)
-        self._timer.setInterval(coin.SbTime(1.0 / 30.0))
-        self._timer.schedule()
+        if _frame_clocks:
+            self._timer = _frame_clocks[0](self._on_frame)
 
     def _stop_timer(self) -> None:
         if self._timer is not None:
-            self._timer.unschedule()
+            self._timer()
             self._timer = None
 
     def _on_frame(self) -> None:

@@ -10,13 +10,13 @@ import math
 import os
 import time
 from dataclasses import dataclass
-from typing import Any, Iterable, Sequence
+from typing import Any, Iterable, Protocol, Sequence
 
 import numpy as np
 
-from . import core, sculpt_state
-from .replay_device import ReplayDevice
-from .sculpt_feature import SculptFeature, is_sculpt
+from .. import core
+from . import sculpt_state
+from .sculpt_feature import SculptFeature, attach_view_provider, is_sculpt
 from .sculpt_properties import face_of, read_state
 from .source_surface import source_surface
 from .undo import transaction
@@ -106,10 +106,7 @@ def make_sculpt(doc: Any = None, source: Any = None, controls: tuple[int, int] =
     with transaction(doc, "Create sculpt"):
         obj = doc.addObject("Part::FeaturePython", name)
         SculptFeature(obj, state, made.method, made.error, made.description)
-        import FreeCAD
-        if FreeCAD.GuiUp:
-            from .view_provider import SculptViewProvider
-            SculptViewProvider(obj.ViewObject)
+        attach_view_provider(obj)
         obj.Shape = face_of(state)
         obj.purgeTouched()
     return obj
@@ -240,6 +237,13 @@ def paint(obj: Any, map: str, path: Sequence[Sequence[float]], radius: float = 0
     obj.Proxy.live.edit(change, f"Paint {map}")
 
 
+class CursorSource(Protocol):
+    """Anything with a cursor at a given time, as :class:`HapticSculpt.ReplayDevice` has."""
+
+    def sample(self, t: float) -> Any:
+        """The cursor at ``t`` seconds: ``position``, ``orientation`` and ``grab``."""
+
+
 @dataclass(frozen=True)
 class RunReport:
     """What :func:`run` did."""
@@ -257,7 +261,7 @@ class RunReport:
         return self.steps / self.wall_seconds if self.wall_seconds > 0 else math.inf
 
 
-def run(obj: Any, seconds: float, device: ReplayDevice | None = None, tool: str | None = "rope",
+def run(obj: Any, seconds: float, device: CursorSource | None = None, tool: str | None = "rope",
         dt: float = 1e-3, integrator: str | None = None) -> RunReport:
     """Steps the sculpt synchronously and deterministically for ``seconds`` of simulated time.
 

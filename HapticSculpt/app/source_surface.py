@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from . import core
+from .. import core
 
 
 @dataclass(frozen=True)

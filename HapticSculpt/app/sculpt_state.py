@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from . import core
+from .. import core
 
 FORMAT_VERSION = 1
 #: The float arrays of a state, by the name of the document property that holds each.

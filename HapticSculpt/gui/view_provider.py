@@ -4,7 +4,7 @@ from __future__ import annotations
 import os
 from typing import Any
 
-ICONS = os.path.join(os.path.dirname(__file__), "resources", "icons")
+ICONS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "resources", "icons")
 
 
 def icon(name: str) -> str:

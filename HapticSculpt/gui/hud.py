@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from . import analysis
+from ..app import analysis
 
 FONT_SIZE = 16.0  # points: each text line is about this many pixels high
 CUBE_CORNER = 170  # pixels kept free in the top-right corner (FreeCAD's navigation cube)

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from . import core
+from .. import core
 from .coin_events import FrontCallbacks
 from .echo import ref, run_echoed
 from .overlay import Overlay
@@ -158,7 +158,7 @@ class Controller:
         import FreeCAD
         import FreeCADGui as Gui
 
-        from .sculpt_feature import is_sculpt
+        from ..app.sculpt_feature import is_sculpt
         sel = [o for o in Gui.Selection.getSelection() if is_sculpt(o)]
         if sel:
             return sel[0]
@@ -195,7 +195,7 @@ class Controller:
         which sculpt is under the mouse."""
         import FreeCAD
 
-        from .sculpt_feature import is_sculpt
+        from ..app.sculpt_feature import is_sculpt
         info = view.getObjectInfo((x, y))
         self.mouse_object = None
         if info and all(k in info for k in ("x", "y", "z")):
@@ -298,7 +298,7 @@ class Controller:
     def _dab_to(self, obj: Any, at: np.ndarray) -> None:
         """Dabs from the last dab to the mass point nearest `at`, shown at once (no session runs
         while the mouse paints)."""
-        from .api import paint_dabs
+        from ..app.api import paint_dabs
         end = self._map_uv(obj, at)
         if self._paint_path and end == self._paint_path[-1]:
             return
@@ -374,8 +374,9 @@ class Controller:
 
     def start_session(self, device: Any = None) -> Any:
         """Starts sculpting the active sculpt with `device`, else the first attached device, else the mouse."""
-        from .devices import MouseDevice, list_devices, spacemouse
-        from .session import Session
+        from ..runtime.devices import list_devices, spacemouse
+        from ..runtime.session import Session
+        from .mouse_device import MouseDevice
         obj = self.active_sculpt()
         if obj is None:
             raise RuntimeError("select the sculpt to sculpt (or create a patch first)")

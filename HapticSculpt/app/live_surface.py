@@ -20,7 +20,8 @@ from typing import Any, Callable, Protocol, TypeVar
 
 import numpy as np
 
-from . import core, sculpt_state
+from .. import core
+from . import sculpt_state
 from .sculpt_properties import face_of, read_state, set_error, write_state
 from .undo import transaction
 

@@ -1,0 +1,13 @@
+"""The GUI layer: the workbench's commands, view input, overlay, HUD, panel and view provider.
+
+Imported only while FreeCAD's GUI runs (InitGui imports it at start-up). Importing it installs
+the GUI's parts into the layers below, which never import this one: new Sculpt objects get their
+view provider, and running sessions show their shape at graphics rate.
+"""
+from ..app import sculpt_feature
+from ..runtime import session
+from .frame_clock import coin_frame_clock
+from .view_provider import SculptViewProvider
+
+sculpt_feature.set_view_provider(SculptViewProvider)
+session.set_frame_clock(coin_frame_clock)
