@@ -26,12 +26,13 @@ OrientationTool = _core.OrientationTool
 SmoothTool = _core.SmoothTool
 MAX_DEGREE: int = _core.MAX_DEGREE
 
-INTEGRATORS = ("explicit", "implicit", "local_global")
-TOOLS = ("rope", "magnet", "orientation", "smooth")
-CONSTRAINTS = ("point", "tangent", "normal", "curvature")
-FALLOFFS = ("constant", "spherical", "cylindrical", "conical")
-LAWS = ("linear", "cubic", "saturating")
-MAPS = ("mass", "damping", "stiffness")
+# The names of the core's choices, from its one table of each (native_core/src/names.hpp).
+INTEGRATORS: tuple[str, ...] = _core.INTEGRATORS
+TOOLS: tuple[str, ...] = _core.TOOLS
+CONSTRAINTS: tuple[str, ...] = _core.CONSTRAINTS
+FALLOFFS: tuple[str, ...] = _core.FALLOFFS
+LAWS: tuple[str, ...] = _core.LAWS
+MAPS: tuple[str, ...] = _core.MAPS
 
 
 def patch(controls: tuple[int, int] = (8, 8), degree: tuple[int, int] = (3, 3),

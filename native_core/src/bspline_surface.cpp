@@ -22,6 +22,26 @@ BSplineSurface::BSplineSurface(int nu, int nv, int degreeU, int degreeV, std::ve
     }
 }
 
+void BSplineSurface::checkGridSize(int nu, int nv) {
+    requireInRange(nu, "nu", 2, kMaxGrid);
+    requireInRange(nv, "nv", 2, kMaxGrid);
+}
+
+void BSplineSurface::grid(int nu, int nv, double* points, double* normals) const {
+    checkGridSize(nu, nv);
+    const double u0 = ku_.domainStart(), u1 = ku_.domainEnd(), v0 = kv_.domainStart(), v1 = kv_.domainEnd();
+    for (int i = 0; i < nu; ++i)
+        for (int j = 0; j < nv; ++j) {
+            const double u = u0 + (u1 - u0) * i / (nu - 1), v = v0 + (v1 - v0) * j / (nv - 1);
+            const Vec3 p = evaluate(u, v, 1).s, n = normal(u, v);
+            const std::size_t k = 3 * (static_cast<std::size_t>(i) * nv + j);
+            for (int c = 0; c < 3; ++c) {
+                points[k + c] = p[c];
+                normals[k + c] = n[c];
+            }
+        }
+}
+
 BSplineSurface BSplineSurface::plane(int nu, int nv, int degreeU, int degreeV, double sx, double sy) {
     if (!(std::isfinite(sx) && std::isfinite(sy) && sx > 0 && sy > 0))
         throw std::invalid_argument("size: must be finite and > 0");

@@ -1,23 +1,9 @@
 // A tensor-product B-spline surface, optionally rational with fixed weights.
 #pragma once
-#include <Eigen/Core>
-#include <Eigen/Geometry>
-
 #include "knot_vector.hpp"
+#include "types.hpp"
 
 namespace hs {
-
-using Points = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;  ///< one 3D point per row
-using Vec3 = Eigen::Vector3d;
-
-/// Largest coordinate accepted anywhere (poles, cursor, targets): 1e9 (1000 km in mm). Beyond it
-/// squared lengths times stiffness leave the double range; nothing real is that large.
-constexpr double kMaxCoordinate = 1e9;
-/// Largest material value (mass, damping, stiffness per unit area) and smallest non-zero one.
-constexpr double kMaxMaterial = 1e12, kMinMaterial = 1e-12;
-inline bool withinRange(const Eigen::Ref<const Eigen::MatrixXd>& x) {
-    return x.allFinite() && x.cwiseAbs().maxCoeff() <= kMaxCoordinate;
-}
 
 /// Position and partial derivatives of a surface at one (u, v).
 struct SurfaceDerivatives {
@@ -56,6 +42,12 @@ public:
     SurfaceDerivatives evaluate(double u, double v, int order = 2) const;
     Vec3 normal(double u, double v) const;
     Curvature curvature(double u, double v) const { return curvatureFrom(evaluate(u, v, 2)); }
+    /// Largest grid side grid() takes; throws std::invalid_argument unless 2 <= nu, nv <= it.
+    static constexpr int kMaxGrid = 4096;
+    static void checkGridSize(int nu, int nv);
+    /// Exact points and unit normals on an nu x nv grid evenly spaced over the domain, into
+    /// (nu, nv, 3) row-major buffers (for displays that shade per pixel).
+    void grid(int nu, int nv, double* points, double* normals) const;
 
     /// Basis (rational if weighted) of the poles at (u, v) and its derivatives: calls
     /// visit(poleIndex, R, Ru, Rv, Ruu, Ruv, Rvv) for each of the (p+1)(q+1) non-zero entries.

@@ -10,14 +10,14 @@ DynamicSurface::DynamicSurface(BSplineSurface surface, int g, int h)
     : surface_(std::move(surface)), A_(surface_, g, h), mass_(1.0, "mass"), damping_(1.0, "damping"),
       stiffness_(100.0, "stiffness") {
     const Eigen::Index S = static_cast<Eigen::Index>(g) * h, N = surface_.poles().rows();
-    for (Points* m : {&d_, &dd_, &fext_, &ftool_, &force_, &meshTmp_, &meshTmp2_, &base_, &dPrev_, &av_, &dHist_, &avHist_, &dHat_, &yMesh_})
+    for (Points* m : {&d_, &dd_, &fext_, &ftool_, &force_, &meshTmp_, &meshTmp2_, &base_, &dPrev_, &av_, &history_.d, &history_.av, &history_.dHat, &yMesh_})
         m->setZero(S, 3);
-    for (Points* m : {&v_, &fp_, &p0_, &v0_, &a0_, &pStep_, &vStep_, &acc_, &cgR_, &cgZ_, &cgP_, &cgQ_, &x_, &pHist_, &vHist_, &xHat_, &aVerlet_})
+    for (Points* m : {&v_, &fp_, &explicit_.p0, &explicit_.v0, &explicit_.a0, &backup_.p, &backup_.v, &acc_, &cg_.r, &cg_.z, &cg_.p, &cg_.q, &x_, &history_.p, &history_.v, &history_.xHat, &verlet_.a})
         m->setZero(N, 3);
     m_.setZero(S);
     gamma_.setZero(S);
-    appliedPoles_.reserve(static_cast<size_t>(N));
-    poleMark_.assign(static_cast<size_t>(N), 0);
+    verlet_.appliedPoles.reserve(static_cast<size_t>(N));
+    verlet_.poleMark.assign(static_cast<size_t>(N), 0);
     damping_.allowZero(true);
     A_.apply(surface_.poles(), d_);
     springs_ = SpringMesh(g, h, d_);
@@ -47,6 +47,59 @@ void DynamicSurface::setReference(const std::array<double, 3>& r) {
     touch();
 }
 
+void SolverSettings::validate() const {
+    requireInRange(iterations, "iterations", 1, 1000);
+    if (timeOrder != 1 && timeOrder != 2) throw std::invalid_argument("time_order: 1 (backward Euler) or 2 (BDF2)");
+    requireInRange(cgIterations, "cg_iterations", 1, 10000);
+    requirePositive(accelerationLimit, "acceleration_limit", true);
+    requireInRange(maxHalvings, "max_halvings", 0, 30);
+    requirePositive(energyTolerance, "energy_tolerance", true);
+}
+
+void DynamicSurface::setSolver(const SolverSettings& s) {
+    s.validate();
+    solver_ = s;
+    wake();
+}
+
+void DynamicSurface::setSleep(const SleepSettings& s) {
+    s.validate();
+    sleep_.settings = s;
+    wake();
+}
+
+void DynamicSurface::setEnergyGuard(const EnergyGuardSettings& s) {
+    s.validate();
+    guard_.settings = s;
+    wake();
+}
+
+void DynamicSurface::setPlasticity(const Plasticity& p) {
+    p.validate();
+    springs_.plasticity = p;
+    wake();
+}
+
+void DynamicSurface::setStiffnessLaw(const ResponseLaw& law) {
+    ResponseLaw::checked(law.kind, law.scale);
+    springs_.law = law;
+    wake();
+}
+
+void DynamicSurface::setDampingLaw(const ResponseLaw& law) {
+    ResponseLaw::checked(law.kind, law.scale);
+    dampingLaw_ = law;
+    wake();
+}
+
+double DynamicSurface::meshCurvature(int index, int direction) const {
+    requireInRange(index, "index", 0, g() * h() - 1);
+    const int i = index / h(), j = index % h();
+    if (i < 1 || j < 1 || i > g() - 2 || j > h() - 2) throw std::invalid_argument("index: must be an interior point");
+    if (direction != 0 && direction != 1) throw std::invalid_argument("direction: 0 (u) or 1 (v)");
+    return constraints_.meshCurvature(d_, index, direction);
+}
+
 const Points& DynamicSurface::meshVelocities() {
     A_.apply(v_, dd_);
     return dd_;
@@ -57,7 +110,7 @@ void DynamicSurface::setPoles(const Points& poles) {
     if (!withinRange(poles)) throw std::invalid_argument("poles: must be finite and within +-1e9");
     surface_.mutablePoles() = poles;
     v_.setZero();
-    avValid_ = histValid_ = false;
+    avValid_ = history_.valid = false;
     A_.apply(surface_.poles(), d_);
     touch();
     resetEnergyCeiling();
@@ -80,12 +133,12 @@ void DynamicSurface::continueFrom(DynamicSurface& live, bool keepMaps) {
     }
     cursor_ = live.cursor_;
     // The BDF2 history carries over, so the step after an edit stays second order.
-    pHist_ = live.pHist_;
-    vHist_ = live.vHist_;
-    dHist_ = live.dHist_;
-    avHist_ = live.avHist_;
-    histDt_ = live.histDt_;
-    histValid_ = live.histValid_;
+    history_.p = live.history_.p;
+    history_.v = live.history_.v;
+    history_.d = live.history_.d;
+    history_.av = live.history_.av;
+    history_.dt = live.history_.dt;
+    history_.valid = live.history_.valid;
     time_ = live.time_;
     work_ = live.work_;
     steps_ = live.steps_;
@@ -96,7 +149,7 @@ void DynamicSurface::setVelocities(const Points& v) {
     if (v.rows() != v_.rows()) throw std::invalid_argument("velocities: wrong number of rows");
     if (!v.allFinite()) throw std::invalid_argument("velocities: contain NaN or Inf");
     v_ = v;
-    avValid_ = histValid_ = false;
+    avValid_ = history_.valid = false;
     touch();
     resetEnergyCeiling();
 }
@@ -135,7 +188,7 @@ void DynamicSurface::refreshMaterials() {
     maxDampingRate_ = (gamma_.array() / m_.array()).maxCoeff();
     maxStiffness_ = stiffness_.values().maxCoeff();
     for (int i = 0; i < 3; ++i) materialKey_[i] = key[i];
-    accelerationValid_ = verletValid_ = false;
+    accelerationValid_ = verlet_.valid = false;
 }
 
 void DynamicSurface::ensureMassFactor() {
@@ -158,7 +211,7 @@ void DynamicSurface::ensureSystem(double dt, bool factor) {
     const Eigen::SparseMatrix<double> Sm = D + (dt * dt) * laplacian();
     const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
     const Eigen::SparseMatrix<double> sys = A.transpose() * Sm * A;
-    cgInvDiag_ = sys.diagonal().cwiseInverse();  // Jacobi preconditioner
+    cg_.invDiag = sys.diagonal().cwiseInverse();  // Jacobi preconditioner
     if (factor) {
         ensureMassFactor();  // throws first if the mesh does not see every control point
         try {
@@ -190,14 +243,14 @@ void DynamicSurface::setPointForce(int index, const Vec3& force) {
     const double n = force.norm();
     fext_.row(index) = (n > maxPointForce ? Vec3(force * (maxPointForce / n)) : force).transpose();
     hasExternal_ = true;
-    histValid_ = false;  // the force jumps: BDF2 restarts (see histValid_)
+    history_.valid = false;  // the force jumps: BDF2 restarts (see history_.valid)
     touch();
 }
 
 void DynamicSurface::clearForces() {
     fext_.setZero();
     hasExternal_ = false;
-    histValid_ = false;
+    history_.valid = false;
     touch();
 }
 
@@ -216,11 +269,11 @@ void DynamicSurface::setCursor(const Cursor& c) {
     n.orientation.normalize();
     if (n.grab && !tool_->grabbed()) {
         tool_->grab(meshView(), n);
-        histValid_ = false;
+        history_.valid = false;
         touch();
     } else if (!n.grab && tool_->grabbed()) {
         tool_->release();
-        histValid_ = false;
+        history_.valid = false;
         touch();
     }
     cursor_ = n;
@@ -242,9 +295,9 @@ void DynamicSurface::applyToolForces(double dt, StepReport& r, const Points& at,
 double DynamicSurface::meshForces(const Points& d, const Points& dd, double) {
     force_.setZero();
     const double energy = springs_.addForces(d, force_);
-    const bool nonlinearDamping = dampingLaw.kind != LawKind::Linear;
+    const bool nonlinearDamping = dampingLaw_.kind != LawKind::Linear;
     if (nonlinearDamping)
-        for (Eigen::Index i = 0; i < d.rows(); ++i) meshTmp2_(i, 0) = dampingLaw.dampingFactor(force_.row(i).norm());
+        for (Eigen::Index i = 0; i < d.rows(); ++i) meshTmp2_(i, 0) = dampingLaw_.dampingFactor(force_.row(i).norm());
     if (hasExternal_) force_ += fext_;
     if (toolForces_) force_ += ftool_;
     double penalty = 0;
@@ -263,32 +316,26 @@ StepReport DynamicSurface::step(double dt) {
     for (int i = 0; i < 4; ++i)
         if (key[i] != wakeKey_[i]) { touch(); resetEnergyCeiling(); wakeKey_[i] = key[i]; }
     // A held tool keeps the surface awake; its forces are refreshed by applyToolForces each step.
-    if (tool_->grabbed()) {
-        asleep_ = false;
-        quietSteps_ = 0;
-    }
+    if (tool_->grabbed()) sleep_.wake();
     StepReport r;
-    if (asleep_) {
+    if (sleep_.asleep()) {
         r.slept = true;
         return r;
     }
-    const bool verlet = solver.kind == IntegratorKind::LocalGlobal && verletStable(dt);
+    const bool verlet = solver_.kind == IntegratorKind::LocalGlobal && verletStable(dt);
     const bool guard = guardsEnergy(dt, verlet);
-    stepPotential_ = -1;
-    if (!guard) ceilingValid_ = false;
-    else if (!ceilingValid_) {
-        ceiling_ = kineticEnergy() + potentialEnergy();
-        ceilingValid_ = true;
-    }
+    verlet_.stepPotential = -1;
+    if (!guard) guard_.reset();
+    else guard_.begin([this] { return kineticEnergy() + potentialEnergy(); });
     // Backup for a refused step (separate from the explicit integrator's substep buffers).
-    pStep_ = surface_.poles();
-    vStep_ = v_;
+    backup_.p = surface_.poles();
+    backup_.v = v_;
     const bool tracksWork = hasExternal_ || tool_->grabbed();
     // The mesh before the step: for the work of the applied forces, and for local/global's A v.
-    if (tracksWork || solver.kind == IntegratorKind::LocalGlobal) dPrev_ = d_;
-    if (solver.kind != IntegratorKind::LocalGlobal) avValid_ = histValid_ = false;
-    if (!verlet) verletValid_ = false;
-    switch (solver.kind) {
+    if (tracksWork || solver_.kind == IntegratorKind::LocalGlobal) dPrev_ = d_;
+    if (solver_.kind != IntegratorKind::LocalGlobal) avValid_ = history_.valid = false;
+    if (!verlet) verlet_.valid = false;
+    switch (solver_.kind) {
         case IntegratorKind::Explicit: r = stepExplicit(dt); break;
         case IntegratorKind::ImplicitCG: r = stepImplicitCG(dt); break;
         case IntegratorKind::LocalGlobal: r = verlet ? stepVerlet(dt) : stepLocalGlobal(dt); break;
@@ -310,7 +357,7 @@ StepReport DynamicSurface::step(double dt) {
     work_ += work;
     if (springs_.plasticity.enabled) {
         springs_.applyPlasticity(d_, dt);
-        verletValid_ = false;  // the rest lengths moved under the forces Verlet carries over
+        verlet_.valid = false;  // the rest lengths moved under the forces Verlet carries over
     }
     time_ += dt;
     ++steps_;
@@ -322,17 +369,17 @@ void DynamicSurface::prepare(double dt) {
     if (!(dt >= kMinDt) || !std::isfinite(dt)) throw std::invalid_argument("dt: must be finite and >= 1e-9 s");
     refreshMaterials();
     ensureMassFactor();
-    if (solver.kind != IntegratorKind::LocalGlobal) return;
+    if (solver_.kind != IntegratorKind::LocalGlobal) return;
     verletStable(dt);
     ensureSystem(localGlobalH(dt), true);
 }
 
 bool DynamicSurface::guardsEnergy(double dt, bool verlet) const {
-    if (!energyGuard.enabled) return false;
+    if (!guard_.settings.enabled) return false;
     // Verlet is stable here but not a descent method: the guard stays as for every explicit scheme.
     if (verlet) return true;
     // Point, tangent and normal constraints project onto convex sets, so they keep the guarantee.
-    if (solver.kind != IntegratorKind::LocalGlobal || springs_.law.kind != LawKind::Linear || constraints_.anyNonConvex())
+    if (solver_.kind != IntegratorKind::LocalGlobal || springs_.law.kind != LawKind::Linear || constraints_.anyNonConvex())
         return true;
     // Local/global's descent guarantee is exact arithmetic's: the solve's rounding grows with the
     // system's stiffness-to-mass ratio (~ dt^2 8 k_max / m_min, Gershgorin), and past 1e8 it can
@@ -341,23 +388,17 @@ bool DynamicSurface::guardsEnergy(double dt, bool verlet) const {
 }
 
 bool DynamicSurface::limitEnergy(double work, StepReport& r) {
-    // Work done during a step that is refused was never done: the ceiling grows only on acceptance.
-    const double ceiling = ceiling_ + std::max(0.0, work);
     // Below this floor energy is rounding noise: 1e-12 of a surface-sized stretch at the mean stiffness.
     const double floor = 1e-12 * stiffness_.mean() * size_ * size_;
-    const double ke = kineticEnergy(), pe = stepPotential_ >= 0 ? stepPotential_ : potentialEnergy();
-    if (ke + pe <= (1 + energyGuard.slack) * ceiling + floor) {
-        ceiling_ = ceiling;
-        return true;
-    }
+    const double ke = kineticEnergy(), pe = verlet_.stepPotential >= 0 ? verlet_.stepPotential : potentialEnergy();
+    const EnergyGuard::Verdict verdict = guard_.judge(ke, pe, work, floor);
+    if (verdict.kind == EnergyGuard::Verdict::Accept) return true;
     r.energyLimited = true;
-    if (pe <= ceiling && ke > 0) {
-        const double s = std::sqrt((ceiling - pe) / ke);
-        v_ *= s;
-        av_ *= s;
-        histValid_ = false;
-        accelerationValid_ = verletValid_ = false;
-        ceiling_ = ceiling;
+    if (verdict.kind == EnergyGuard::Verdict::Scale) {
+        v_ *= verdict.scale;
+        av_ *= verdict.scale;
+        history_.valid = false;
+        accelerationValid_ = verlet_.valid = false;
         r.reason = "the step would have created energy; velocities scaled back to the energy ceiling (reduce dt or stiffness)";
         return true;
     }
@@ -368,20 +409,14 @@ bool DynamicSurface::limitEnergy(double work, StepReport& r) {
 }
 
 void DynamicSurface::checkSleep(double dt) {
-    if (!sleep.enabled || tool_->grabbed()) { quietSteps_ = 0; return; }
-    const double vmax = v_.cwiseAbs().maxCoeff();
-    if (!(vmax < sleep.tolerance * size_)) { quietSteps_ = 0; return; }
-    if (++quietSteps_ < sleep.steps) return;
+    if (!sleep_.quietStep(v_.cwiseAbs().maxCoeff(), size_, tool_->grabbed())) return;
     // Net force check, once, at the moment the surface would fall asleep.
     dd_.setZero();
     meshForces(d_, dd_, dt);
     A_.applyTransposed(force_, fp_);
-    if (fp_.cwiseAbs().maxCoeff() < sleep.tolerance * stiffness_.mean() * size_) {
-        asleep_ = true;
+    if (sleep_.settle(fp_.cwiseAbs().maxCoeff(), stiffness_.mean() * size_)) {
         v_.setZero();
-        avValid_ = histValid_ = verletValid_ = false;
-    } else {
-        quietSteps_ = 0;
+        avValid_ = history_.valid = verlet_.valid = false;
     }
 }
 
@@ -395,12 +430,12 @@ double DynamicSurface::kineticEnergy() {
 }
 
 void DynamicSurface::restoreStepStart(bool keepVelocity) {
-    surface_.mutablePoles() = pStep_;
-    if (keepVelocity) v_ = vStep_;
+    surface_.mutablePoles() = backup_.p;
+    if (keepVelocity) v_ = backup_.v;
     else v_.setZero();
-    avValid_ = histValid_ = false;
+    avValid_ = history_.valid = false;
     A_.apply(surface_.poles(), d_);
-    accelerationValid_ = verletValid_ = false;
+    accelerationValid_ = verlet_.valid = false;
 }
 
 double DynamicSurface::potentialEnergy() {

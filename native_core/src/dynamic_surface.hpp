@@ -10,9 +10,12 @@
 
 #include "bspline_surface.hpp"
 #include "constraints.hpp"
+#include "energy_guard.hpp"
+#include "integrator_state.hpp"
 #include "material_map.hpp"
 #include "prefactored_solver.hpp"
 #include "sampling_operator.hpp"
+#include "sleep_monitor.hpp"
 #include "spring_mesh.hpp"
 #include "tools.hpp"
 
@@ -48,29 +51,16 @@ struct SolverSettings {
     int maxHalvings = 10;            ///< explicit: deepest recursion (at most 2^10 substeps a step)
     /// explicit: also halve while a substep gains more than this fraction of its energy beyond the work put in
     double energyTolerance = 0.01;
+    /// Throws std::invalid_argument naming the first bad field.
+    void validate() const;
 };
 
-/// Sleeping: with no tool active, after `steps` consecutive steps whose largest control-point
-/// speed is below tolerance * size per second and whose net force is below tolerance * stiffness * size.
-/// Energy guard: kinetic plus potential energy may not exceed (1 + slack) times the ceiling, which
-/// starts at the energy when the configuration last changed and grows by the positive work of the
-/// applied forces and tools. A step past it has its velocities scaled back to the ceiling; one whose
-/// potential energy alone is past it is refused (positions kept, motion stopped). Local/global on
-/// linear springs is a descent method on backward Euler's incremental potential and needs no guard,
-/// so it runs only where that does not hold: the explicit and linearised implicit schemes, non-linear
-/// spring laws, curvature constraints (projections onto arcs, a non-convex set; point, tangent and
-/// normal constraints project onto convex sets), and steps so long for the stiffness and mass that
-/// rounding in the solve is no longer negligible.
-struct EnergyGuardSettings {
-    bool enabled = true;
-    double slack = 0.25;
-};
-
-struct SleepSettings {
-    bool enabled = true;
-    double tolerance = 1e-6;
-    int steps = 10;
-};
+/// The energy guard (energy_guard.hpp) runs only where local/global's descent guarantee does not
+/// hold: the explicit and linearised implicit schemes, non-linear spring laws, curvature
+/// constraints (projections onto arcs, a non-convex set; point, tangent and normal constraints
+/// project onto convex sets), and steps so long for the stiffness and mass that rounding in the
+/// solve is no longer negligible. A step past its ceiling has its velocities scaled back to it; one
+/// whose potential energy alone is past it is refused (positions kept, motion stopped).
 
 /// What one call to step() did.
 struct StepReport {
@@ -123,7 +113,8 @@ public:
     const MaterialMap& stiffnessMap() const { return stiffness_; }
     SpringMesh& springs() { touch(); resetEnergyCeiling(); return springs_; }
     const SpringMesh& springs() const { return springs_; }
-    ResponseLaw dampingLaw;  ///< non-linear damping: multiplier g(F)/F of each point's spring-force magnitude F
+    /// Non-linear damping: multiplier g(F)/F of each point's spring-force magnitude F.
+    const ResponseLaw& dampingLaw() const { return dampingLaw_; }
     const Eigen::VectorXd& pointMasses() { refreshMaterials(); return m_; }
 
     // --- forces, tools and constraints -------------------------------------------------------
@@ -149,9 +140,16 @@ public:
     double defaultConstraintStiffness() const { return constraintStiffnessFactor * stiffness_.mean(); }
 
     // --- stepping -----------------------------------------------------------------------------
-    SolverSettings solver;
-    SleepSettings sleep;
-    EnergyGuardSettings energyGuard;
+    // Settings: each setter checks its argument (std::invalid_argument naming the field) and wakes the surface.
+    const SolverSettings& solver() const { return solver_; }
+    void setSolver(const SolverSettings& s);
+    const SleepSettings& sleep() const { return sleep_.settings; }
+    void setSleep(const SleepSettings& s);
+    const EnergyGuardSettings& energyGuard() const { return guard_.settings; }
+    void setEnergyGuard(const EnergyGuardSettings& s);
+    void setPlasticity(const Plasticity& p);
+    void setStiffnessLaw(const ResponseLaw& law);
+    void setDampingLaw(const ResponseLaw& law);
     /// Advances by dt seconds; never allocates after the first step with a given configuration.
     StepReport step(double dt);
     /// Does ahead what a first step at dt would (factorisations, Verlet's stability bound), so that
@@ -164,13 +162,13 @@ public:
     /// settings, solver settings. An edit made during a session is a configured surface that
     /// continues from the live one (see HapticRuntime::postEdit).
     void continueFrom(DynamicSurface& live, bool keepMaps);
-    bool asleep() const { return asleep_; }
+    bool asleep() const { return sleep_.asleep(); }
     void wake() { touch(); resetEnergyCeiling(); }
     std::uint64_t stepCount() const { return steps_; }
     double time() const { return time_; }
     double workDone() const { return work_; }  ///< work of external and tool forces so far
     /// The energy guard's current ceiling (0 while the guard is not running for this scene).
-    double energyCeiling() const { return ceilingValid_ ? ceiling_ : 0.0; }
+    double energyCeiling() const { return guard_.ceiling(); }
     /// Longest step local/global takes by its explicit Verlet branch in the current configuration
     /// (0 where it never does: switched off, non-linear laws, curvature constraints, smooth tool).
     double verletStepLimit();
@@ -180,13 +178,16 @@ public:
     double potentialEnergy();
     /// Gradient of potentialEnergy() with respect to the poles, -A^T f(d) (springs and constraints).
     const Points& potentialGradient();
+    /// Curvature of the circle through interior mesh point `index` and its two neighbours along
+    /// u (direction 0) or v (1); throws std::invalid_argument for a boundary point.
+    double meshCurvature(int index, int direction) const;
     /// Per mesh point: u and v normal curvature, min and max principal, mean, Gaussian (g*h x 6).
     Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> curvatureGrid() const;
 
 private:
-    void touch() { asleep_ = false; quietSteps_ = 0; accelerationValid_ = false; verletValid_ = false; }
+    void touch() { sleep_.wake(); accelerationValid_ = false; verlet_.valid = false; }
     /// Something outside a step changed the energy (shape, velocities, springs, materials, constraints).
-    void resetEnergyCeiling() { ceilingValid_ = false; }
+    void resetEnergyCeiling() { guard_.reset(); }
     bool guardsEnergy(double dt, bool verlet) const;
     /// Back to the state step() started from (refused steps); velocities kept or zeroed.
     void restoreStepStart(bool keepVelocity);
@@ -198,7 +199,7 @@ private:
     /// Laplacian of the springs and penalty terms on the mesh (S x S, per coordinate).
     Eigen::SparseMatrix<double> laplacian() const;
     /// local/global's h: 2 dt / 3 for BDF2, dt for backward Euler.
-    double localGlobalH(double dt) const { return solver.timeOrder == 2 ? 2.0 * dt / 3.0 : dt; }
+    double localGlobalH(double dt) const { return solver_.timeOrder == 2 ? 2.0 * dt / 3.0 : dt; }
     /// Total mesh force (external, tool, springs, constraints, damping) into force_; returns the
     /// elastic energy. Needs dd_ (mesh velocity) current.
     double meshForces(const Points& d, const Points& dd, double dt);
@@ -213,7 +214,7 @@ private:
     /// The tool's share of Verlet's omega^2 bound; infinite where Verlet is never taken.
     double verletToolTerm() const;
     /// Whether omega_max^2 of the springs and penalty terms in control space is provably below
-    /// `limit` (verlet_stability_bound.cpp); `tight` makes omegaUpper_ the computed bound. Allocates
+    /// `limit` (verlet_stability_bound.cpp); `tight` makes omega_.upper the computed bound. Allocates
     /// when it recomputes (a new configuration).
     bool omegaSquaredBelow(double limit, bool tight = false);
     void rescaleOmegaBounds();
@@ -233,55 +234,43 @@ private:
 
     BSplineSurface surface_;
     SamplingOperator A_;
-    Points d_, dd_, v_, fext_, ftool_, force_, meshTmp_, meshTmp2_, base_;
-    Points fp_, p0_, v0_, a0_, pStep_, vStep_, acc_, cgR_, cgZ_, cgP_, cgQ_, x_;
-    Points dPrev_;  // the mesh before the current step (set by step())
-    Points av_;  // local/global: A v kept from the last step (saves one A product a step)
-    // local/global BDF2: the state one step back (poles, velocities, mesh, A v) and x^ = (4 x_n - x_n-1) / 3
-    Points pHist_, vHist_, dHist_, avHist_, xHat_, dHat_;
-    Points yMesh_;  // local/global: the inertial prediction y on the mesh
-    Points aVerlet_;  // Verlet: acceleration of the internal forces at the step's start (first same as last)
-    std::vector<int> appliedPoles_;  // solveApplied(): the poles the applied forces reach (reserved)
-    std::vector<char> poleMark_;
-    bool verletValid_ = false;  // aVerlet_ belongs to the current state (cleared by touch() and anything moving it)
-    double stepPotential_ = -1;  // Verlet: potential energy at the step's end, for the energy guard (-1: none)
-    std::uint64_t omegaKey_[3] = {~0ull, ~0ull, ~0ull};
-    // Bounds on omega_max^2 for omegaKey_ (upper infinite where unknown); tight: upper from Lanczos
-    // for exactly this configuration. The snapshot: stiffnesses, masses, constraint structure and
-    // bounds where they were last computed, which map changes rescale.
-    double omegaUpper_ = std::numeric_limits<double>::infinity(), omegaLower_ = 0;
-    bool omegaTight_ = false;
-    Eigen::VectorXd snapK_, snapM_;
-    std::uint64_t snapStructure_ = 0;
-    double snapUpper_ = 0, snapLower_ = 0;
-    double histDt_ = 0;
-    /// The history is the previous step's at histDt_ (cleared with avValid_, and where the applied
-    /// forces jump: external forces set or cleared, a grab or a release). BDF2 extrapolates the
-    /// acceleration from its history, so across a jump it overshoots: a force held for one step
-    /// from rest and then removed left 16/9 of the kinetic energy it put in. Restarting (the
-    /// history synthesised from the new forces) is the textbook cure for multistep methods.
-    bool histValid_ = false;
-    Eigen::VectorXd m_, gamma_, cgInvDiag_;
+    SolverSettings solver_;
+    // The mesh (d = A p, its velocity A p', the mesh before the step, A v kept by local/global) and
+    // the forces on it; work buffers shared by the integrators.
+    Points d_, dd_, dPrev_, av_, fext_, ftool_, force_, meshTmp_, meshTmp2_, base_, yMesh_;
+    // Control space: velocities, A^T f, accelerations of the applied forces, local/global's iterate.
+    Points v_, fp_, acc_, x_;
+    bool avValid_ = false;  ///< av_ == A v_ (set by a local/global step, cleared by anything else touching v)
+    bool accelerationValid_ = false;
+    ExplicitState explicit_;
+    CgState cg_;
+    Bdf2History history_;
+    VerletState verlet_;
+    OmegaBounds omega_;
+    StepBackup backup_;
+    EnergyGuard guard_;
+    SleepMonitor sleep_;
+    // Material: per mesh point masses and damping rates, the maps, springs, constraints, tool.
+    Eigen::VectorXd m_, gamma_;
     MaterialMap mass_, damping_, stiffness_;
     SpringMesh springs_;
+    ResponseLaw dampingLaw_;
     ConstraintSet constraints_;
     std::vector<ConstraintTerm> terms_;
     std::unique_ptr<Tool> tool_;
     Cursor cursor_;
+    // Factorisations and the versions of what they were built from.
     PrefactoredSolver massSolver_, systemSolver_;
     Eigen::SparseMatrix<double> massMatrix_;  // A^T M A, as last factored by ensureMassFactor()
     std::uint64_t massVersion_ = ~0ull, materialKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
     std::uint64_t systemKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
     std::uint64_t wakeKey_[4] = {0, 0, 0, 0};
     double systemDt_ = -1;
-    double minMass_ = 0, maxStiffness_ = 0, maxDampingRate_ = 0, size_ = 1, spacingU_ = 1, spacingV_ = 1;
-    double time_ = 0, work_ = 0, ceiling_ = 0;
-    double accEnergy_ = 0;  // explicit: kinetic + elastic energy where acc_ was computed
-    bool ceilingValid_ = false;
-    bool hasExternal_ = false, toolForces_ = false, asleep_ = false, accelerationValid_ = false;
     bool systemFactored_ = false;
-    bool avValid_ = false;  ///< av_ == A v_ (set by a local/global step, cleared by anything else touching v)
-    int quietSteps_ = 0;
+    // Measures of the material and the initial shape; the clock.
+    double minMass_ = 0, maxStiffness_ = 0, maxDampingRate_ = 0, size_ = 1, spacingU_ = 1, spacingV_ = 1;
+    double time_ = 0, work_ = 0;
+    bool hasExternal_ = false, toolForces_ = false;
     std::uint64_t steps_ = 0;
 };
 

@@ -1,5 +1,7 @@
 #include "haptic_runtime.hpp"
 
+#include "names.hpp"
+
 #include <pthread.h>
 #include <sched.h>
 
@@ -63,15 +65,7 @@ void AirbrushSettings::validate() const {
     if (!(rate > 0 && rate <= 1000)) throw std::invalid_argument("rate: must be in (0, 1000] dabs per second");
 }
 
-const char* mapName(AirbrushSettings::Map map) {
-    switch (map) {
-        case AirbrushSettings::Map::Mass: return "mass";
-        case AirbrushSettings::Map::Damping: return "damping";
-        case AirbrushSettings::Map::Stiffness: return "stiffness";
-        case AirbrushSettings::Map::Off: break;
-    }
-    return "";
-}
+const char* mapName(AirbrushSettings::Map map) { return nameOf(kMapNames, map); }
 
 MaterialMap& HapticRuntime::mapOf(AirbrushSettings::Map map) {
     return map == AirbrushSettings::Map::Mass ? surface_->massMap()

@@ -16,7 +16,7 @@ namespace hs {
 
 void DynamicSurface::computeAcceleration() {
     A_.apply(v_, dd_);
-    accEnergy_ = meshForces(d_, dd_, 0.0) + 0.5 * (m_.asDiagonal() * dd_).cwiseProduct(dd_).sum();
+    explicit_.energy = meshForces(d_, dd_, 0.0) + 0.5 * (m_.asDiagonal() * dd_).cwiseProduct(dd_).sum();
     A_.applyTransposed(force_, fp_);
     massSolver_.solve(fp_, acc_);
     accelerationValid_ = true;
@@ -33,32 +33,32 @@ StepReport DynamicSurface::stepExplicit(double dt) {
 void DynamicSurface::explicitSubstep(double dt, int depth, StepReport& r) {
     if (!accelerationValid_) computeAcceleration();
     // One saved state suffices: a rejected trial always restarts from the current substep's start.
-    p0_ = surface_.poles();
-    v0_ = v_;
-    a0_ = acc_;
+    explicit_.p0 = surface_.poles();
+    explicit_.v0 = v_;
+    explicit_.a0 = acc_;
     meshTmp_ = d_;
-    const double e0 = accEnergy_;
+    const double e0 = explicit_.energy;
     Points& p = surface_.mutablePoles();
     v_ += dt * acc_;
     p += dt * v_;
     A_.apply(p, d_);
     computeAcceleration();
     const double amax = acc_.cwiseAbs().maxCoeff();
-    const double limit = solver.accelerationLimit > 0 ? solver.accelerationLimit : 0.1 * size_ / (dt * dt);
+    const double limit = solver_.accelerationLimit > 0 ? solver_.accelerationLimit : 0.1 * size_ / (dt * dt);
     double work = 0;
     if (hasExternal_) work += fext_.cwiseProduct(d_ - meshTmp_).sum();
     if (toolForces_) work += ftool_.cwiseProduct(d_ - meshTmp_).sum();
-    const double gained = accEnergy_ - e0 - std::max(0.0, work);
-    const bool ok = std::isfinite(amax) && amax <= limit && std::isfinite(accEnergy_) &&
-                    gained <= solver.energyTolerance * (e0 + std::abs(work)) + 1e-12 * stiffness_.mean() * size_ * size_;
-    if (ok || depth >= solver.maxHalvings) {
+    const double gained = explicit_.energy - e0 - std::max(0.0, work);
+    const bool ok = std::isfinite(amax) && amax <= limit && std::isfinite(explicit_.energy) &&
+                    gained <= solver_.energyTolerance * (e0 + std::abs(work)) + 1e-12 * stiffness_.mean() * size_ * size_;
+    if (ok || depth >= solver_.maxHalvings) {
         ++r.substeps;
         return;
     }
-    p = p0_;
-    v_ = v0_;
-    acc_ = a0_;
-    accEnergy_ = e0;
+    p = explicit_.p0;
+    v_ = explicit_.v0;
+    acc_ = explicit_.a0;
+    explicit_.energy = e0;
     A_.apply(p, d_);
     explicitSubstep(0.5 * dt, depth + 1, r);
     explicitSubstep(0.5 * dt, depth + 1, r);

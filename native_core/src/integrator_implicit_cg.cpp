@@ -20,31 +20,31 @@ StepReport DynamicSurface::stepImplicitCG(double dt) {
     };
     stiffnessTimes(dd_, meshTmp2_);
     meshTmp_ = dt * force_ - dt * dt * meshTmp2_;
-    A_.applyTransposed(meshTmp_, cgR_);
-    const double bnorm = std::sqrt(cgR_.squaredNorm());
+    A_.applyTransposed(meshTmp_, cg_.r);
+    const double bnorm = std::sqrt(cg_.r.squaredNorm());
     x_.setZero();
     double rnorm = bnorm;
     if (bnorm > 0) {
-        cgZ_ = cgInvDiag_.asDiagonal() * cgR_;
-        cgP_ = cgZ_;
-        double rz = cgR_.cwiseProduct(cgZ_).sum();
-        for (int it = 0; it < solver.cgIterations; ++it) {
+        cg_.z = cg_.invDiag.asDiagonal() * cg_.r;
+        cg_.p = cg_.z;
+        double rz = cg_.r.cwiseProduct(cg_.z).sum();
+        for (int it = 0; it < solver_.cgIterations; ++it) {
             // q = (Mp + dt Dp + dt^2 Kp) p, applied through the mesh.
-            A_.apply(cgP_, meshTmp_);
+            A_.apply(cg_.p, meshTmp_);
             stiffnessTimes(meshTmp_, meshTmp2_);
             meshTmp2_ = (m_ + dt * gamma_).asDiagonal() * meshTmp_ + dt * dt * meshTmp2_;
-            A_.applyTransposed(meshTmp2_, cgQ_);
-            const double pq = cgP_.cwiseProduct(cgQ_).sum();
+            A_.applyTransposed(meshTmp2_, cg_.q);
+            const double pq = cg_.p.cwiseProduct(cg_.q).sum();
             ++r.iterations;
             if (!(pq > 0)) break;
             const double alpha = rz / pq;
-            x_ += alpha * cgP_;
-            cgR_ -= alpha * cgQ_;
-            rnorm = std::sqrt(cgR_.squaredNorm());
+            x_ += alpha * cg_.p;
+            cg_.r -= alpha * cg_.q;
+            rnorm = std::sqrt(cg_.r.squaredNorm());
             if (rnorm <= 1e-14 * bnorm) break;
-            cgZ_ = cgInvDiag_.asDiagonal() * cgR_;
-            const double rzNew = cgR_.cwiseProduct(cgZ_).sum();
-            cgP_ = cgZ_ + (rzNew / rz) * cgP_;
+            cg_.z = cg_.invDiag.asDiagonal() * cg_.r;
+            const double rzNew = cg_.r.cwiseProduct(cg_.z).sum();
+            cg_.p = cg_.z + (rzNew / rz) * cg_.p;
             rz = rzNew;
         }
     }

@@ -43,7 +43,7 @@ double DynamicSurface::predictorWeight(double dt, bool fixedTargets) const {
 
 StepReport DynamicSurface::stepLocalGlobal(double dt) {
     StepReport r;
-    const bool bdf2 = solver.timeOrder == 2;
+    const bool bdf2 = solver_.timeOrder == 2;
     const double h = localGlobalH(dt);
     ensureSystem(h, true);
     const Points& p = surface_.poles();
@@ -52,35 +52,35 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     const Points* dBase = &d_;  // x^ on the mesh
     // y, the inertial prediction: x_ in control space, yMesh_ on the mesh (A y without a product by A)
     if (bdf2) {
-        if (!histValid_ || histDt_ != dt) {
+        if (!history_.valid || history_.dt != dt) {
             // The state one step back. Without the acceleration term v_n-1 = v_n is O(dt) off, and a
             // start from rest under load (a pushed pole let go) was then first order throughout.
             // Where extrapolation is unstable (predictorWeight, point constraints included: their
             // stiff pull would enter as a velocity impulse) the term fades out.
-            pHist_ = p - dt * v_;
-            vHist_ = v_;
-            dHist_ = d_ - dt * av_;
-            avHist_ = av_;
+            history_.p = p - dt * v_;
+            history_.v = v_;
+            history_.d = d_ - dt * av_;
+            history_.av = av_;
             // Heavy damping is a stiff mode too (rate gamma / m): a past accelerating freely
             // against it is not one BDF2 can start from.
             const double rate = dt * maxDampingRate_;
-            const double wh = dampingLaw.kind != LawKind::Linear
+            const double wh = dampingLaw_.kind != LawKind::Linear
                                   ? 0.0 : std::min(predictorWeight(dt, true), extrapolationWeight(rate * rate));
             if (wh > 0) {
                 ensureMassFactor();
                 computeAcceleration();  // acc_, and A acc_ into dd_ below
                 A_.apply(acc_, dd_);
-                pHist_ += (0.5 * dt * dt * wh) * acc_;
-                vHist_ -= (dt * wh) * acc_;
-                dHist_ += (0.5 * dt * dt * wh) * dd_;
-                avHist_ -= (dt * wh) * dd_;
+                history_.p += (0.5 * dt * dt * wh) * acc_;
+                history_.v -= (dt * wh) * acc_;
+                history_.d += (0.5 * dt * dt * wh) * dd_;
+                history_.av -= (dt * wh) * dd_;
             }
         }
-        xHat_ = (4.0 / 3.0) * p - (1.0 / 3.0) * pHist_;
-        x_ = xHat_ + h * ((4.0 / 3.0) * v_ - (1.0 / 3.0) * vHist_);
-        dHat_ = (4.0 / 3.0) * d_ - (1.0 / 3.0) * dHist_;
-        yMesh_ = dHat_ + h * ((4.0 / 3.0) * av_ - (1.0 / 3.0) * avHist_);
-        dBase = &dHat_;
+        history_.xHat = (4.0 / 3.0) * p - (1.0 / 3.0) * history_.p;
+        x_ = history_.xHat + h * ((4.0 / 3.0) * v_ - (1.0 / 3.0) * history_.v);
+        history_.dHat = (4.0 / 3.0) * d_ - (1.0 / 3.0) * history_.d;
+        yMesh_ = history_.dHat + h * ((4.0 / 3.0) * av_ - (1.0 / 3.0) * history_.av);
+        dBase = &history_.dHat;
     } else {
         x_ = p + dt * v_;
         yMesh_ = d_ + dt * av_;
@@ -88,7 +88,7 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     // The tool pulls where the mesh is predicted at the step's end, as BDF2 wants its forces: taken
     // at the start, they made the rope scene first order. The tool is explicit, so its own slope
     // limits the prediction as the springs' does (the smooth tool's slope is unknown: none).
-    if (w > 0) dd_ = dt * av_ + (0.5 * dt) * (av_ - avHist_);  // the predicted motion over the step (mesh)
+    if (w > 0) dd_ = dt * av_ + (0.5 * dt) * (av_ - history_.av);  // the predicted motion over the step (mesh)
     const double wt = w > 0 && tool_->grabbed() ? std::min(w, extrapolationWeight(dt * dt * tool_->slope() / minMass_)) : 0.0;
     if (wt > 0) {
         meshTmp_ = d_ + wt * dd_;
@@ -100,12 +100,12 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     base_ = (h * gamma_).asDiagonal() * (*dBase - yMesh_);
     if (hasExternal_) base_ += (h * h) * fext_;
     if (toolForces_) base_ += (h * h) * ftool_;
-    if (dampingLaw.kind != LawKind::Linear) {
+    if (dampingLaw_.kind != LawKind::Linear) {
         // Extra non-linear damping, explicit, limited to h * extra / m <= 1 so it cannot destabilise.
         force_.setZero();
         springs_.addForces(d_, force_);
         for (Eigen::Index i = 0; i < d_.rows(); ++i) {
-            const double extra = (dampingLaw.dampingFactor(force_.row(i).norm()) - 1.0) * gamma_[i];
+            const double extra = (dampingLaw_.dampingFactor(force_.row(i).norm()) - 1.0) * gamma_[i];
             const double limited = std::min(extra, m_[i] / h);
             base_.row(i) -= h * limited * (yMesh_.row(i) - dBase->row(i));  // h^2 * extra * v^
         }
@@ -113,7 +113,7 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     // The first iterate: y, or the end of the step predicted to O(dt^3) (predictorWeight).
     const Points* iterate = &yMesh_;
     if (w > 0) {
-        x_ += w * (p + dt * v_ + (0.5 * dt) * (v_ - vHist_) - x_);
+        x_ += w * (p + dt * v_ + (0.5 * dt) * (v_ - history_.v) - x_);
         meshTmp_ = yMesh_ + w * (d_ + dd_ - yMesh_);
         iterate = &meshTmp_;
     }
@@ -124,7 +124,7 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     // then biases every step the same way, and BDF2 turns that into a drifting velocity (error
     // 4.7e-5 at a 1 us step in bench/time_vs_error.py's oscillation, growing as the step shrinks).
     double change = 0;
-    for (int it = 0; it < solver.iterations; ++it) {
+    for (int it = 0; it < solver_.iterations; ++it) {
         if (it > 0) {
             A_.apply(x_, meshTmp_);
             iterate = &meshTmp_;
@@ -141,23 +141,23 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     }
     r.residual = change / size_;
     if (bdf2) {
-        v_ = (x_ - xHat_) / h;
+        v_ = (x_ - history_.xHat) / h;
         // History for the next step: the state this step started from (step()'s backups).
-        pHist_ = pStep_;
-        vHist_ = vStep_;
-        dHist_ = dPrev_;
-        avHist_.swap(av_);
+        history_.p = backup_.p;
+        history_.v = backup_.v;
+        history_.d = dPrev_;
+        history_.av.swap(av_);
     } else {
         v_ = (x_ - p) / dt;
     }
     surface_.mutablePoles() = x_;
     A_.apply(surface_.poles(), d_);
     // A v up to rounding, since A is linear, without a product by A
-    if (bdf2) av_ = (d_ - dHat_) / h;
+    if (bdf2) av_ = (d_ - history_.dHat) / h;
     else av_ = (d_ - dPrev_) / dt;
     avValid_ = true;
-    histValid_ = bdf2;
-    histDt_ = dt;
+    history_.valid = bdf2;
+    history_.dt = dt;
     accelerationValid_ = false;
     return r;
 }

@@ -32,9 +32,9 @@ double DynamicSurface::verletForces(const Points& d, const Points& dd) {
 }
 
 double DynamicSurface::verletToolTerm() const {
-    if (!solver.explicitWhenStable) return kInf;
+    if (!solver_.explicitWhenStable) return kInf;
     // Non-linear laws stiffen without bound; curvature constraints project onto arcs (not convex).
-    if (springs_.law.kind != LawKind::Linear || dampingLaw.kind != LawKind::Linear || constraints_.anyNonConvex())
+    if (springs_.law.kind != LawKind::Linear || dampingLaw_.kind != LawKind::Linear || constraints_.anyNonConvex())
         return kInf;
     // The tool adds at most slope on each point it holds: omega^2 grows by at most slope / m_min.
     return tool_->grabbed() ? tool_->slope() / minMass_ : 0.0;
@@ -55,7 +55,7 @@ double DynamicSurface::verletStepLimit() {
     const double tool = verletToolTerm();
     if (!std::isfinite(tool)) return 0.0;
     omegaSquaredBelow(kInf, true);
-    double dt = kVerletStability / std::sqrt(omegaUpper_ + tool);
+    double dt = kVerletStability / std::sqrt(omega_.upper + tool);
     if (maxDampingRate_ > 0) dt = std::min(dt, 0.1 / maxDampingRate_);
     return dt;
 }
@@ -63,7 +63,7 @@ double DynamicSurface::verletStepLimit() {
 void DynamicSurface::solveApplied() {
     const CsrMatrix& a = A_.matrix();
     fp_.setZero();
-    appliedPoles_.clear();
+    verlet_.appliedPoles.clear();
     for (Eigen::Index r = 0; r < d_.rows(); ++r) {
         Vec3 f = Vec3::Zero();
         if (hasExternal_) f += fext_.row(r).transpose();
@@ -71,15 +71,15 @@ void DynamicSurface::solveApplied() {
         if (f.isZero(0.0)) continue;
         for (int e = a.rowStart[static_cast<size_t>(r)]; e < a.rowStart[static_cast<size_t>(r) + 1]; ++e) {
             const int c = a.col[static_cast<size_t>(e)];
-            if (!poleMark_[static_cast<size_t>(c)]) {
-                poleMark_[static_cast<size_t>(c)] = 1;
-                appliedPoles_.push_back(c);
+            if (!verlet_.poleMark[static_cast<size_t>(c)]) {
+                verlet_.poleMark[static_cast<size_t>(c)] = 1;
+                verlet_.appliedPoles.push_back(c);
             }
             fp_.row(c) += a.value[static_cast<size_t>(e)] * f.transpose();
         }
     }
-    for (int c : appliedPoles_) poleMark_[static_cast<size_t>(c)] = 0;
-    massSolver_.solveSparse(fp_, appliedPoles_, acc_);
+    for (int c : verlet_.appliedPoles) verlet_.poleMark[static_cast<size_t>(c)] = 0;
+    massSolver_.solveSparse(fp_, verlet_.appliedPoles, acc_);
 }
 
 StepReport DynamicSurface::stepVerlet(double dt) {
@@ -89,10 +89,10 @@ StepReport DynamicSurface::stepVerlet(double dt) {
     ensureMassFactor();
     const double h = dt;
     if (!avValid_) A_.apply(v_, av_);
-    if (!verletValid_) {
+    if (!verlet_.valid) {
         verletForces(d_, av_);
         A_.applyTransposed(force_, fp_);
-        massSolver_.solve(fp_, aVerlet_);
+        massSolver_.solve(fp_, verlet_.a);
     }
     if (tool_->grabbed()) {
         meshTmp_ = d_ + (0.5 * h) * av_;
@@ -105,19 +105,19 @@ StepReport DynamicSurface::stepVerlet(double dt) {
         solveApplied();
         v_ += (0.5 * h) * acc_;
     }
-    v_ += (0.5 * h) * aVerlet_;
+    v_ += (0.5 * h) * verlet_.a;
     surface_.mutablePoles() += h * v_;
     A_.apply(surface_.poles(), d_);
     // The mesh velocity at the step's end, to second order, for the damping: 2 v+ - v_n.
     meshTmp_ = (2.0 / h) * (d_ - dPrev_) - av_;
-    stepPotential_ = verletForces(d_, meshTmp_);
+    verlet_.stepPotential = verletForces(d_, meshTmp_);
     A_.applyTransposed(force_, fp_);
-    massSolver_.solve(fp_, aVerlet_);
-    v_ += (0.5 * h) * aVerlet_;
+    massSolver_.solve(fp_, verlet_.a);
+    v_ += (0.5 * h) * verlet_.a;
     if (applied) v_ += (0.5 * h) * acc_;
     A_.apply(v_, av_);
-    avValid_ = verletValid_ = true;
-    histValid_ = accelerationValid_ = false;
+    avValid_ = verlet_.valid = true;
+    history_.valid = accelerationValid_ = false;
     return r;
 }
 

@@ -6,11 +6,12 @@
 
 namespace hs {
 
-std::vector<double> clampedUniformKnots(int count, int degree) {
+std::vector<double> clampedUniformKnots(int count, int degree, const char* countName) {
     if (degree < 1 || degree > kMaxDegree)
-        throw std::invalid_argument("degree must be in 1.." + std::to_string(kMaxDegree));
+        throw std::invalid_argument("degree: must be in 1.." + std::to_string(kMaxDegree) + ", got " + std::to_string(degree));
     if (count < degree + 1)
-        throw std::invalid_argument("control count must be >= degree+1");
+        throw std::invalid_argument(std::string(countName) + ": need at least degree+1 = " + std::to_string(degree + 1) +
+                                    " control points in each direction, got " + std::to_string(count));
     std::vector<double> k(static_cast<size_t>(count + degree + 1));
     const int inner = count - degree;  // number of spans
     for (int i = 0; i < static_cast<int>(k.size()); ++i) {

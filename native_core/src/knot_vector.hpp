@@ -11,7 +11,7 @@ namespace hs {
 constexpr int kMaxDegree = 5;
 
 /// Clamped uniform knot vector for `count` control points of degree `degree` on [0, 1].
-std::vector<double> clampedUniformKnots(int count, int degree);
+std::vector<double> clampedUniformKnots(int count, int degree, const char* countName = "controls");
 
 /// Throws std::invalid_argument naming `name` unless `knots` is a valid clamped-or-not,
 /// non-decreasing knot vector for `count` control points of degree `degree`

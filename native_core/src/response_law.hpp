@@ -2,6 +2,8 @@
 #pragma once
 #include <cmath>
 
+#include "types.hpp"
+
 namespace hs {
 
 /// g(x) maps a linear response x to the actual one; `scale` is the characteristic value s:
@@ -46,6 +48,11 @@ struct ResponseLaw {
     double dampingFactor(double f) const {
         if (kind == LawKind::Linear || f <= 0) return 1.0;
         return value(f) / f;
+    }
+    /// A law with its scale checked (in [1e-12, 1e12]; throws std::invalid_argument naming it).
+    static ResponseLaw checked(LawKind kind, double scale) {
+        requireInRange(scale, "scale", 1e-12, 1e12);
+        return {kind, scale};
     }
 };
 

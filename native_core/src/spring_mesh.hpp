@@ -13,8 +13,13 @@ namespace hs {
 /// Plastic flow: past `yieldStrain` the rest length creeps toward the current length at `rate` (1/s).
 struct Plasticity {
     bool enabled = false;
-    double yieldStrain = 0.05;
-    double rate = 1.0;
+    double yieldStrain = 0.05;  ///< strain past which the rest length creeps
+    double rate = 1.0;          ///< creep rate, 1/s
+    /// Throws std::invalid_argument naming the first bad field.
+    void validate() const {
+        requirePositive(yieldStrain, "yield_strain", true);
+        requirePositive(rate, "rate", true);
+    }
 };
 
 class SpringMesh {

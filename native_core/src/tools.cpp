@@ -1,5 +1,7 @@
 #include "tools.hpp"
 
+#include "names.hpp"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -237,7 +239,7 @@ std::unique_ptr<Tool> makeTool(const std::string& name) {
     if (name == "magnet") return std::make_unique<MagnetTool>();
     if (name == "orientation") return std::make_unique<OrientationTool>();
     if (name == "smooth") return std::make_unique<SmoothTool>();
-    throw std::invalid_argument("tool: unknown tool '" + name + "' (rope, magnet, orientation, smooth)");
+    throw std::invalid_argument("tool: unknown tool '" + name + "' (" + listNames(kToolNames) + ")");
 }
 
 }  // namespace hs

@@ -1,6 +1,8 @@
 // Sculpting tools: each adds forces on the mesh points and returns the exact reaction on the cursor.
 #pragma once
 #include <algorithm>
+#include <array>
+#include <type_traits>
 #include <limits>
 #include <Eigen/Geometry>
 #include <memory>
@@ -169,6 +171,43 @@ private:
     Points u1_, u2_, u3_;
 };
 
+/// rope, magnet, orientation or smooth (names.hpp lists them); throws std::invalid_argument otherwise.
 std::unique_ptr<Tool> makeTool(const std::string& name);
+
+/// A tool setting and its range (finite and > 0, or >= 0 where zero is allowed): the one place
+/// its name, range and meaning are written; set() is the check every caller goes through.
+template <class T, class Owner = T>
+struct ToolParameter {
+    const char* name;
+    double Owner::*member;
+    bool allowZero;
+    const char* doc;
+    double get(const T& t) const { return owner(t).*member; }
+    void set(T& t, double value) const { owner(t).*member = requirePositive(value, name, allowZero); }
+
+private:
+    template <class U>
+    static auto& owner(U& t) {  // the tool itself, or its limits (ToolLimits, shared by every tool)
+        if constexpr (std::is_same_v<T, Owner>) return t;
+        else return t.limits;
+    }
+};
+
+inline const std::array<ToolParameter<Tool, ToolLimits>, 2> kToolLimitParameters{{
+    {"max_force", &ToolLimits::maxForce, false, "clamp on the tool's total force"},
+    {"ramp_time", &ToolLimits::rampTime, true, "seconds for the force to ramp in after a grab"}}};
+inline const std::array<ToolParameter<RopeTool>, 4> kRopeParameters{{
+    {"stiffness", &RopeTool::stiffness, false, "force per length below the threshold"},
+    {"stiff_stiffness", &RopeTool::stiffStiffness, false, "force per length past the threshold"},
+    {"threshold", &RopeTool::threshold, true, "extension beyond rest length where the rope turns stiff"},
+    {"reel_time", &RopeTool::reelTime, true, "seconds for the rest length to reel in to zero"}}};
+inline const std::array<ToolParameter<MagnetTool>, 2> kMagnetParameters{{
+    {"radius", &MagnetTool::radius, false, "selection radius"},
+    {"stiffness", &MagnetTool::stiffness, false, "spring stiffness per point"}}};
+inline const std::array<ToolParameter<OrientationTool>, 1> kOrientationParameters{{
+    {"stiffness", &OrientationTool::stiffness, false, "stiffness of the five springs"}}};
+inline const std::array<ToolParameter<SmoothTool>, 2> kSmoothParameters{{
+    {"radius", &SmoothTool::radius, false, "brush radius"},
+    {"strength", &SmoothTool::strength, false, "fairing force per unit of U^3 x"}}};
 
 }  // namespace hs

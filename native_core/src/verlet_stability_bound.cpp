@@ -20,38 +20,38 @@ namespace hs {
 
 bool DynamicSurface::omegaSquaredBelow(double limit, bool tight) {
     const std::uint64_t key[3] = {mass_.version(), stiffness_.version(), constraints_.structureVersion()};
-    if (key[0] != omegaKey_[0] || key[1] != omegaKey_[1] || key[2] != omegaKey_[2]) {
+    if (key[0] != omega_.key[0] || key[1] != omega_.key[1] || key[2] != omega_.key[2]) {
         rescaleOmegaBounds();
-        for (int i = 0; i < 3; ++i) omegaKey_[i] = key[i];
+        for (int i = 0; i < 3; ++i) omega_.key[i] = key[i];
     }
     if (!tight) {
-        if (omegaUpper_ <= limit) return true;
-        if (omegaLower_ > limit || omegaTight_) return false;
+        if (omega_.upper <= limit) return true;
+        if (omega_.lower > limit || omega_.tight) return false;
     }
-    if (!omegaTight_) computeOmegaBounds(tight ? std::numeric_limits<double>::infinity() : limit);
-    return omegaUpper_ <= limit;
+    if (!omega_.tight) computeOmegaBounds(tight ? std::numeric_limits<double>::infinity() : limit);
+    return omega_.upper <= limit;
 }
 
 void DynamicSurface::rescaleOmegaBounds() {
-    omegaTight_ = false;
-    if (snapK_.size() == 0 || snapStructure_ != constraints_.structureVersion()) {
-        omegaUpper_ = std::numeric_limits<double>::infinity();
-        omegaLower_ = 0;
+    omega_.tight = false;
+    if (omega_.snapK.size() == 0 || omega_.snapStructure != constraints_.structureVersion()) {
+        omega_.upper = std::numeric_limits<double>::infinity();
+        omega_.lower = 0;
         return;
     }
     double kUp = 1, kDown = 1, mUp = 0, mDown = std::numeric_limits<double>::infinity();
-    for (Eigen::Index s = 0; s < snapK_.size(); ++s) {
-        const double r = springs_.stiffness(static_cast<int>(s)) / snapK_[s];
+    for (Eigen::Index s = 0; s < omega_.snapK.size(); ++s) {
+        const double r = springs_.stiffness(static_cast<int>(s)) / omega_.snapK[s];
         kUp = std::max(kUp, r);
         kDown = std::min(kDown, r);
     }
     for (Eigen::Index i = 0; i < m_.size(); ++i) {
-        const double r = m_[i] / snapM_[i];
+        const double r = m_[i] / omega_.snapM[i];
         mUp = std::max(mUp, r);
         mDown = std::min(mDown, r);
     }
-    omegaUpper_ = snapUpper_ * kUp / mDown;
-    omegaLower_ = snapLower_ * kDown / mUp;
+    omega_.upper = omega_.snapUpper * kUp / mDown;
+    omega_.lower = omega_.snapLower * kDown / mUp;
 }
 
 void DynamicSurface::computeOmegaBounds(double limit) {
@@ -59,16 +59,16 @@ void DynamicSurface::computeOmegaBounds(double limit) {
     const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
     const Eigen::SparseMatrix<double> K = A.transpose() * laplacian() * A;
     const Eigen::SparseMatrix<double>& M = massMatrix_;
-    snapK_.resize(static_cast<Eigen::Index>(springs_.first().size()));
-    for (Eigen::Index s = 0; s < snapK_.size(); ++s) snapK_[s] = springs_.stiffness(static_cast<int>(s));
-    snapM_ = m_;
-    snapStructure_ = constraints_.structureVersion();
+    omega_.snapK.resize(static_cast<Eigen::Index>(springs_.first().size()));
+    for (Eigen::Index s = 0; s < omega_.snapK.size(); ++s) omega_.snapK[s] = springs_.stiffness(static_cast<int>(s));
+    omega_.snapM = m_;
+    omega_.snapStructure = constraints_.structureVersion();
     // max K_ii / M_ii is a Rayleigh quotient, so a lower bound: it rules out long steps cheaply.
     const double lower = (K.diagonal().array() / M.diagonal().array()).maxCoeff();
     if (lower > limit) {
-        omegaLower_ = snapLower_ = lower;
-        omegaUpper_ = snapUpper_ = std::numeric_limits<double>::infinity();
-        omegaTight_ = false;
+        omega_.lower = omega_.snapLower = lower;
+        omega_.upper = omega_.snapUpper = std::numeric_limits<double>::infinity();
+        omega_.tight = false;
         return;
     }
     // Lanczos in the M inner product (M^-1 K is self-adjoint there): its largest Ritz value is a
@@ -111,9 +111,9 @@ void DynamicSurface::computeOmegaBounds(double limit) {
         if (!live[0] && !live[1] && !live[2]) break;
     }
     // Ritz values are Rayleigh quotients: lower bounds that reach lambda_max from below; hence the margin.
-    omegaLower_ = snapLower_ = best;
-    omegaUpper_ = snapUpper_ = 1.05 * best;
-    omegaTight_ = true;
+    omega_.lower = omega_.snapLower = best;
+    omega_.upper = omega_.snapUpper = 1.05 * best;
+    omega_.tight = true;
 }
 
 }  // namespace hs

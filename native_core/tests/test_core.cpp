@@ -90,10 +90,10 @@ class AllocationFree : public ::testing::TestWithParam<IntegratorKind> {};
 // and checks every step against `check`.
 template <class Check>
 long allocationsWhileSculpting(DynamicSurface& s, double penalty, double dt, Check check) {
-    s.sleep.enabled = false;
+    s.setSleep({false, 1e-6, 10});
     s.constraints().add(ConstraintKind::Point, 40, penalty, s.mesh(), nullptr, nullptr, nullptr);
     s.constraints().add(ConstraintKind::Normal, 300, penalty, s.mesh(), nullptr, nullptr, nullptr);
-    s.springs().plasticity.enabled = true;
+    s.setPlasticity({true, 0.05, 1.0});
     s.stiffnessMap().dab(0.5, 0.5, 0.2, 50.0, Falloff::Conical, 1.0);
     Cursor c;
     c.position = Vec3(1, 2, 3);
@@ -113,9 +113,9 @@ long allocationsWhileSculpting(DynamicSurface& s, double penalty, double dt, Che
 
 TEST_P(AllocationFree, SteppingWithToolConstraintsAndLawsDoesNotAllocate) {
     DynamicSurface s(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 30, 30);
-    s.solver.kind = GetParam();
-    s.springs().law = {LawKind::Saturating, 50.0};
-    s.dampingLaw = {LawKind::CubicHardening, 10.0};
+    { SolverSettings solver = s.solver(); solver.kind = GetParam(); s.setSolver(solver); }
+    s.setStiffnessLaw({LawKind::Saturating, 50.0});
+    s.setDampingLaw({LawKind::CubicHardening, 10.0});
     EXPECT_EQ(allocationsWhileSculpting(s, 1e4, 1e-3, [](const StepReport& r) { ASSERT_FALSE(r.refused); }), 0);
 }
 
