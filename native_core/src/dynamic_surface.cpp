@@ -409,7 +409,7 @@ bool DynamicSurface::limitEnergy(double work, StepReport& r) {
 }
 
 void DynamicSurface::checkSleep(double dt) {
-    if (!sleep_.quietStep(v_.cwiseAbs().maxCoeff(), size_, tool_->grabbed())) return;
+    if (!sleep_.watching(tool_->grabbed()) || !sleep_.quietStep(v_.cwiseAbs().maxCoeff(), size_)) return;
     // Net force check, once, at the moment the surface would fall asleep.
     dd_.setZero();
     meshForces(d_, dd_, dt);

@@ -22,10 +22,16 @@ public:
 
     bool asleep() const { return asleep_; }
     void wake() { asleep_ = false; quiet_ = 0; }
-    /// After a step with largest speed `vmax` (tool held: `busy`): whether the net force should now
-    /// be checked, the last condition for falling asleep.
-    bool quietStep(double vmax, double size, bool busy) {
-        if (!settings.enabled || busy || !(vmax < settings.tolerance * size)) {
+    /// Whether steps are being watched at all (sleeping on, no tool held); else the count restarts.
+    bool watching(bool toolHeld) {
+        if (settings.enabled && !toolHeld) return true;
+        quiet_ = 0;
+        return false;
+    }
+    /// After a watched step with largest speed `vmax`: whether the net force should now be checked,
+    /// the last condition for falling asleep.
+    bool quietStep(double vmax, double size) {
+        if (!(vmax < settings.tolerance * size)) {
             quiet_ = 0;
             return false;
         }

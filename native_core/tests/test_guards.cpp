@@ -29,18 +29,19 @@ TEST(SleepMonitor, FallsAsleepAfterQuietStepsWhenTheNetForceIsSmall) {
     SleepMonitor m;
     m.settings.steps = 3;
     m.settings.tolerance = 1e-6;
-    EXPECT_FALSE(m.quietStep(0.0, 100.0, false));
-    EXPECT_FALSE(m.quietStep(0.0, 100.0, false));
-    EXPECT_FALSE(m.quietStep(0.0, 100.0, true));  // a held tool starts the count again
-    EXPECT_FALSE(m.quietStep(0.0, 100.0, false));
-    EXPECT_FALSE(m.quietStep(1.0, 100.0, false));  // too fast
-    EXPECT_FALSE(m.quietStep(0.0, 100.0, false));
-    EXPECT_FALSE(m.quietStep(0.0, 100.0, false));
-    ASSERT_TRUE(m.quietStep(0.0, 100.0, false));
+    EXPECT_FALSE(m.quietStep(0.0, 100.0));
+    EXPECT_FALSE(m.quietStep(0.0, 100.0));
+    EXPECT_FALSE(m.watching(true));  // a held tool starts the count again
+    EXPECT_TRUE(m.watching(false));
+    EXPECT_FALSE(m.quietStep(0.0, 100.0));
+    EXPECT_FALSE(m.quietStep(1.0, 100.0));  // too fast
+    EXPECT_FALSE(m.quietStep(0.0, 100.0));
+    EXPECT_FALSE(m.quietStep(0.0, 100.0));
+    ASSERT_TRUE(m.quietStep(0.0, 100.0));
     EXPECT_FALSE(m.settle(1.0, 1.0));  // a net force keeps it awake, counting again
     EXPECT_FALSE(m.asleep());
-    for (int i = 0; i < 2; ++i) EXPECT_FALSE(m.quietStep(0.0, 100.0, false));
-    ASSERT_TRUE(m.quietStep(0.0, 100.0, false));
+    for (int i = 0; i < 2; ++i) EXPECT_FALSE(m.quietStep(0.0, 100.0));
+    ASSERT_TRUE(m.quietStep(0.0, 100.0));
     EXPECT_TRUE(m.settle(1e-9, 1.0));
     EXPECT_TRUE(m.asleep());
     m.wake();
