@@ -18,7 +18,7 @@ from freecad_support import ROOT, run_freecadcmd
 
 SHOTS = os.path.join(ROOT, "build", "screenshots")
 TOOLBAR_Y = 122  # the HapticSculpt toolbar's row at 1280 x 1024 (FreeCAD 0.20's default layout)
-BUTTON = {"NewPatch": 30, "Session": 98, "Material": 133, "KeepShape": 167, "ToolMagnet": 235,
+BUTTON = {"NewPatch": 30, "Session": 98, "Material": 133, "KeepShape": 167, "ToolRope": 201, "ToolMagnet": 235,
           "PaintStiffness": 546, "ShowCurvature": 617, "Zebra": 683, "ZebraMode": 717,
           "Panel": 786}  # x of each button on that row
 RECORD_BUTTON = (536, 552)  # the Record button of FreeCAD's macro recording dialog
@@ -282,6 +282,14 @@ def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
         d.press_button("PaintStiffness", lambda s: s["painting"] is None, "the airbrush off")
         for button, title in (("ToolMagnet", "Tool: magnet"), ("Material", "Material: elastic")):
             s = d.press_button(button, lambda s: undo(s)[0] == title, title)
+        # A stroke in a threaded session (its shape depends on the device's timing): the macro
+        # records the state it left, and the elastic patch's motion after it as the session's end.
+        d.press_button("ToolRope", lambda s: undo(s)[0] == "Tool: rope", "Tool: rope")
+        d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
+        d.drag([south] + [(south[0], south[1] - 10 * k) for k in range(1, 12)], seconds=0.6)
+        d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the session's stroke")
+        s = d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
+        assert sculpt(s)["strokes"] == 1
         gui_digest = sculpt(s)["digest"]
         d.xdo("mousemove", "640", "500")
         d.xdo("key", "alt+m")  # Macro > Stop macro recording
@@ -293,7 +301,7 @@ def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
             text = open(macro).read() if os.path.exists(macro) else ""
     finally:
         d.close()
-    for call in ("make_sculpt", "add_constraint", "paint", "set_tool", "set_material"):
+    for call in ("make_sculpt", "add_constraint", "paint", "set_tool", "set_material", "record_state"):
         assert f"HapticSculpt.{call}(" in text, text
     out = run_freecadcmd(f"""
         import sys
@@ -301,9 +309,11 @@ def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
         exec(open({macro!r}).read())
         import FreeCAD, observer_digest
         obj = FreeCAD.ActiveDocument.getObject("Sculpt")
-        answer({{"digest": observer_digest.digest(obj), "undo": FreeCAD.ActiveDocument.UndoNames}})
+        answer({{"digest": observer_digest.digest(obj), "undo": FreeCAD.ActiveDocument.UndoNames,
+                 "strokes": obj.Strokes}})
         """, str(tmp_path / "replay"))
     assert out["digest"] == gui_digest, (out["undo"], text)
+    assert "Sculpt stroke" in out["undo"] and out["strokes"] == sculpt(s)["strokes"]
 
 
 @pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")

@@ -15,7 +15,7 @@ from typing import Any, Iterable, Protocol, Sequence
 import numpy as np
 
 from .. import core
-from . import sculpt_state
+from . import recorded_state, sculpt_state
 from .sculpt_feature import SculptFeature, attach_view_provider, is_sculpt
 from .sculpt_properties import face_of, read_state
 from .source_surface import source_surface
@@ -156,6 +156,34 @@ def keep_shape(obj: Any) -> None:
     step; a running session takes it at once, also while the tool is held."""
     _sculpt(obj)
     obj.Proxy.live.edit(lambda s: None, "Keep shape", keep_shape=True)
+
+
+def record_state(obj: Any, packed: str, title: str = "Sculpt stroke", strokes: int = 1) -> bool:
+    """Gives ``obj`` a recorded state: ``packed`` is what a stroke (or a spray, or a session's end)
+    in a threaded session changed, as :func:`HapticSculpt.app.recorded_state.pack` writes it. One
+    undo step named ``title``, counting ``strokes``. Returns False and does nothing if ``obj``
+    holds that state already: the GUI echoes this call after each stroke it commits, so FreeCAD's
+    macro recorder records the stroke, and a recorded macro replays it exactly in console mode."""
+    _sculpt(obj)
+    if not isinstance(title, str) or not title:
+        raise TypeError("title: expected a non-empty string")
+    if isinstance(strokes, bool) or not isinstance(strokes, int) or strokes < 0:
+        raise ValueError(f"strokes: expected a count >= 0, got {strokes!r}")
+    before = read_state(obj)
+    state = recorded_state.unpack(packed, before)
+    if state.settings_json() == before.settings_json() and all(
+            np.array_equal(state.arrays[k], before.arrays[k]) for k in state.arrays):
+        return False
+    sculpt_state.restore(state)  # (raises ValueError naming what does not fit, before anything changes)
+    live = obj.Proxy.live
+    with transaction(obj.Document, title):
+        live.write(state)
+        if strokes:
+            obj.Strokes = obj.Strokes + strokes
+        obj.purgeTouched()
+    live.document_changed()
+    live.restore_into_session()  # (a running session takes it up, at rest, as after an Undo)
+    return True
 
 
 def set_tool(obj: Any, tool: str, falloff: str | None = None) -> None:

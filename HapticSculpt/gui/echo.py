@@ -20,3 +20,13 @@ def run_echoed(code: str, modules: tuple[str, ...] = ("HapticSculpt",)) -> None:
 def ref(obj: Any) -> str:
     """How a script names a document object."""
     return f"App.getDocument({obj.Document.Name!r}).getObject({obj.Name!r})"
+
+
+def echo_recorded_state(obj: Any, before: Any, title: str, strokes: int) -> None:
+    """Echoes a stroke, spray or session end that a threaded session committed as the
+    ``HapticSculpt.record_state`` call that gives the state it left: run here it changes nothing
+    (the object holds that state), and in a recorded macro it replays the stroke exactly."""
+    from ..app.recorded_state import pack
+    from ..app.sculpt_properties import read_state
+    packed = pack(before, read_state(obj))
+    run_echoed(f"HapticSculpt.record_state({ref(obj)}, {packed!r}, {title!r}, strokes={strokes})")

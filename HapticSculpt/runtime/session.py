@@ -34,6 +34,18 @@ FrameClock = Callable[[Callable[[], None]], Callable[[], None]]
 _frame_clocks: list[FrameClock] = []
 
 
+#: Called after each commit a session makes that no scripting call made (a stroke, a spray, the
+#: session's end) with the object, its state before, the undo step's title and the strokes it
+#: counts: the GUI layer installs one that echoes HapticSculpt.record_state, so a macro records it.
+CommitListener = Callable[[Any, sculpt_state.SculptState, str, int], None]
+_commit_listeners: list[CommitListener] = []
+
+
+def set_commit_listener(listener: CommitListener) -> None:
+    """Installs the listener told of every stroke, spray and session end a session commits."""
+    _commit_listeners[:] = [listener]
+
+
 def set_frame_clock(clock: FrameClock) -> None:
     """Installs the clock sessions use while FreeCAD's GUI runs."""
     _frame_clocks[:] = [clock]
@@ -267,6 +279,8 @@ class Session:
                 if strokes:
                     obj.Strokes = obj.Strokes + strokes
                 obj.purgeTouched()
+            if strokes:
+                _tell_commit(obj, state, title, strokes)
             n += strokes
         return n
 
@@ -287,6 +301,7 @@ class Session:
             return
         live.reset_shape()
         live.commit("Sculpt session end")
+        _tell_commit(obj, stored, "Sculpt session end", 0)
 
     # --- GUI: shape at graphics rate, strokes as they end ----------------------------------------
     def _start_timer(self) -> None:
@@ -310,6 +325,11 @@ class Session:
         if painted is not None:
             self._latest_maps[painted["map"]] = painted["values"]
         self.poll()
+
+
+def _tell_commit(obj: Any, before: sculpt_state.SculptState, title: str, strokes: int) -> None:
+    for listener in _commit_listeners:
+        listener(obj, before, title, strokes)
 
 
 def stop_all(commit: bool = True) -> None:
