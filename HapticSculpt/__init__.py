@@ -9,9 +9,25 @@ called, so importing this package never imports FreeCAD or a GUI.
 __version__ = "0.2.0"
 
 from . import legacy_paths
-from .app.api import (CursorSource, RunReport, add_constraint, export_step, keep_shape, make_sculpt, material_of,
-                      paint, record_state, remove_constraint, run, set_curvature_target, set_material, set_tool,
-                      set_uniform, thicken, to_cadquery)
+from .app.api import (
+                      CursorSource,
+                      RunReport,
+                      add_constraint,
+                      export_step,
+                      keep_shape,
+                      make_sculpt,
+                      material_of,
+                      paint,
+                      record_state,
+                      remove_constraint,
+                      run,
+                      set_curvature_target,
+                      set_material,
+                      set_tool,
+                      set_uniform,
+                      thicken,
+                      to_cadquery,
+)
 from .runtime.replay_device import CursorSample, ReplayDevice
 from .runtime.session import Session, stop_all
 

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from freecad_support import DocumentTestCase
 
 import HapticSculpt as hs
