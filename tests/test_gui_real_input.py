@@ -152,12 +152,15 @@ class Desktop:
     def calibrate(self) -> None:
         """Maps the active 3D view's viewport pixels to screen pixels, from where the view itself
         reports the mouse at two screen points."""
+        def active(s: dict) -> dict:
+            return next(v for v in s["views"] if v["active"])
+
         pts = []
         for sx, sy in ((400, 400), (800, 600)):
-            before = self.state()["views"][0]["cursor"]
+            before = active(self.state())["cursor"]
             self.xdo("mousemove", str(sx), str(sy))
-            s = self.wait(lambda s: s["views"][0]["cursor"] != before, "the view to see the mouse move")
-            pts.append(((sx, sy), s["views"][0]["cursor"]))
+            s = self.wait(lambda s: active(s)["cursor"] != before, "the view to see the mouse move")
+            pts.append(((sx, sy), active(s)["cursor"]))
         (s0, v0), (s1, v1) = pts
         self._map = [(s0[k], v0[k], (s1[k] - s0[k]) / (v1[k] - v0[k])) for k in (0, 1)]
 
@@ -445,5 +448,54 @@ def test_keys_follow_the_view_across_documents_opened_switched_and_closed(tmp_pa
         time.sleep(0.3)
         d.xdo("key", "m")
         d.wait(lambda s: all(o["display"] == "shading" for o in s["overlays"]), "M still works after the close")
+    finally:
+        d.close()
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_a_second_view_of_the_same_document_takes_keys_and_strokes_and_closes_cleanly(tmp_path):
+    """View > Create new view opens a second 3D view of the sculpt's document while the workbench
+    is active: keys and a session's rope stroke work in it, the first view still takes keys after
+    a switch, and closing the second view leaves the first one working."""
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        d.xdo("mousemove", "640", "500")
+        s, _ = patch_with_keyed_constraints(d)
+        doc = s["active"]
+        d.xdo("key", "alt+v")  # View > Create new view (the menu's first item)
+        d.xdo("key", "Return")
+        s = d.wait(lambda s: len([v for v in s["views"] if v["doc"] == doc]) == 2 and s["inputs"] == 2,
+                   "the second view of the document to be attached")
+        assert [v["redirect"] for v in s["views"]] == [True, True]
+        d.calibrate()
+        centre, east, _, _, south = [d.to_screen(p) for p in sculpt(s)["screen"]]
+        d.xdo("mousemove", str(east[0]), str(east[1]))
+        d.wait(lambda s: s["mouse_point"] is not None, "the mouse over the patch in the second view")
+        time.sleep(0.2)
+        d.xdo("key", "p")  # P at the point constraint toggles it off
+        s = d.wait(lambda s: "point" not in [c[0] for c in sculpt(s)["constraints"]], "P in the second view")
+        assert len(sculpt(s)["constraints"]) == 2
+        d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
+        d.drag([south] + [(south[0], south[1] - 10 * k) for k in range(1, 12)], seconds=0.6)
+        s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "a rope stroke in the second view")
+        assert np.abs(np.array(sculpt(s)["poles"]).reshape(-1, 3)[:, 2]).max() > 3.0, "the rope did not pull"
+        d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
+        d.shot("second_view_stroke")
+        d.xdo("key", "ctrl+Tab")  # to the first view
+        s = d.wait(lambda s: s["views"][0]["active"], "ctrl+tab to the first view")
+        d.xdo("mousemove", str(centre[0]), str(centre[1] + 20))
+        time.sleep(0.3)
+        d.xdo("key", "m")
+        d.wait(lambda s: any(o["display"] == "mass" for o in s["overlays"]), "M in the first view")
+        d.xdo("key", "ctrl+Tab")  # back to the second view, and close it (the document stays open)
+        d.wait(lambda s: s["views"][1]["active"], "ctrl+tab to the second view")
+        d.xdo("key", "ctrl+w")
+        s = d.wait(lambda s: len(s["views"]) == 1 and s["inputs"] == 1, "the closed view forgotten")
+        assert doc in s["docs"]
+        d.focus()
+        d.xdo("mousemove", str(centre[0]), str(centre[1] + 20))
+        time.sleep(0.3)
+        d.xdo("key", "m")
+        d.wait(lambda s: all(o["display"] == "shading" for o in s["overlays"]), "M in the first view after the close")
     finally:
         d.close()
