@@ -5,19 +5,21 @@ BUILD       := build
 JOBS        ?= 2
 APT_PACKAGES := build-essential cmake ninja-build pkg-config libeigen3-dev pybind11-dev libgtest-dev \
                 python3-dev python3-numpy python3-scipy python3-pytest python3-hypothesis python3-matplotlib \
-                python3-venv freecad-python3 freecad libhidapi-dev xvfb xauth xdotool imagemagick
+                python3-venv freecad-python3 freecad libhidapi-dev xvfb xauth xdotool imagemagick debootstrap
 SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
 PHONY_LONG := stress fuzz bench-peers
-.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-gui-repeat test-cpp test-asan test-python test-freecad ocp-venv demo bench install install-udev uninstall clean
+.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-gui-repeat test-cpp test-asan test-python test-freecad ocp-venv demo bench install install-udev uninstall clean test-debian13 test-gui-repeat-debian13
 # A private FreeCAD user folder whose Mod/HapticSculpt links this checkout (tests, demo render).
 FC_HOME     := $(BUILD)/freecad-home
 # cadquery (with its own OCCT, OCP) in its own virtual environment: its numpy must not shadow Debian's.
 OCP_VENV    := $(BUILD)/ocp-venv
 CADQUERY    := cadquery==2.8.0
-# Where `make install` links the addon (FreeCAD 0.20/1.0; 1.1 uses ~/.local/share/FreeCAD/v1-1/Mod).
-FREECAD_MOD ?= $(HOME)/.local/share/FreeCAD/Mod
+# Where `make install` links the addon: the Mod folder of the FreeCAD installed here, as FreeCAD
+# itself names it (getUserAppDataDir: ~/.local/share/FreeCAD/ for 0.20 and 1.0, versioned folders
+# such as v1-1/ for 1.1). Give FREECAD_MOD=... to install elsewhere.
+FREECAD_MOD ?= $(shell cd /tmp && freecadcmd -c "import FreeCAD; print('HS_MOD=' + FreeCAD.getUserAppDataDir() + 'Mod')" 2>/dev/null | sed -n 's/^HS_MOD=//p')
 
 all: build
 
@@ -73,7 +75,21 @@ test-freecad: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
 	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python FREECAD_USER_HOME=$(CURDIR)/$(FC_HOME) \
 	  freecadcmd -t TestHapticSculpt
 
-test: test-cpp test-asan test-tsan test-python test-freecad
+test: test-cpp test-asan test-tsan test-python test-freecad test-debian13
+
+# The same against Debian 13's FreeCAD 1.0 (Python 3.13, GCC 14), in a Debian 13 root made by
+# debootstrap from Debian's archive with the same packages, built once and cached outside the
+# checkout (tools/debian13-root; rebuilt when the package list changes). Its builds, virtual
+# environment and demo go to build/debian13/.
+DEBIAN13_PACKAGES := $(APT_PACKAGES) make ca-certificates
+DEBIAN13 := tools/debian13-root run make BUILD=build/debian13 DEMO_OUT=build/debian13/demo
+test-debian13: deps
+	tools/debian13-root ensure $(DEBIAN13_PACKAGES)
+	$(DEBIAN13) test-cpp test-asan test-python test-freecad demo
+
+test-gui-repeat-debian13: deps
+	tools/debian13-root ensure $(DEBIAN13_PACKAGES)
+	$(DEBIAN13) test-gui-repeat GUI_REPEAT=$(GUI_REPEAT)
 
 # The GUI and runtime tests GUI_REPEAT times in a row (a test that fails one run in three fails CI).
 GUI_REPEAT ?= 10
@@ -109,13 +125,14 @@ STRESS_SCENES ?= 100000
 stress: build
 	$(PY) bench/stress_campaign.py --scenes $(STRESS_SCENES)
 
+DEMO_OUT ?= out
 demo: build
-	$(PY) demo.py --out out
+	$(PY) demo.py --out $(DEMO_OUT)
 
 install: build
-	mkdir -p $(FREECAD_MOD)
-	ln -sfn $(CURDIR) $(FREECAD_MOD)/HapticSculpt
-	@echo "linked $(FREECAD_MOD)/HapticSculpt -> $(CURDIR); restart FreeCAD and pick the HapticSculpt workbench"
+	@mod="$(FREECAD_MOD)"; [ -n "$$mod" ] || { echo "FreeCAD's Mod folder not found (is freecadcmd installed?): give FREECAD_MOD=..."; exit 1; }; \
+	mkdir -p "$$mod" && ln -sfn $(CURDIR) "$$mod/HapticSculpt" && \
+	echo "linked $$mod/HapticSculpt -> $(CURDIR); restart FreeCAD and pick the HapticSculpt workbench"
 
 # SpaceMouse access for the logged-in user (uaccess; nothing broader).
 install-udev:
@@ -123,7 +140,8 @@ install-udev:
 	$(SUDO) udevadm control --reload-rules && $(SUDO) udevadm trigger --subsystem-match=hidraw || true
 
 uninstall:
-	rm -f $(FREECAD_MOD)/HapticSculpt
+	@mod="$(FREECAD_MOD)"; [ -n "$$mod" ] || { echo "FreeCAD's Mod folder not found: give FREECAD_MOD=..."; exit 1; }; \
+	rm -f "$$mod/HapticSculpt" && echo "removed $$mod/HapticSculpt"
 
 # Benchmarks print tables and write bench/results/*.json and *.png (tracked JSON, untracked plots).
 bench: build

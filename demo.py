@@ -55,7 +55,8 @@ def render(fcstd: str, png: str) -> str:
     if not os.path.lexists(os.path.join(home, "Mod", "HapticSculpt")):
         os.symlink(ROOT, os.path.join(home, "Mod", "HapticSculpt"))
     env = dict(os.environ, QTWEBENGINE_DISABLE_SANDBOX="1", FREECAD_USER_HOME=home)
-    subprocess.run([xvfb, "-a", "-s", "-screen 0 1280x1024x24", "freecad", script], env=env,
+    first = os.environ.get("HS_XVFB_FIRST", "99")  # (the first display number to try; see tests/freecad_support.py)
+    subprocess.run([xvfb, "-a", "-n", first, "-s", "-screen 0 1280x1024x24", "freecad", script], env=env,
                    capture_output=True, timeout=180)
     os.remove(script)
     if not os.path.isfile(png):

@@ -20,6 +20,10 @@ import FreeCAD  # noqa: E402  (before Part, or Part segfaults on import)
 import Part  # noqa: E402,F401
 
 FREECADCMD = shutil.which("freecadcmd") or shutil.which("FreeCADCmd")
+FREECAD_VERSION = tuple(int(x) for x in FreeCAD.Version()[:2])
+#: Where the GUI tests put their pictures, one folder per FreeCAD version (0.20's has the plain name).
+SCREENSHOTS = os.path.join(ROOT, "build", "screenshots" if FREECAD_VERSION < (1, 0)
+                           else "screenshots-freecad-%d.%d" % FREECAD_VERSION)
 #: cadquery/OCP in its own virtual environment (its numpy must not shadow FreeCAD's): `make ocp-venv`.
 OCP_PYTHON = os.environ.get("HS_OCP_PYTHON", os.path.join(ROOT, "build", "ocp-venv", "bin", "python"))
 
@@ -67,6 +71,9 @@ def run_freecadcmd(script: str, tmp: str, timeout: float = 300) -> dict:
         return json.load(f)
 
 
+#: The first X display number xvfb-run tries (it takes the next free one): a Debian 13 root started
+#: from the host shares the host's abstract X sockets, so it starts elsewhere (Makefile: test-debian13).
+XVFB_FIRST = os.environ.get("HS_XVFB_FIRST", "99")
 #: The FreeCAD GUI can run here (under Xvfb); GUI tests skip otherwise (make deps installs both).
 GUI_AVAILABLE = shutil.which("xvfb-run") is not None and shutil.which("freecad") is not None
 
@@ -81,7 +88,7 @@ def run_freecad_gui(script: str, tmp: str, timeout: float = 300) -> dict:
     with open(path, "w") as f:
         f.write(textwrap.dedent(script).replace("{answer}", repr(out)))
     env = dict(os.environ, QTWEBENGINE_DISABLE_SANDBOX="1", FREECAD_USER_HOME=home)
-    proc = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", "freecad", path],
+    proc = subprocess.run(["xvfb-run", "-a", "-n", XVFB_FIRST, "-s", "-screen 0 1280x1024x24", "freecad", path],
                           env=env, capture_output=True, text=True, timeout=timeout)
     if not os.path.exists(out):
         raise AssertionError(f"the FreeCAD GUI gave no answer (rc {proc.returncode}):\n{proc.stdout[-2000:]}\n{proc.stderr[-2000:]}")

@@ -9,10 +9,9 @@ import os
 
 import numpy as np
 import pytest
+from freecad_support import GUI_AVAILABLE, ROOT, SCREENSHOTS, run_freecad_gui
 
-from freecad_support import GUI_AVAILABLE, ROOT, run_freecad_gui
-
-SHOTS = os.path.join(ROOT, "build", "screenshots")
+SHOTS = SCREENSHOTS
 
 GUI_SCRIPT = """
 import json, os, time, traceback

@@ -5,6 +5,7 @@ reads document state (tests/gui_input/observer.py); every action is a real key o
 Screenshots go to build/screenshots/real_*.png."""
 from __future__ import annotations
 
+import ast
 import json
 import os
 import shutil
@@ -13,14 +14,22 @@ import time
 
 import numpy as np
 import pytest
+from freecad_support import ROOT, SCREENSHOTS, run_freecadcmd
 
-from freecad_support import ROOT, run_freecadcmd
+SHOTS = SCREENSHOTS
+# The HapticSculpt toolbar in FreeCAD's default layout at 1280 x 1024, by FreeCAD version: the
+# centre of its first button, the distance between buttons and the row (measured on screenshots).
+TOOLBAR = {(0, 20): (30, 34.4, 122), (1, 0): (28, 32.97, 117)}
+def _toolbar() -> list[str]:
+    """The toolbar's commands in order, read from gui/commands.py (not imported: importing the GUI
+    layer would install its hooks in this test process)."""
+    tree = ast.parse(open(os.path.join(ROOT, "HapticSculpt", "gui", "commands.py")).read())
+    names = next(ast.literal_eval(n.value) for n in tree.body if isinstance(n, ast.Assign)
+                 and any(getattr(t, "id", "") == "TOOLBAR" for t in n.targets))
+    return [name.removeprefix("HapticSculpt_") for name in names]
 
-SHOTS = os.path.join(ROOT, "build", "screenshots")
-TOOLBAR_Y = 122  # the HapticSculpt toolbar's row at 1280 x 1024 (FreeCAD 0.20's default layout)
-BUTTON = {"NewPatch": 30, "Session": 98, "Material": 133, "KeepShape": 167, "ToolRope": 201, "ToolMagnet": 235,
-          "PaintStiffness": 546, "ShowCurvature": 617, "Zebra": 683, "ZebraMode": 717,
-          "Panel": 786}  # x of each button on that row
+
+BUTTONS = _toolbar()
 RECORD_BUTTON = (536, 552)  # the Record button of FreeCAD's macro recording dialog
 STYLES = {"CAD": "Gui::CADNavigationStyle", "OpenInventor": "Gui::InventorNavigationStyle",
           "Blender": "Gui::BlenderNavigationStyle", "Gesture": "Gui::GestureNavigationStyle"}
@@ -57,7 +66,8 @@ class Desktop:
         files = [open_file] if open_file else []
         self.freecad = subprocess.Popen(["freecad", os.path.join(ROOT, "tests", "gui_input", "observer.py"), *files],
                                         env=self.env, stdout=self.log, stderr=subprocess.STDOUT)
-        self.wait(lambda s: s.get("workbench") == "HapticSculptWorkbench", "FreeCAD starting on the workbench", 120)
+        self.version = self.wait(lambda s: s.get("workbench") == "HapticSculptWorkbench",
+                                 "FreeCAD starting on the workbench", 120)["version"]
         self.focus()
 
     def wait_window(self, title: str, timeout: float = 20.0) -> None:
@@ -129,8 +139,10 @@ class Desktop:
         """Clicks a toolbar button until ``condition`` holds (FreeCAD enables a command's button on
         its next update after the command becomes usable: a click before that does nothing, for a
         user too, who clicks again)."""
+        x0, step, y = TOOLBAR[tuple(self.version)]
+        x = int(round(x0 + step * BUTTONS.index(button)))
         for _ in range(10):
-            self.xdo("mousemove", str(BUTTON[button]), str(TOOLBAR_Y), "click", "1")
+            self.xdo("mousemove", str(x), str(y), "click", "1")
             try:
                 return self.wait(condition, what, timeout=1.5, shot=False)
             except AssertionError:
@@ -444,6 +456,9 @@ def test_keys_follow_the_view_across_documents_opened_switched_and_closed(tmp_pa
         d.xdo("key", "alt+d")  # "Discard"
         d.wait(lambda s: second not in s["docs"] and s["inputs"] == 1, "the closed view forgotten")
         d.focus()
+        d.calibrate()  # click in the view first, as a user does (FreeCAD 1.0 gives the keys to the tree)
+        corner = d.to_screen((30, 30))
+        d.xdo("mousemove", str(corner[0]), str(corner[1]), "click", "1")
         d.xdo("mousemove", "640", "520")
         time.sleep(0.3)
         d.xdo("key", "m")

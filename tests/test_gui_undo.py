@@ -4,7 +4,6 @@ X-event tests cover the keys, strokes and paint, this covers each command)."""
 from __future__ import annotations
 
 import pytest
-
 from freecad_support import GUI_AVAILABLE, run_freecad_gui
 
 GUI_SCRIPT = """

@@ -7,8 +7,7 @@ import os
 
 import numpy as np
 import pytest
-
-from freecad_support import GUI_AVAILABLE, ROOT, run_freecad_gui
+from freecad_support import GUI_AVAILABLE, ROOT, SCREENSHOTS, run_freecad_gui
 
 GUI_SCRIPT = """
 import json, os, traceback
@@ -84,8 +83,8 @@ os._exit(0)
 
 @pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
 def test_workbench_loads_and_commands_run(tmp_path):
-    os.makedirs(os.path.join(ROOT, "build", "screenshots"), exist_ok=True)
-    png = os.path.join(ROOT, "build", "screenshots", "gui_workbench.png")
+    os.makedirs(SCREENSHOTS, exist_ok=True)
+    png = os.path.join(SCREENSHOTS, "gui_workbench.png")
     if os.path.exists(png):
         os.remove(png)
     legacy = os.path.join(ROOT, "tests", "fixtures", "documents", "sculpt_0_1.FCStd")

@@ -2,22 +2,55 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstddef>
 #include <cstdlib>
 #include <new>
 
 #include "dynamic_surface.hpp"
 
-// Counts heap allocations so a test can assert that stepping allocates nothing. GCC 12 with LTO
-// inlines these replacements and then mistakes the malloc/free pairing for a mismatch.
+// Counts heap allocations so a test can assert that stepping allocates nothing. Every form of
+// operator new and delete is replaced, all on malloc/free: a library that allocates with one form
+// and frees with another (GCC 14's std::stable_sort: nothrow new, then sized delete) must meet a
+// matching pair, or AddressSanitizer reports an alloc-dealloc mismatch. GCC 12 with LTO inlines
+// these replacements and then mistakes the malloc/free pairing for a mismatch.
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 static std::atomic<long> g_allocations{0};
-void* operator new(std::size_t n) {
+namespace {
+void* counted(std::size_t n, std::size_t align = 0) noexcept {
     ++g_allocations;
-    if (void* p = std::malloc(n ? n : 1)) return p;
+    if (n == 0) n = 1;
+    if (align <= alignof(std::max_align_t)) return std::malloc(n);
+    return std::aligned_alloc(align, (n + align - 1) / align * align);  // (a multiple of the alignment)
+}
+void* countedOrThrow(std::size_t n, std::size_t align = 0) {
+    if (void* p = counted(n, align)) return p;
     throw std::bad_alloc();
 }
+}  // namespace
+void* operator new(std::size_t n) { return countedOrThrow(n); }
+void* operator new[](std::size_t n) { return countedOrThrow(n); }
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept { return counted(n); }
+void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return counted(n); }
+void* operator new(std::size_t n, std::align_val_t a) { return countedOrThrow(n, static_cast<std::size_t>(a)); }
+void* operator new[](std::size_t n, std::align_val_t a) { return countedOrThrow(n, static_cast<std::size_t>(a)); }
+void* operator new(std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
+    return counted(n, static_cast<std::size_t>(a));
+}
+void* operator new[](std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
+    return counted(n, static_cast<std::size_t>(a));
+}
 void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
 long allocationCount() { return g_allocations.load(); }  // for the other test files
 
 using namespace hs;

@@ -64,7 +64,8 @@ def _views():
 
 
 def write(*_):
-    state = {"workbench": Gui.activeWorkbench().name() if Gui.activeWorkbench() else "",
+    state = {"version": [int(x) for x in FreeCAD.Version()[:2]],
+             "workbench": Gui.activeWorkbench().name() if Gui.activeWorkbench() else "",
              "active": FreeCAD.ActiveDocument.Name if FreeCAD.ActiveDocument else None, "docs": {}, "views": _views()}
     for name, doc in FreeCAD.listDocuments().items():
         state["docs"][name] = {"undo": list(doc.UndoNames), "redo": list(doc.RedoNames), "file": doc.FileName,
