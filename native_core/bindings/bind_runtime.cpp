@@ -90,9 +90,6 @@ void bindRuntime(py::module_& m) {
             DeviceSample s;
             s.position = Vec3(position[0], position[1], position[2]);
             s.orientation = Eigen::Quaterniond(orientation[0], orientation[1], orientation[2], orientation[3]);
-            if (!s.position.allFinite() || !s.orientation.coeffs().allFinite() || !(s.orientation.norm() > 0))
-                throw std::invalid_argument("position/orientation: must be finite (and a non-zero quaternion)");
-            s.orientation.normalize();
             s.buttons = buttons;
             s.valid = true;
             d.push(s);

@@ -2,6 +2,7 @@
 // the latest cursor, the haptic loop reads it; lock-free, no allocation.
 #pragma once
 #include <atomic>
+#include <stdexcept>
 
 #include "device.hpp"
 #include "triple_buffer.hpp"
@@ -14,7 +15,14 @@ public:
     std::string name() const override { return name_; }
     DeviceCaps caps() const override { return {6, false, 0, 0, 0}; }
     /// Feeder thread (one): the newest cursor.
-    void push(const DeviceSample& s) { latest_.write(s); }
+    /// Publishes the latest cursor (orientation normalised); throws std::invalid_argument for a
+    /// non-finite position or orientation or a zero quaternion, which never reach the loop.
+    void push(DeviceSample s) {
+        if (!s.position.allFinite() || !s.orientation.coeffs().allFinite() || !(s.orientation.norm() > 0))
+            throw std::invalid_argument("position/orientation: must be finite (and a non-zero quaternion)");
+        s.orientation.normalize();
+        latest_.write(s);
+    }
     /// Marks the device lost (e.g. its view closed): the session stops.
     void lose() { lost_.store(true, std::memory_order_release); }
     bool sample(double, DeviceSample& out) override {
