@@ -192,7 +192,13 @@ try:
     ov.per_pixel = True
     ov.stripe_mode, ov.stripes = "isophote", 48.0  # (bands of 3.75 degrees: the bump is gentle)
     shot("isophote")
+    Gui.runCommand("HapticSculpt_ZebraDirection")  # the isophotes to +X, the reflection strips horizontal
+    out["zebra_turned"] = [ov.stripe_angle, list(ov.stripe_direction), ov.display]
+    shot("isophote_x")
     ov.stripe_mode, ov.stripes = "reflection", 12.0
+    shot("reflection_horizontal")
+    ov.stripe_angle, ov.stripe_direction = 0.0, (0.0, 0.0, 1.0)
+    shot("reflection_vertical")
     # graphics against simulation: the same held stroke with the overlay drawing the curvature
     # display at 60 Hz and with it off (recorded, not asserted: timing belongs to benchmarks)
     rates = {{}}
@@ -312,6 +318,10 @@ def test_overlay_commands_keys_and_pictures(tmp_path):
         json.dump(measures, f, indent=1)
     for zoom in (1, 4):
         assert measures[f"pixel_{zoom}x"] < 0.5 * measures[f"vertex_{zoom}x"], measures
+    # "Zebra: direction" turns the stripes: other bands in both modes
+    assert out["zebra_turned"] == [90.0, [1.0, 0.0, 0.0], "zebra"]
+    for a, b in (("isophote", "isophote_x"), ("reflection_vertical", "reflection_horizontal")):
+        assert np.mean(np.abs(load(a) - load(b)) > 0.5) > 0.02, f"{a} and {b} show the same stripes"
     isophote = load("isophote")
     assert colour_fraction(isophote, lambda r, g, b: (r > 0.9) & (g > 0.9) & (b > 0.9)) > 1e-2  # white bands
     surface = isophote.mean(axis=2) > 0.02

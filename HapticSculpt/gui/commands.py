@@ -15,6 +15,7 @@ TOOLBAR = ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Ses
            "HapticSculpt_CurvatureConstraint", "HapticSculpt_PaintMass", "HapticSculpt_PaintDamping",
            "HapticSculpt_PaintStiffness", "HapticSculpt_ShowMap", "HapticSculpt_ShowCurvature",
            "HapticSculpt_Combs", "HapticSculpt_Zebra", "HapticSculpt_ZebraMode", "HapticSculpt_ZebraStripes",
+           "HapticSculpt_ZebraDirection",
            "HapticSculpt_Panel", "HapticSculpt_CombDensity", "HapticSculpt_CombScale", "HapticSculpt_Thicken",
            "HapticSculpt_ExportStep"]
 
@@ -345,6 +346,22 @@ class ZebraStripes(_SculptCommand):
             _ctl().set_display("zebra")
 
 
+class ZebraDirection(_SculptCommand):
+    icon_name, menu = "Zebra", "Zebra: direction"
+    tip = ("Turn the zebra stripes: the reflection lines' light strips vertical, horizontal or diagonal on "
+           "the screen; the isophotes' direction +Z, +X, +Y or the space diagonal")
+
+    def Activated(self) -> None:
+        from .stripes import DIRECTIONS
+        ov = _ctl().overlay()
+        if ov is not None:
+            turns = [(angle, direction) for _, angle, direction in DIRECTIONS]
+            now = (ov.stripe_angle, tuple(ov.stripe_direction))
+            ov.stripe_angle, ov.stripe_direction = turns[(turns.index(now) + 1) % len(turns)] if now in turns \
+                else turns[0]
+            _ctl().set_display("zebra")
+
+
 class Panel(_SculptCommand):
     icon_name, menu = "Panel", "Slider panel"
     tip = "Toggle the 3D slider panel (mass, damping, stiffness, curvature targets), operated with the cursor"
@@ -366,5 +383,6 @@ COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_SculptFace": Sculpt
             "HapticSculpt_PaintStiffness": PaintStiffness, "HapticSculpt_ShowMap": ShowMap,
             "HapticSculpt_ShowCurvature": ShowCurvature, "HapticSculpt_Combs": Combs, "HapticSculpt_Zebra": Zebra,
             "HapticSculpt_ZebraMode": ZebraMode, "HapticSculpt_ZebraStripes": ZebraStripes,
+            "HapticSculpt_ZebraDirection": ZebraDirection,
             "HapticSculpt_CombDensity": CombDensity, "HapticSculpt_CombScale": CombScale,
             "HapticSculpt_Panel": Panel, "HapticSculpt_Thicken": Thicken, "HapticSculpt_ExportStep": ExportStep}

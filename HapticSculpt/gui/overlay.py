@@ -48,6 +48,7 @@ class Overlay:
         self.stripe_mode = "reflection"  # zebra: "reflection" (view-dependent) or "isophote" (world-fixed)
         self.stripes = 12.0  # zebra: bands over a half turn
         self.stripe_direction = (0.0, 0.0, 1.0)  # isophote: the direction the bands' angle is taken to
+        self.stripe_angle = 0.0  # reflection: the light strips' angle from the view's up direction (degrees)
         self.per_pixel = True  # zebra per pixel where the driver runs GLSL (False: per mesh vertex)
         self._sampled: tuple[bytes, np.ndarray, tuple[bytes, bytes], int] | None = None  # poles, points, texture, size
         self.hud: Hud | None = None  # the screen-space layer, made when the overlay first draws
@@ -180,7 +181,7 @@ class Overlay:
         _, points, texture, size = self._sampled
         g, h = points.shape[:2]
         return stripe_shading.stripe_mesh(points, texture, size, self.stripe_mode, self.stripes,
-                                          self.stripe_direction, shapes.quad_indices(g, h))
+                                          self.stripe_direction, shapes.quad_indices(g, h), self.stripe_angle)
 
     def _status(self, s: core.DynamicSurface) -> str:
         """The tool, the material and what goes on, for the HUD's status line."""
@@ -188,7 +189,9 @@ class Overlay:
         if self._session() is not None:
             parts.append("sculpting")
         if self.display == "zebra":
-            parts.append(f"zebra: {self.stripe_mode}, {self.stripes:g} stripes")
+            turn = (f"strips at {self.stripe_angle:g} deg" if self.stripe_mode == "reflection"
+                    else "to ({:.2g}, {:.2g}, {:.2g})".format(*self.stripe_direction))
+            parts.append(f"zebra: {self.stripe_mode}, {self.stripes:g} stripes, {turn}")
         if self.combs:
             parts.append(f"combs: every {self.comb_every}, x{self.comb_gain:g}")
         if self.mode:

@@ -3,8 +3,9 @@ SoShaderProgram shades every pixel from the exact B-spline normal, read from a n
 sampled from the surface (not interpolated mesh normals), so the stripes stay smooth at any zoom.
 
 Two modes: "reflection" (view-dependent: the eye ray mirrored in the surface, across light strips
-along the view's up direction) and "isophote" (world-fixed: bands of equal angle between the
-normal and ``direction``). ``stripes`` sets the number of bands over a half turn. Where the driver
+that run at ``angle`` degrees from the view's up direction) and "isophote" (world-fixed: bands of
+equal angle between the normal and ``direction``). ``stripes`` sets the number of bands over a
+half turn; :data:`DIRECTIONS` are the directions the workbench's command cycles through. Where the driver
 runs no GLSL, :func:`shaders_work` says so once and the overlay falls back to per-vertex colours.
 No Qt: pivy only.
 """
@@ -15,6 +16,11 @@ from typing import Any
 import numpy as np
 
 MODES = ("reflection", "isophote")
+#: The stripe directions "Zebra: direction" cycles through: its name, the reflection strips' angle
+#: from the view's up direction (degrees) and the isophotes' world direction.
+DIRECTIONS = (("vertical, to +Z", 0.0, (0.0, 0.0, 1.0)), ("horizontal, to +X", 90.0, (1.0, 0.0, 0.0)),
+              ("diagonal, to +Y", 45.0, (0.0, 1.0, 0.0)),
+              ("other diagonal, to +X+Y+Z", 135.0, (0.5773502691896258, 0.5773502691896258, 0.5773502691896258)))
 TEXTURE = 256  # normal texture resolution per side while the surface rests (128 while sculpting)
 
 VERTEX = """
@@ -35,6 +41,7 @@ uniform sampler2D normalsLow;
 uniform float size;
 uniform float stripes;
 uniform int reflection;
+uniform float angle;
 uniform float directionX;
 uniform float directionY;
 uniform float directionZ;
@@ -59,7 +66,7 @@ void main() {
         // the eye ray: along -z for an orthographic camera (FreeCAD's default), through the point otherwise
         vec3 eye = gl_ProjectionMatrix[3][3] == 1.0 ? vec3(0.0, 0.0, -1.0) : normalize(eyePosition);
         vec3 r = reflect(eye, n);
-        phase = asin(clamp(r.x, -1.0, 1.0)) / 3.14159265;
+        phase = asin(clamp(r.x * cos(angle) + r.y * sin(angle), -1.0, 1.0)) / 3.14159265;
     } else {
         vec3 d = normalize(gl_NormalMatrix * vec3(directionX, directionY, directionZ));
         phase = acos(clamp(dot(n, d), -1.0, 1.0)) / 3.14159265;
@@ -117,10 +124,10 @@ def _param(coin: Any, kind: str, name: str, value: Any) -> Any:
 
 
 def stripe_mesh(mesh: np.ndarray, texture: tuple[bytes, bytes], size: int, mode: str, stripes: float,
-                direction: tuple[float, float, float], quads: list[int]) -> Any:
+                direction: tuple[float, float, float], quads: list[int], angle: float = 0.0) -> Any:
     """The surface shaded per pixel: ``mesh`` its points on an even grid over the domain (from
     :func:`sample`), ``texture`` the normal texture of ``size`` x ``size`` texels, ``quads`` the
-    mesh's face indices."""
+    mesh's face indices; ``angle`` (degrees) turns the reflection strips from the view's up direction."""
     from pivy import coin
     g, h = mesh.shape[:2]
     us, vs = np.linspace(0.0, 1.0, g), np.linspace(0.0, 1.0, h)
@@ -153,6 +160,7 @@ def stripe_mesh(mesh: np.ndarray, texture: tuple[bytes, bytes], size: int, mode:
         _param(coin, "SoShaderParameter1f", "size", float(size)),
         _param(coin, "SoShaderParameter1f", "stripes", float(stripes)),
         _param(coin, "SoShaderParameter1i", "reflection", 1 if mode == "reflection" else 0),
+        _param(coin, "SoShaderParameter1f", "angle", float(np.radians(angle))),
         # (three floats: a vec3 parameter did not reach the shader through pivy)
         _param(coin, "SoShaderParameter1f", "directionX", float(direction[0])),
         _param(coin, "SoShaderParameter1f", "directionY", float(direction[1])),
