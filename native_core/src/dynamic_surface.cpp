@@ -56,41 +56,12 @@ void SolverSettings::validate() const {
     requirePositive(energyTolerance, "energy_tolerance", true);
 }
 
-void DynamicSurface::setSolver(const SolverSettings& s) {
-    s.validate();
-    solver_ = s;
-    wake();
-}
-
-void DynamicSurface::setSleep(const SleepSettings& s) {
-    s.validate();
-    sleep_.settings = s;
-    wake();
-}
-
-void DynamicSurface::setEnergyGuard(const EnergyGuardSettings& s) {
-    s.validate();
-    guard_.settings = s;
-    wake();
-}
-
-void DynamicSurface::setPlasticity(const Plasticity& p) {
-    p.validate();
-    springs_.plasticity = p;
-    wake();
-}
-
-void DynamicSurface::setStiffnessLaw(const ResponseLaw& law) {
-    ResponseLaw::checked(law.kind, law.scale);
-    springs_.law = law;
-    wake();
-}
-
-void DynamicSurface::setDampingLaw(const ResponseLaw& law) {
-    ResponseLaw::checked(law.kind, law.scale);
-    dampingLaw_ = law;
-    wake();
-}
+void DynamicSurface::setSolver(const SolverSettings& s) { configure(solver_, s); }
+void DynamicSurface::setSleep(const SleepSettings& s) { configure(sleep_.settings, s); }
+void DynamicSurface::setEnergyGuard(const EnergyGuardSettings& s) { configure(guard_.settings, s); }
+void DynamicSurface::setPlasticity(const Plasticity& p) { configure(springs_.plasticity, p); }
+void DynamicSurface::setStiffnessLaw(const ResponseLaw& law) { configure(springs_.law, law); }
+void DynamicSurface::setDampingLaw(const ResponseLaw& law) { configure(dampingLaw_, law); }
 
 double DynamicSurface::meshCurvature(int index, int direction) const {
     requireInRange(index, "index", 0, g() * h() - 1);

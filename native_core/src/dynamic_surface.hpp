@@ -186,6 +186,14 @@ public:
 
 private:
     void touch() { sleep_.wake(); accelerationValid_ = false; verlet_.valid = false; }
+    /// The settings setters: check `value` (std::invalid_argument naming the field), store it in
+    /// `slot`, wake the surface.
+    template <class Settings>
+    void configure(Settings& slot, const Settings& value) {
+        value.validate();
+        slot = value;
+        wake();
+    }
     /// Something outside a step changed the energy (shape, velocities, springs, materials, constraints).
     void resetEnergyCeiling() { guard_.reset(); }
     bool guardsEnergy(double dt, bool verlet) const;

@@ -49,11 +49,8 @@ struct ResponseLaw {
         if (kind == LawKind::Linear || f <= 0) return 1.0;
         return value(f) / f;
     }
-    /// A law with its scale checked (in [1e-12, 1e12]; throws std::invalid_argument naming it).
-    static ResponseLaw checked(LawKind kind, double scale) {
-        requireInRange(scale, "scale", 1e-12, 1e12);
-        return {kind, scale};
-    }
+    /// Throws std::invalid_argument unless the scale is in [1e-12, 1e12].
+    void validate() const { requireInRange(scale, "scale", 1e-12, 1e12); }
 };
 
 }  // namespace hs
