@@ -11,11 +11,18 @@ class HapticSculptWorkbench(Gui.Workbench):
     ToolTip = "Sculpt physics-based B-spline surfaces; results are Part.BSplineSurface faces"
 
     def __init__(self):
+        import importlib.util
         import os
 
-        import HapticSculpt
-        self.__class__.Icon = os.path.join(os.path.dirname(HapticSculpt.__file__), "resources", "icons",
-                                           "HapticSculpt.svg")
+        import FreeCAD
+        package = os.path.dirname(importlib.util.find_spec("HapticSculpt").origin)
+        self.__class__.Icon = os.path.join(package, "resources", "icons", "HapticSculpt.svg")
+        try:
+            import HapticSculpt.gui  # noqa: F401  (its hooks: view providers, frame clock, stroke echo)
+        except ImportError as exc:  # no native core: say what to do; the workbench stays listed
+            FreeCAD.Console.PrintError(f"HapticSculpt: {exc}\n")
+        else:
+            FreeCAD.Console.PrintLog(f"HapticSculpt: native core: {HapticSculpt.core.NATIVE_ORIGIN}\n")
 
     def Initialize(self):
         import HapticSculptGui

@@ -6,8 +6,6 @@ Layers, each importing only those before it: :mod:`HapticSculpt.core` (the C++ d
 FreeCAD's GUI runs). The scripting API below imports FreeCAD only when a function that needs it is
 called, so importing this package never imports FreeCAD or a GUI.
 """
-__version__ = "0.2.0"
-
 from . import legacy_paths
 from .app.api import (
                       CursorSource,
@@ -30,6 +28,7 @@ from .app.api import (
 )
 from .runtime.replay_device import CursorSample, ReplayDevice
 from .runtime.session import Session, stop_all
+from .version import __version__
 
 legacy_paths.install()
 

@@ -8,31 +8,72 @@ forces are in kg*mm/s^2 (mN).
 """
 from __future__ import annotations
 
-try:
-    from . import _core
-except ImportError as exc:  # pragma: no cover - exercised only on a broken install
-    raise ImportError(
-        "HapticSculpt's native core is not built: run `make build` in the HapticSculpt checkout "
-        f"(it must be built for {__import__('sys').executable})") from exc
+import importlib
+import os
+import sys
+from types import ModuleType
 
-BSplineSurface = _core.BSplineSurface
-DynamicSurface = _core.DynamicSurface
-MaterialMap = _core.MaterialMap
-StepReport = _core.StepReport
-Tool = _core.Tool
-RopeTool = _core.RopeTool
-MagnetTool = _core.MagnetTool
-OrientationTool = _core.OrientationTool
-SmoothTool = _core.SmoothTool
-MAX_DEGREE: int = _core.MAX_DEGREE
+from .version import __version__
+
+#: Which native core to prefer: "installed" (the default: the hapticsculpt_core package, e.g. from
+#: the wheel in FreeCAD's AdditionalPythonPackages, then the in-tree build) or "in-tree" (a
+#: developer's fresh `make build` first).
+PREFERENCE_VARIABLE = "HAPTICSCULPT_CORE"
+
+
+def _load_native() -> tuple[ModuleType, str]:
+    """The native module and a sentence saying which one it is and where it was found."""
+    tried: list[str] = []
+    passed_over: list[str] = []
+    order = ("hapticsculpt_core", "HapticSculpt._core")
+    preference = os.environ.get(PREFERENCE_VARIABLE, "installed")
+    if preference not in ("installed", "in-tree"):
+        raise ImportError(f"{PREFERENCE_VARIABLE}={preference!r}: give 'installed' or 'in-tree'")
+    if preference == "in-tree":
+        order = order[::-1]
+    for name in order:
+        try:
+            module = importlib.import_module(name)
+        except ImportError as exc:
+            tried.append(f"{name}: {exc}")
+            continue
+        version = getattr(module, "__version__", "unknown")
+        if version != __version__:
+            passed_over.append(f"{name} at {module.__file__} is version {version}, this addon is {__version__}")
+            continue
+        kind = "installed package" if name == "hapticsculpt_core" else "in-tree build"
+        note = f"; passed over: {'; '.join(passed_over)}" if passed_over else ""
+        return module, f"{kind} {name} {version} ({module.__file__}){note}"
+    tried += passed_over
+    raise ImportError(
+        f"HapticSculpt {__version__} finds no native core it can use for Python "
+        f"{sys.version_info.major}.{sys.version_info.minor} ({sys.executable}):\n  " + "\n  ".join(tried) +
+        "\nEither install the hapticsculpt_core wheel for this Python into FreeCAD's "
+        "AdditionalPythonPackages folder (`python3 tools/install_core.py WHEEL` in the addon's folder; "
+        "the README's Install section), or build it in the checkout with `make build`.")
+
+
+#: The native module in use, and which one it is (FreeCAD's log shows it when the workbench loads).
+native, NATIVE_ORIGIN = _load_native()
+
+BSplineSurface = native.BSplineSurface
+DynamicSurface = native.DynamicSurface
+MaterialMap = native.MaterialMap
+StepReport = native.StepReport
+Tool = native.Tool
+RopeTool = native.RopeTool
+MagnetTool = native.MagnetTool
+OrientationTool = native.OrientationTool
+SmoothTool = native.SmoothTool
+MAX_DEGREE: int = native.MAX_DEGREE
 
 # The names of the core's choices, from its one table of each (native_core/src/names.hpp).
-INTEGRATORS: tuple[str, ...] = _core.INTEGRATORS
-TOOLS: tuple[str, ...] = _core.TOOLS
-CONSTRAINTS: tuple[str, ...] = _core.CONSTRAINTS
-FALLOFFS: tuple[str, ...] = _core.FALLOFFS
-LAWS: tuple[str, ...] = _core.LAWS
-MAPS: tuple[str, ...] = _core.MAPS
+INTEGRATORS: tuple[str, ...] = native.INTEGRATORS
+TOOLS: tuple[str, ...] = native.TOOLS
+CONSTRAINTS: tuple[str, ...] = native.CONSTRAINTS
+FALLOFFS: tuple[str, ...] = native.FALLOFFS
+LAWS: tuple[str, ...] = native.LAWS
+MAPS: tuple[str, ...] = native.MAPS
 
 
 def patch(controls: tuple[int, int] = (8, 8), degree: tuple[int, int] = (3, 3),

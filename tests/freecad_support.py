@@ -21,9 +21,10 @@ import Part  # noqa: E402,F401
 
 FREECADCMD = shutil.which("freecadcmd") or shutil.which("FreeCADCmd")
 FREECAD_VERSION = tuple(int(x) for x in FreeCAD.Version()[:2])
-#: Where the GUI tests put their pictures, one folder per FreeCAD version (0.20's has the plain name).
-SCREENSHOTS = os.path.join(ROOT, "build", "screenshots" if FREECAD_VERSION < (1, 0)
-                           else "screenshots-freecad-%d.%d" % FREECAD_VERSION)
+#: Where the GUI tests put their pictures, one folder per FreeCAD version (0.20's has the plain name;
+#: HS_SCREENSHOTS puts them elsewhere: the addon-install test's go to the checkout's build folder).
+SCREENSHOTS = os.path.join(os.environ.get("HS_SCREENSHOTS", os.path.join(ROOT, "build", "screenshots")),
+                           "" if FREECAD_VERSION < (1, 0) else "freecad-%d.%d" % FREECAD_VERSION)
 #: cadquery/OCP in its own virtual environment (its numpy must not shadow FreeCAD's): `make ocp-venv`.
 OCP_PYTHON = os.environ.get("HS_OCP_PYTHON", os.path.join(ROOT, "build", "ocp-venv", "bin", "python"))
 
@@ -40,14 +41,29 @@ class DocumentTestCase(unittest.TestCase):
         shutil.rmtree(self.tmp, ignore_errors=True)
 
 
-def _addon_home(tmp: str, name: str) -> str:
-    """A private FREECAD_USER_HOME under ``tmp`` whose Mod/HapticSculpt links this checkout."""
-    home = os.path.join(tmp, name)
+#: The addon-install test (tests/addon_install.py) runs the tests from a copy of the repository
+#: without build output, with the core from a wheel installed into this AdditionalPythonPackages
+#: folder of a FreeCAD home; every FreeCAD home the tests make then links it, as the Addon Manager's
+#: install would have it.
+CORE_SITE = os.environ.get("HS_CORE_SITE")
+
+
+def make_addon_home(home: str) -> str:
+    """Makes ``home`` a FREECAD_USER_HOME with this checkout as the addon Mod/HapticSculpt (and the
+    installed core, with HS_CORE_SITE); returns it."""
     os.makedirs(os.path.join(home, "Mod"), exist_ok=True)
     link = os.path.join(home, "Mod", "HapticSculpt")
     if not os.path.lexists(link):
         os.symlink(ROOT, link)
+    packages = os.path.join(home, "AdditionalPythonPackages")
+    if CORE_SITE and not os.path.lexists(packages):
+        os.symlink(CORE_SITE, packages)
     return home
+
+
+def _addon_home(tmp: str, name: str) -> str:
+    """A private FREECAD_USER_HOME under ``tmp`` whose Mod/HapticSculpt links this checkout."""
+    return make_addon_home(os.path.join(tmp, name))
 
 
 def run_freecadcmd(script: str, tmp: str, timeout: float = 300) -> dict:

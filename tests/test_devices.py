@@ -9,10 +9,11 @@ import time
 import numpy as np
 import pytest
 
-from HapticSculpt import _core, core
+from HapticSculpt import core
+from HapticSculpt.core import native as _core
 from HapticSculpt.runtime import devices
-from HapticSculpt.runtime.replay_device import ReplayDevice
 from HapticSculpt.runtime.devices import native_device
+from HapticSculpt.runtime.replay_device import ReplayDevice
 
 FIXTURES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fixtures", "hid")
 

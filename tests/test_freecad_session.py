@@ -5,14 +5,12 @@ from __future__ import annotations
 
 import time
 
+import FreeCAD
 import numpy as np
-
 from freecad_support import DocumentTestCase
 
-import FreeCAD
-
 import HapticSculpt as hs
-from HapticSculpt import _core
+from HapticSculpt.core import native as _core
 
 
 def two_strokes() -> hs.ReplayDevice:

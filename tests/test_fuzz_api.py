@@ -13,7 +13,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from HapticSculpt import _core, core
+from HapticSculpt import core
+from HapticSculpt.core import native as _core
 from HapticSculpt.runtime.replay_device import ReplayDevice
 
 SETTINGS = settings(max_examples=1000, deadline=None, derandomize=True,

@@ -28,6 +28,13 @@ def pump(seconds=0.0):
             break
         time.sleep(0.01)
 
+def wait(condition, what, timeout=30.0):
+    end = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > end:
+            raise TimeoutError("waited %.0f s for %s" % (timeout, what))
+        pump(0.02)
+
 def shot(name):
     ov.frame()
     view.fitAll()  # the legend and the panel too
@@ -116,9 +123,10 @@ try:
     # A replay stroke through the session path the mouse and the devices use.
     ov = ctl.overlay(obj)
     ctl.set_display("shading")  # (painting left the stiffness map on)
-    stroke = hs.ReplayDevice.stroke((0, 0, 0), (0, 0, 30.0), seconds=0.8, hold=0.8)
+    # (held for 3 s: the picture is taken while it is held, even when FreeCAD runs slowly under load)
+    stroke = hs.ReplayDevice.stroke((0, 0, 0), (0, 0, 30.0), seconds=0.8, hold=3.0)
     ctl.start_session(stroke)
-    pump(1.0)
+    wait(lambda: ctl.cursor()[2] > 10.0, "the stroke pulling the surface up")
     out["session_running"] = ctl.session.running
     out["cursor"] = list(ctl.cursor())
     shot("stroke")
@@ -127,7 +135,7 @@ try:
         ov.frame()
         frames.append(ov.frame_ms)
     out["frame_ms_session"] = float(np.median(frames))
-    pump(1.0)  # the stroke ends (released) and is committed by the session's timer
+    wait(lambda: obj.Strokes >= 1, "the stroke released and committed by the session's timer")
     ctl.stop_session()
     out["strokes"] = obj.Strokes
     # the airbrush during a session: the paint command, then the device's button sprays (no grab)
@@ -135,7 +143,7 @@ try:
     undo_before = doc.UndoCount
     ctl.start_session(hs.ReplayDevice.stroke((-30, 0, 1), (30, 0, 1), seconds=0.6))
     out["session_airbrush"] = ctl.session.airbrush
-    pump(1.5)
+    wait(lambda: "Paint damping" in doc.UndoNames[:doc.UndoCount - undo_before], "the spray committed")
     out["live_map"] = [m for m in ("mass", "damping", "stiffness") if ctl.session.latest_map(m) is not None]
     ctl.stop_session()
     out["session_spray_undo"] = doc.UndoNames[:doc.UndoCount - undo_before]
@@ -149,7 +157,7 @@ try:
     hsdev.spacemouse = lambda path=None, **kw: opener(recording={recording!r}, **kw)  # the defaults: rate control
     try:
         Gui.runCommand("HapticSculpt_Session")
-        pump(1.0)
+        wait(lambda: np.linalg.norm(ctl.session.status()["cursor"]) > 0.5, "the recorded SpaceMouse moving the cursor")
         st = ctl.session.status()
         out["spacemouse"] = [ctl.mouse is None, ctl.session.running, float(np.linalg.norm(st["cursor"]))]
         Gui.runCommand("HapticSculpt_Session")  # stop

@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 import pytest
-from freecad_support import ROOT, SCREENSHOTS, run_freecadcmd
+from freecad_support import ROOT, SCREENSHOTS, make_addon_home, run_freecadcmd
 
 SHOTS = SCREENSHOTS
 # The HapticSculpt toolbar in FreeCAD's default layout at 1280 x 1024, by FreeCAD version: the
@@ -51,8 +51,7 @@ class Desktop:
         self.tmp = tmp
         home = os.path.join(tmp, "home")
         if not os.path.isdir(home):  # (a restart keeps the home, as a user's does)
-            os.makedirs(os.path.join(home, "Mod"))
-            os.symlink(ROOT, os.path.join(home, "Mod", "HapticSculpt"))
+            make_addon_home(home)
             with open(os.path.join(home, "user.cfg"), "w") as f:
                 f.write(USER_CFG.format(style=STYLES[style]))
         self.home = home

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from typing import Any, Sequence
 
-from .. import _core
+from ..core import native as _core
 
 
 class MouseDevice:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 from typing import Any, Sequence
 
-from .. import _core
+from ..core import native as _core
 
 #: The udev rules for the supported devices (install with `sudo make install-udev`).
 UDEV_RULES = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, os.pardir, "udev",

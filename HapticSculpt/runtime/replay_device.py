@@ -112,7 +112,7 @@ class ReplayDevice:
     def native(self) -> Any:
         """A fresh C++ replay of this trajectory (what sessions run; one per session, since it keeps a
         position hint)."""
-        from .. import _core
+        from ..core import native as _core
         return _core.NativeReplayDevice(self._t.tolist(), self._xyz, self._q, self._buttons.astype(np.uint32).tolist())
 
     def sample(self, time: float) -> CursorSample:

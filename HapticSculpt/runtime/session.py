@@ -16,11 +16,12 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .. import _core, core
+from .. import core
 from ..app import sculpt_state
 from ..app.sculpt_feature import is_sculpt
 from ..app.sculpt_properties import read_state
 from ..app.undo import transaction
+from ..core import native as _core
 from .devices import native_device
 from .replay_device import ReplayDevice
 

@@ -1,0 +1,81 @@
+"""The Addon Manager's install, tried as a user gets it (make test-addon): no compiler involved.
+
+The repository is copied without any build output into a private FreeCAD home's Mod folder (as the
+Addon Manager's clone), the hapticsculpt_core wheel is installed into that home's
+AdditionalPythonPackages folder by tools/install_core.py (the README's command), and then, from the
+copy: the core's origin is checked, ``freecadcmd -t TestHapticSculpt`` runs the FreeCAD-layer
+tests and pytest runs the GUI tests (real FreeCAD under Xvfb, real input events).
+
+    /usr/bin/python3 tests/addon_install.py --wheel WHEEL --pip-python PYTHON --out DIR
+
+PYTHON is an interpreter with pip for FreeCAD's Python version (a virtual environment's).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+#: What a clone of the repository has and a build adds: left out of the copy.
+BUILD_OUTPUT = shutil.ignore_patterns(".git", "build", "out", "__pycache__", "*.so", "*.pyc", ".pytest_cache",
+                                      ".hypothesis")
+
+
+def run(what: str, command: list[str], **kwargs) -> subprocess.CompletedProcess:
+    """Runs ``command``, printing what it is and how long it took; fails the script if it fails."""
+    print(f"== {what}", flush=True)
+    start = time.monotonic()
+    proc = subprocess.run(command, **kwargs)
+    print(f"   ({time.monotonic() - start:.0f} s)", flush=True)
+    if proc.returncode != 0:
+        sys.exit(f"addon install: {what} failed (exit {proc.returncode})")
+    return proc
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--wheel", required=True)
+    parser.add_argument("--pip-python", required=True)
+    parser.add_argument("--out", required=True)
+    parser.add_argument("--pytest-args", default="", help="more arguments for the GUI tests' pytest")
+    args = parser.parse_args(argv)
+    out = os.path.abspath(args.out)
+    shutil.rmtree(out, ignore_errors=True)
+    home = os.path.join(out, "home")
+    addon = os.path.join(home, "Mod", "HapticSculpt")
+    shutil.copytree(ROOT, addon, ignore=BUILD_OUTPUT, symlinks=True)
+    built = [os.path.join(d, f) for d, _, files in os.walk(addon) for f in files if f.endswith(".so")]
+    assert not built, f"the copy has build output: {built}"
+
+    run("install the wheel (tools/install_core.py)",
+        [args.pip_python, os.path.join(addon, "tools", "install_core.py"), os.path.abspath(args.wheel),
+         "--freecad-home", home], check=False)
+    packages = os.path.join(home, "AdditionalPythonPackages")
+    env = dict(os.environ, FREECAD_USER_HOME=home, HS_CORE_SITE=packages,
+               HS_SCREENSHOTS=os.path.join(ROOT, "build", "screenshots-addon"))
+    env.pop("PYTHONPATH", None)
+
+    origin = run("the core FreeCAD loads", ["freecadcmd", "-c", "import HapticSculpt.core as c; "
+                                            "print('HS_ORIGIN=' + c.NATIVE_ORIGIN)"],
+                 env=env, cwd=out, capture_output=True, text=True)
+    line = next((x for x in origin.stdout.splitlines() if x.startswith("HS_ORIGIN=")), "")
+    print("   " + line)
+    if not (line.startswith("HS_ORIGIN=installed package") and f"({packages}" in line):
+        sys.exit(f"addon install: FreeCAD did not load the installed core:\n{origin.stdout[-2000:]}{origin.stderr[-2000:]}")
+
+    run("freecadcmd -t TestHapticSculpt (from the installed addon)", ["freecadcmd", "-t", "TestHapticSculpt"],
+        env=env, cwd=out)
+    run("GUI tests (from the installed addon)",
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-rfE", *args.pytest_args.split(),
+         "tests/test_gui_workbench.py", "tests/test_gui_undo.py", "tests/test_gui_overlay.py",
+         "tests/test_gui_real_input.py"],
+        env=env, cwd=addon)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

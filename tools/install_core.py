@@ -1,0 +1,75 @@
+"""Installs a hapticsculpt_core wheel where FreeCAD looks for add-ons' Python packages, the folder
+the Addon Manager installs into: ``<UserAppDataDir>/AdditionalPythonPackages/py3XX`` for FreeCAD
+0.21 and later, ``<UserAppDataDir>/AdditionalPythonPackages`` for 0.20.
+
+    python3 tools/install_core.py WHEEL [--freecad-home DIR]
+
+FreeCAD itself is asked for its user folder, its version and its Python (``freecadcmd``), so the
+folder is the one this FreeCAD reads, also with FREECAD_USER_HOME or 1.1's versioned folders.
+``--freecad-home`` installs for a FreeCAD started with FREECAD_USER_HOME=DIR (the tests do).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+_QUERY = ("import FreeCAD, json, sys; print('HS_FREECAD=' + json.dumps({'user': FreeCAD.getUserAppDataDir(), "
+          "'version': [int(x) for x in FreeCAD.Version()[:2]], 'python': list(sys.version_info[:2])}))")
+
+
+def freecad_facts(home: str | None = None) -> dict:
+    """FreeCAD's user folder, version and Python version, as FreeCAD reports them."""
+    freecadcmd = shutil.which("freecadcmd") or shutil.which("FreeCADCmd")
+    if freecadcmd is None:
+        raise SystemExit("freecadcmd not found: install FreeCAD (Debian: apt install freecad-python3)")
+    env = dict(os.environ)
+    if home is not None:
+        os.makedirs(home, exist_ok=True)  # (FreeCAD ignores a FREECAD_USER_HOME that does not exist)
+        env["FREECAD_USER_HOME"] = os.path.abspath(home)
+    out = subprocess.run([freecadcmd, "-c", _QUERY], capture_output=True, text=True, env=env, cwd="/",
+                         timeout=120).stdout
+    found = re.search(r"^HS_FREECAD=(.*)$", out, re.M)
+    if not found:
+        raise SystemExit(f"freecadcmd did not answer:\n{out[-2000:]}")
+    return json.loads(found.group(1))
+
+
+def packages_folder(facts: dict) -> str:
+    """The folder FreeCAD adds to sys.path for add-ons' packages (FreeCADInit.py)."""
+    base = os.path.join(facts["user"], "AdditionalPythonPackages")
+    if tuple(facts["version"]) < (0, 21):
+        return base
+    major, minor = facts["python"]
+    return os.path.join(base, f"py{major}{minor}")
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("wheel", help="a hapticsculpt_core-*.whl file")
+    parser.add_argument("--freecad-home", help="install for FreeCAD started with FREECAD_USER_HOME=DIR")
+    args = parser.parse_args(argv)
+    if not os.path.isfile(args.wheel) or not args.wheel.endswith(".whl"):
+        parser.error(f"wheel: {args.wheel!r} is not a .whl file")
+    facts = freecad_facts(args.freecad_home)
+    tag = "cp%d%d" % tuple(facts["python"])
+    if f"-{tag}-" not in os.path.basename(args.wheel):
+        parser.error(f"wheel: FreeCAD {'.'.join(map(str, facts['version']))} runs Python "
+                     f"{'.'.join(map(str, facts['python']))}; take the wheel whose name has -{tag}-")
+    if subprocess.run([sys.executable, "-m", "pip", "--version"], capture_output=True).returncode != 0:
+        raise SystemExit(f"{sys.executable} has no pip (Debian: apt install python3-pip)")
+    target = packages_folder(facts)
+    os.makedirs(target, exist_ok=True)
+    # --no-deps: FreeCAD brings numpy; --upgrade: replaces an older hapticsculpt_core in the folder.
+    subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--disable-pip-version-check", "--no-deps",
+                    "--upgrade", "--target", target, args.wheel], check=True)
+    print(f"installed {os.path.basename(args.wheel)} into {target}; restart FreeCAD")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
