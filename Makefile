@@ -11,8 +11,8 @@ SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 PHONY_TSAN := build-tsan test-tsan
 PHONY_LONG := stress fuzz bench-peers
 .PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-gui-repeat test-cpp test-asan test-python \
-        test-gui test-freecad test-addon wheel ocp-venv demo bench install install-udev uninstall clean test-debian13 \
-        test-gui-repeat-debian13
+        test-gui test-freecad test-addon wheel ocp-venv demo bench install install-udev uninstall clean test-other-debian \
+        test-gui-repeat-other-debian
 # A private FreeCAD user folder whose Mod/HapticSculpt links this checkout (tests, demo render).
 FC_HOME     := $(BUILD)/freecad-home
 # cadquery (with its own OCCT, OCP) in its own virtual environment: its numpy must not shadow Debian's.
@@ -105,21 +105,24 @@ test-freecad: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
 	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python FREECAD_USER_HOME=$(CURDIR)/$(FC_HOME) \
 	  freecadcmd -t TestHapticSculpt
 
-test: test-cpp test-asan test-tsan test-python test-addon test-debian13
+test: test-cpp test-asan test-tsan test-python test-addon test-other-debian
 
-# The same against Debian 13's FreeCAD 1.0 (Python 3.13, GCC 14), in a Debian 13 root made by
-# debootstrap from Debian's archive with the same packages, built once and cached outside the
-# checkout (tools/debian13-root; rebuilt when the package list changes). Its builds, virtual
-# environment and demo go to build/debian13/.
-DEBIAN13_PACKAGES := $(APT_PACKAGES) make ca-certificates
-DEBIAN13 := tools/debian13-root run make BUILD=build/debian13 DEMO_OUT=build/debian13/demo
-test-debian13: deps
-	tools/debian13-root ensure $(DEBIAN13_PACKAGES)
-	$(DEBIAN13) test-cpp test-asan test-python test-addon demo
+# The same against the other Debian's FreeCAD: on Debian 12 (FreeCAD 0.20.2, Python 3.11) that is
+# Debian 13's FreeCAD 1.0 (Python 3.13, GCC 14), on Debian 13 it is Debian 12's 0.20.2. It runs in
+# a root made by debootstrap from Debian's archive with the same packages, built once and cached
+# outside the checkout (tools/debian-root; rebuilt when the package list changes). Its builds,
+# virtual environments and demo go to build/<suite>/. (TSan runs on the host only: same code.)
+HOST_SUITE  := $(shell . /etc/os-release 2>/dev/null; echo $$VERSION_CODENAME)
+OTHER_SUITE := $(if $(filter trixie,$(HOST_SUITE)),bookworm,trixie)
+OTHER_PACKAGES := $(APT_PACKAGES) make ca-certificates
+OTHER := tools/debian-root $(OTHER_SUITE) run make BUILD=build/$(OTHER_SUITE) DEMO_OUT=build/$(OTHER_SUITE)/demo
+test-other-debian: deps
+	tools/debian-root $(OTHER_SUITE) ensure $(OTHER_PACKAGES)
+	$(OTHER) test-cpp test-asan test-python test-addon demo
 
-test-gui-repeat-debian13: deps
-	tools/debian13-root ensure $(DEBIAN13_PACKAGES)
-	$(DEBIAN13) test-gui-repeat GUI_REPEAT=$(GUI_REPEAT)
+test-gui-repeat-other-debian: deps
+	tools/debian-root $(OTHER_SUITE) ensure $(OTHER_PACKAGES)
+	$(OTHER) test-gui-repeat GUI_REPEAT=$(GUI_REPEAT)
 
 # The GUI and runtime tests GUI_REPEAT times in a row (a test that fails one run in three fails CI).
 GUI_REPEAT ?= 10

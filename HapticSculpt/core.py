@@ -8,7 +8,6 @@ forces are in kg*mm/s^2 (mN).
 """
 from __future__ import annotations
 
-import importlib
 import os
 import sys
 from types import ModuleType
@@ -21,19 +20,29 @@ from .version import __version__
 PREFERENCE_VARIABLE = "HAPTICSCULPT_CORE"
 
 
+def _installed() -> ModuleType:
+    import hapticsculpt_core
+    return hapticsculpt_core
+
+
+def _in_tree() -> ModuleType:
+    from . import _core
+    return _core
+
+
 def _load_native() -> tuple[ModuleType, str]:
     """The native module and a sentence saying which one it is and where it was found."""
     tried: list[str] = []
     passed_over: list[str] = []
-    order = ("hapticsculpt_core", "HapticSculpt._core")
+    order = [("installed package", "hapticsculpt_core", _installed), ("in-tree build", "HapticSculpt._core", _in_tree)]
     preference = os.environ.get(PREFERENCE_VARIABLE, "installed")
     if preference not in ("installed", "in-tree"):
         raise ImportError(f"{PREFERENCE_VARIABLE}={preference!r}: give 'installed' or 'in-tree'")
     if preference == "in-tree":
-        order = order[::-1]
-    for name in order:
+        order.reverse()
+    for kind, name, load in order:
         try:
-            module = importlib.import_module(name)
+            module = load()
         except ImportError as exc:
             tried.append(f"{name}: {exc}")
             continue
@@ -41,7 +50,6 @@ def _load_native() -> tuple[ModuleType, str]:
         if version != __version__:
             passed_over.append(f"{name} at {module.__file__} is version {version}, this addon is {__version__}")
             continue
-        kind = "installed package" if name == "hapticsculpt_core" else "in-tree build"
         note = f"; passed over: {'; '.join(passed_over)}" if passed_over else ""
         return module, f"{kind} {name} {version} ({module.__file__}){note}"
     tried += passed_over

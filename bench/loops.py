@@ -20,7 +20,8 @@ import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
-from HapticSculpt import _core, core  # noqa: E402
+from HapticSculpt import core  # noqa: E402
+from HapticSculpt.core import native as _core  # noqa: E402
 from HapticSculpt.runtime.replay_device import ReplayDevice  # noqa: E402
 
 SCENES = [((12, 12), (40, 40), 5e-4), ((32, 32), (128, 128), 1e-3)]

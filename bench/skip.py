@@ -18,7 +18,8 @@ import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
-from HapticSculpt import _core, core  # noqa: E402
+from HapticSculpt import core  # noqa: E402
+from HapticSculpt.core import native as _core  # noqa: E402
 
 CONTROLS, MESH, DT, STEPS, BLOCKS = (12, 12), (40, 40), 1e-3, 300, 15
 

@@ -28,7 +28,7 @@ from stress_scenes import run_scene  # noqa: E402
 
 def core_fingerprint() -> str:
     """SHA-256 of the native core the scenes run on: a log from another build is not resumed."""
-    from HapticSculpt import _core
+    from HapticSculpt.core import native as _core
     with open(_core.__file__, "rb") as f:
         return hashlib.sha256(f.read()).hexdigest()
 

@@ -1,5 +1,5 @@
-"""The package's layers (tools/architecture.py): imports run downward only, no import cycles, the
-live surface's private core surface stays private, no Qt binding, importing the package loads no
+"""The package's layers (tools/architecture.py): imports run downward only, no import cycles, only
+core.py picks the native module, the live surface's private core surface stays private, no Qt binding, importing the package loads no
 GUI, and docs/architecture.dot is generated from the code as it is."""
 from __future__ import annotations
 
@@ -17,8 +17,20 @@ GRAPH = architecture.graph()
 
 
 def test_every_module_belongs_to_a_layer_folder():
-    loose = [m for m in GRAPH if architecture.layer(m) == "core" and m not in ("HapticSculpt.core", "HapticSculpt.version", architecture.NATIVE)]
+    loose = [m for m in GRAPH if architecture.layer(m) == "core"
+             and m not in ("HapticSculpt.core", "HapticSculpt.version", architecture.NATIVE)]
     assert not loose, f"modules outside the layer folders: {loose}"
+
+
+def test_only_core_py_picks_the_native_module():
+    """HapticSculpt.core chooses between an installed hapticsculpt_core and the in-tree build; every
+    other module (and the benchmarks and tests) takes ``core.native``, whichever it is."""
+    assert [m for m in GRAPH if architecture.NATIVE in GRAPH[m]] == ["HapticSculpt.core"]
+    for folder in ("bench", "tests", "tools"):
+        for path in (ROOT / folder).rglob("*.py"):
+            text = path.read_text()
+            assert "from HapticSculpt import _core" not in text and "HapticSculpt._core" not in text \
+                or path.name in ("test_packaging.py", "test_layers.py", "architecture.py"), path
 
 
 def test_imports_run_downward_without_cycles():
