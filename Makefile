@@ -177,12 +177,13 @@ uninstall:
 	rm -f "$$mod/HapticSculpt" && echo "removed $$mod/HapticSculpt"
 
 # Benchmarks print tables and write bench/results/*.json and *.png (tracked JSON, untracked plots).
-bench: build
+bench: build wheel
 	$(PY) bench/table1.py
 	$(PY) bench/loops.py
 	$(PY) bench/skip.py
 	$(PY) bench/time_vs_error.py
 	$(PY) bench/discretisation.py
+	$(PY) bench/builds.py
 
 # Peers run in their own virtual environment (optional benchmark dependencies, not test ones).
 BENCH_VENV := $(BUILD)/bench-venv
