@@ -29,7 +29,7 @@ class HapticSculptWorkbench(Gui.Workbench):
         from HapticSculpt.gui import commands
         HapticSculptGui.register()
         self.appendToolbar("HapticSculpt", commands.TOOLBAR)
-        self.appendMenu("HapticSculpt", commands.TOOLBAR)
+        self.appendMenu("HapticSculpt", commands.MENU)
 
     def Activated(self):
         from HapticSculpt.gui.workbench import controller

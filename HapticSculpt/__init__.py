@@ -12,6 +12,8 @@ from .app.api import (
                       RunReport,
                       add_constraint,
                       export_step,
+                      held_boundary,
+                      hold_boundary,
                       keep_shape,
                       make_sculpt,
                       material_of,
@@ -32,7 +34,8 @@ from .version import __version__
 
 legacy_paths.install()
 
-__all__ = ["make_sculpt", "run", "add_constraint", "remove_constraint", "set_material", "material_of", "keep_shape",
+__all__ = ["make_sculpt", "run", "add_constraint", "remove_constraint", "hold_boundary", "held_boundary",
+           "set_material", "material_of", "keep_shape",
            "set_tool", "set_uniform", "set_curvature_target", "paint", "record_state",
            "export_step", "thicken",
            "to_cadquery", "ReplayDevice", "CursorSample", "CursorSource", "RunReport", "Session", "stop_all",

@@ -376,6 +376,77 @@ def remove_constraint(obj: Any, cid: int) -> None:
     obj.Proxy.live.edit(lambda s: s.remove_constraint(cid), "Remove constraint")
 
 
+#: The four edges of a sculpt's control net, by the side of its parameter domain they lie on.
+EDGES = ("u0", "u1", "v0", "v1")
+#: How an edge may be held: not at all, in place (G0), in place with its tangent planes (G1).
+BOUNDARIES = ("free", "G0", "G1")
+
+
+def boundary_poles(controls: tuple[int, int], boundary: Any) -> list[int]:
+    """The pole indices (i * nv + j for pole (i, j)) that hold ``boundary`` on a net of ``controls``
+    poles: G0 holds an edge's row of poles (a clamped B-spline's edge curve depends on it alone), G1
+    that row and the next (the derivative across the edge depends on those two)."""
+    nu, nv = controls
+    if isinstance(boundary, str):
+        boundary = {edge: boundary for edge in EDGES}
+    if not isinstance(boundary, dict):
+        raise TypeError(f"boundary: one of {', '.join(BOUNDARIES)}, or a dict from edge ({', '.join(EDGES)}) "
+                        f"to one of them, not {boundary!r}")
+    rows = {}
+    for edge, kind in boundary.items():
+        if edge not in EDGES:
+            raise ValueError(f"boundary: unknown edge {edge!r} (one of {', '.join(EDGES)})")
+        if kind not in BOUNDARIES:
+            raise ValueError(f"boundary: {edge} must be one of {', '.join(BOUNDARIES)}, not {kind!r}")
+        rows[edge] = BOUNDARIES.index(kind)  # rows of poles held: 0, 1 or 2
+    for side, count in (("u", nu), ("v", nv)):
+        if rows.get(side + "0", 0) + rows.get(side + "1", 0) >= count:
+            raise ValueError(f"boundary: {side}0 and {side}1 hold {rows.get(side + '0', 0) + rows.get(side + '1', 0)} "
+                             f"rows of the {count} poles along {side}, too few to leave any free (use more controls)")
+    held: set[int] = set()
+    for edge, n in rows.items():
+        count = nu if edge[0] == "u" else nv
+        for r in range(n):
+            line = r if edge[1] == "0" else count - 1 - r
+            if edge[0] == "u":
+                held.update(line * nv + j for j in range(nv))
+            else:
+                held.update(i * nv + line for i in range(nu))
+    return sorted(held)
+
+
+def hold_boundary(obj: Any, boundary: Any = "G0") -> list[int]:
+    """Holds the sculpt's edges exactly, as hard constraints (the poles do not move at all; not
+    penalties): "G0" keeps an edge where it is, "G1" its tangent planes along it too, "free" lets it
+    move. ``boundary`` is one of those for all four edges, or a dict from edge ("u0", "u1", "v0",
+    "v1": the sides of the parameter domain) to one of them, the others free. Replaces what was held
+    before. One undo transaction (also during a session); returns the held pole indices."""
+    _sculpt(obj)
+    controls = tuple(obj.Proxy.live.snapshot().surface.controls)
+    held = boundary_poles(controls, boundary)  # validated before the document changes
+    obj.Proxy.live.edit(lambda s: s.hold_poles(held), "Hold edges")
+    return held
+
+
+def held_boundary(obj: Any) -> dict[str, str]:
+    """What each edge of the sculpt is held as ("free", "G0" or "G1"), read from its held poles."""
+    _sculpt(obj)
+    surface = obj.Proxy.live.snapshot()
+    held, controls = set(surface.held_poles), tuple(surface.surface.controls)
+    out = {}
+    for edge in EDGES:
+        out[edge] = "free"
+        for kind in ("G1", "G0"):
+            try:
+                rows = set(boundary_poles(controls, {edge: kind}))
+            except ValueError:
+                continue
+            if rows <= held:
+                out[edge] = kind
+                break
+    return out
+
+
 def _objects(objs: Any) -> list[Any]:
     items = [objs] if hasattr(objs, "Shape") else list(objs) if isinstance(objs, Iterable) else None
     if not items:

@@ -2,8 +2,8 @@
 
 This is what a FreeCAD document stores (float lists are saved as binary doubles, JSON floats are
 written with ``repr``), so ``restore(capture(s))`` reproduces ``s`` bit for bit: poles, velocities,
-knots, weights, sampling, rest lengths, material maps, constraints (with their ids), laws,
-plasticity, tool and integrator settings. No FreeCAD import here.
+knots, weights, sampling, rest lengths, material maps, constraints (with their ids), held poles,
+laws, plasticity, tool and integrator settings. No FreeCAD import here.
 """
 from __future__ import annotations
 
@@ -121,6 +121,7 @@ def capture(surface: core.DynamicSurface) -> SculptState:
         "max_point_force": surface.max_point_force,
         "tool": tool_settings(surface),
         "constraints": constraints,
+        "held_poles": list(surface.held_poles),
     }
     return SculptState(arrays, settings)
 
@@ -191,6 +192,13 @@ def restore(state: SculptState) -> core.DynamicSurface:
                                        tuple(c["curvature"]) if "curvature" in c else None, c.get("offsets"))
         except (KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"SculptSettings.constraints: invalid constraint {c!r}: {exc}") from exc
+    held = s.get("held_poles", [])
+    if not isinstance(held, list) or not all(isinstance(i, int) and not isinstance(i, bool) for i in held):
+        raise ValueError(f"SculptSettings.held_poles: expected a list of pole indices, got {held!r}")
+    try:
+        surface.hold_poles(held)
+    except ValueError as exc:
+        raise ValueError(f"SculptSettings.held_poles: {exc}") from exc
     return surface
 
 

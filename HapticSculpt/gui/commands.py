@@ -18,6 +18,8 @@ TOOLBAR = ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Ses
            "HapticSculpt_ZebraDirection",
            "HapticSculpt_Panel", "HapticSculpt_CombDensity", "HapticSculpt_CombScale", "HapticSculpt_Thicken",
            "HapticSculpt_ExportStep"]
+#: The menu: the toolbar's commands and the ones that are only in the menu.
+MENU = TOOLBAR[:5] + ["HapticSculpt_HoldEdges"] + TOOLBAR[5:]
 
 
 def _selected_sculpts() -> list[Any]:
@@ -167,6 +169,20 @@ class KeepShape(_SculptCommand):
     def Activated(self) -> None:
         from .echo import ref, run_echoed
         run_echoed(f"HapticSculpt.keep_shape({ref(_ctl().active_sculpt())})")
+
+
+class HoldEdges(_SculptCommand):
+    icon_name, menu = "Session", "Hold edges: free / G0 / G1"
+    tip = ("Hold the sculpt's four edges exactly (hard constraints): G0 keeps them where they are, G1 their "
+           "tangent planes too; each press goes free, G0, G1, free")
+
+    def Activated(self) -> None:
+        from ..app.api import held_boundary
+        from .echo import ref, run_echoed
+        obj = _ctl().active_sculpt()
+        now = set(held_boundary(obj).values())
+        following = "G0" if now == {"free"} else "G1" if now == {"G0"} else "free"
+        run_echoed(f"HapticSculpt.hold_boundary({ref(obj)}, {following!r})")
 
 
 class _Tool(_SculptCommand):
@@ -375,6 +391,7 @@ class Panel(_SculptCommand):
 
 COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_SculptFace": SculptFace, "HapticSculpt_Session": Session,
             "HapticSculpt_Material": Material, "HapticSculpt_KeepShape": KeepShape,
+            "HapticSculpt_HoldEdges": HoldEdges,
             "HapticSculpt_ToolRope": ToolRope, "HapticSculpt_ToolMagnet": ToolMagnet,
             "HapticSculpt_MagnetFalloff": MagnetFalloff, "HapticSculpt_ToolOrientation": ToolOrientation,
             "HapticSculpt_ToolSmooth": ToolSmooth, "HapticSculpt_PointConstraint": PointConstraint,

@@ -100,6 +100,10 @@ void bindDynamicSurface(py::module_& m) {
         .def("set_velocities", [](DynamicSurface& s, DoubleArray v) {
             s.setVelocities(pointsFrom(v, s.poles().rows(), "velocities"));
         }, py::arg("velocities"))
+        .def("hold_poles", &DynamicSurface::holdPoles, py::arg("indices"),
+             "Hard constraints: these poles (index i*nv + j for pole (i, j)) stay exactly where they are, "
+             "the others move as if they were walls. Replaces the held set; [] frees them all.")
+        .def_property_readonly("held_poles", &DynamicSurface::heldPoles, "Indices of the held poles, ascending.")
         .def("sampling_matrix", [](const DynamicSurface& s) {
             const CsrMatrix& a = s.sampling().matrix();
             return py::make_tuple(a.rowStart, a.col, a.value, std::make_pair(a.rows, a.cols));

@@ -80,6 +80,7 @@ void DynamicSurface::setPoles(const Points& poles) {
     if (poles.rows() != surface_.poles().rows()) throw std::invalid_argument("poles: wrong number of rows");
     if (!withinRange(poles)) throw std::invalid_argument("poles: must be finite and within +-1e9");
     surface_.mutablePoles() = poles;
+    held_.capture(poles);
     v_.setZero();
     avValid_ = history_.valid = false;
     A_.apply(surface_.poles(), d_);
@@ -116,10 +117,19 @@ void DynamicSurface::continueFrom(DynamicSurface& live, bool keepMaps) {
     touch();
 }
 
+void DynamicSurface::holdPoles(const std::vector<int>& indices) {
+    held_.set(indices, surface_.poles());
+    held_.zeroRows(v_);
+    avValid_ = history_.valid = false;
+    accelerationValid_ = verlet_.valid = false;
+    wake();
+}
+
 void DynamicSurface::setVelocities(const Points& v) {
     if (v.rows() != v_.rows()) throw std::invalid_argument("velocities: wrong number of rows");
     if (!v.allFinite()) throw std::invalid_argument("velocities: contain NaN or Inf");
     v_ = v;
+    held_.zeroRows(v_);
     avValid_ = history_.valid = false;
     touch();
     resetEnergyCeiling();
@@ -163,16 +173,17 @@ void DynamicSurface::refreshMaterials() {
 }
 
 void DynamicSurface::ensureMassFactor() {
-    if (massSolver_.ready() && massVersion_ == mass_.version()) return;
+    // (mass and held-set versions only grow, so their sum changes whenever either does)
+    if (massSolver_.ready() && massVersion_ == mass_.version() + held_.version()) return;
     const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
     massMatrix_ = A.transpose() * m_.asDiagonal() * A;
+    held_.restrict(massMatrix_, true);
     massSolver_.factor(massMatrix_, "mass matrix A^T M A");
-    massVersion_ = mass_.version();
+    massVersion_ = mass_.version() + held_.version();
 }
 
 void DynamicSurface::ensureSystem(double dt, bool factor) {
-    const std::uint64_t key[4] = {mass_.version(), damping_.version(), stiffness_.version(),
-                                  constraints_.structureVersion()};
+    const std::uint64_t key[4] = {mass_.version(), damping_.version(), stiffness_.version(), structureKey()};
     bool same = dt == systemDt_ && (systemFactored_ || !factor);
     for (int i = 0; i < 4; ++i) same = same && key[i] == systemKey_[i];
     if (same) return;
@@ -181,7 +192,8 @@ void DynamicSurface::ensureSystem(double dt, bool factor) {
     D = (m_ + dt * gamma_).asDiagonal();
     const Eigen::SparseMatrix<double> Sm = D + (dt * dt) * laplacian();
     const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
-    const Eigen::SparseMatrix<double> sys = A.transpose() * Sm * A;
+    Eigen::SparseMatrix<double> sys = A.transpose() * Sm * A;
+    held_.restrict(sys, true);
     cg_.invDiag = sys.diagonal().cwiseInverse();  // Jacobi preconditioner
     if (factor) {
         ensureMassFactor();  // throws first if the mesh does not see every control point
@@ -316,6 +328,10 @@ StepReport DynamicSurface::step(double dt) {
         r.refused = true;
         r.reason = "the step would produce NaN or Inf; state kept (reduce dt or stiffness)";
         return r;
+    }
+    if (!held_.empty() && held_.snap(surface_.mutablePoles(), v_)) {
+        A_.apply(surface_.poles(), d_);
+        avValid_ = false;
     }
     double work = 0;
     if (tracksWork) {

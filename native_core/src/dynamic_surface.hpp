@@ -11,6 +11,7 @@
 #include "bspline_surface.hpp"
 #include "constraints.hpp"
 #include "energy_guard.hpp"
+#include "held_poles.hpp"
 #include "integrator_state.hpp"
 #include "material_map.hpp"
 #include "prefactored_solver.hpp"
@@ -97,6 +98,12 @@ public:
     /// Replaces the poles (e.g. after undo) and zeroes velocities; rest lengths are kept.
     void setPoles(const Points& poles);
     void setVelocities(const Points& v);
+    /// Hard constraints (held_poles.hpp): the poles at `indices` stay exactly where they are now
+    /// (also through setPoles, which holds them where the new net puts them), the others move as if
+    /// they were walls. Replaces the held set; an empty list frees them all. Throws
+    /// std::invalid_argument naming "indices" for an index out of range.
+    void holdPoles(const std::vector<int>& indices);
+    const std::vector<int>& heldPoles() const { return held_.indices(); }
     /// Mesh index nearest to parameter (u, v), and the parameters of a mesh index.
     int meshIndexAt(double u, double v) const;
     std::pair<double, double> meshParameters(int index) const;
@@ -239,6 +246,9 @@ private:
     double predictorWeight(double dt, bool fixedTargets) const;
     void checkSleep(double dt);
     MeshView meshView() const { return {d_, g(), h(), spacingU_, spacingV_}; }
+    /// What the factored systems' structure depends on: the constraints' and the held poles'
+    /// (both versions only grow, so the sum changes whenever either does).
+    std::uint64_t structureKey() const { return constraints_.structureVersion() + held_.version(); }
 
     BSplineSurface surface_;
     SamplingOperator A_;
@@ -258,6 +268,7 @@ private:
     StepBackup backup_;
     EnergyGuard guard_;
     SleepMonitor sleep_;
+    HeldPoles held_;
     // Material: per mesh point masses and damping rates, the maps, springs, constraints, tool.
     Eigen::VectorXd m_, gamma_;
     MaterialMap mass_, damping_, stiffness_;

@@ -21,6 +21,7 @@ StepReport DynamicSurface::stepImplicitCG(double dt) {
     stiffnessTimes(dd_, meshTmp2_);
     meshTmp_ = dt * force_ - dt * dt * meshTmp2_;
     A_.applyTransposed(meshTmp_, cg_.r);
+    held_.zeroRows(cg_.r);  // (and of q below: CG stays in the free poles' subspace)
     const double bnorm = std::sqrt(cg_.r.squaredNorm());
     x_.setZero();
     double rnorm = bnorm;
@@ -34,6 +35,7 @@ StepReport DynamicSurface::stepImplicitCG(double dt) {
             stiffnessTimes(meshTmp_, meshTmp2_);
             meshTmp2_ = (m_ + dt * gamma_).asDiagonal() * meshTmp_ + dt * dt * meshTmp2_;
             A_.applyTransposed(meshTmp2_, cg_.q);
+            held_.zeroRows(cg_.q);
             const double pq = cg_.p.cwiseProduct(cg_.q).sum();
             ++r.iterations;
             if (!(pq > 0)) break;

@@ -134,6 +134,7 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
         springs_.addProjections(*iterate, meshTmp2_, 0.25 * minMass_ / (h * h), h * h);
         if (!constraints_.empty()) constraints_.addProjections(*iterate, meshTmp2_, terms_, h * h);
         A_.applyTransposed(meshTmp2_, fp_);
+        held_.zeroRows(fp_);
         systemSolver_.solve(fp_, acc_);
         change = acc_.cwiseAbs().maxCoeff();
         x_ += acc_;

@@ -79,6 +79,7 @@ void DynamicSurface::solveApplied() {
         }
     }
     for (int c : verlet_.appliedPoles) verlet_.poleMark[static_cast<size_t>(c)] = 0;
+    held_.zeroRows(fp_);
     massSolver_.solveSparse(fp_, verlet_.appliedPoles, acc_);
 }
 
@@ -92,6 +93,7 @@ StepReport DynamicSurface::stepVerlet(double dt) {
     if (!verlet_.valid) {
         verletForces(d_, av_);
         A_.applyTransposed(force_, fp_);
+        held_.zeroRows(fp_);
         massSolver_.solve(fp_, verlet_.a);
     }
     if (tool_->grabbed()) {
@@ -112,6 +114,7 @@ StepReport DynamicSurface::stepVerlet(double dt) {
     meshTmp_ = (2.0 / h) * (d_ - dPrev_) - av_;
     verlet_.stepPotential = verletForces(d_, meshTmp_);
     A_.applyTransposed(force_, fp_);
+    held_.zeroRows(fp_);
     massSolver_.solve(fp_, verlet_.a);
     v_ += (0.5 * h) * verlet_.a;
     if (applied) v_ += (0.5 * h) * acc_;

@@ -19,7 +19,7 @@
 namespace hs {
 
 bool DynamicSurface::omegaSquaredBelow(double limit, bool tight) {
-    const std::uint64_t key[3] = {mass_.version(), stiffness_.version(), constraints_.structureVersion()};
+    const std::uint64_t key[3] = {mass_.version(), stiffness_.version(), structureKey()};
     if (key[0] != omega_.key[0] || key[1] != omega_.key[1] || key[2] != omega_.key[2]) {
         rescaleOmegaBounds();
         for (int i = 0; i < 3; ++i) omega_.key[i] = key[i];
@@ -34,7 +34,7 @@ bool DynamicSurface::omegaSquaredBelow(double limit, bool tight) {
 
 void DynamicSurface::rescaleOmegaBounds() {
     omega_.tight = false;
-    if (omega_.snapK.size() == 0 || omega_.snapStructure != constraints_.structureVersion()) {
+    if (omega_.snapK.size() == 0 || omega_.snapStructure != structureKey()) {
         omega_.upper = std::numeric_limits<double>::infinity();
         omega_.lower = 0;
         return;
@@ -57,12 +57,13 @@ void DynamicSurface::rescaleOmegaBounds() {
 void DynamicSurface::computeOmegaBounds(double limit) {
     ensureMassFactor();
     const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
-    const Eigen::SparseMatrix<double> K = A.transpose() * laplacian() * A;
+    Eigen::SparseMatrix<double> K = A.transpose() * laplacian() * A;
+    held_.restrict(K, false);  // the held poles' modes are gone (massMatrix_ is restricted too)
     const Eigen::SparseMatrix<double>& M = massMatrix_;
     omega_.snapK.resize(static_cast<Eigen::Index>(springs_.first().size()));
     for (Eigen::Index s = 0; s < omega_.snapK.size(); ++s) omega_.snapK[s] = springs_.stiffness(static_cast<int>(s));
     omega_.snapM = m_;
-    omega_.snapStructure = constraints_.structureVersion();
+    omega_.snapStructure = structureKey();
     // max K_ii / M_ii is a Rayleigh quotient, so a lower bound: it rules out long steps cheaply.
     const double lower = (K.diagonal().array() / M.diagonal().array()).maxCoeff();
     if (lower > limit) {
@@ -81,6 +82,7 @@ void DynamicSurface::computeOmegaBounds(double limit) {
     std::mt19937 rng(12345);
     std::uniform_real_distribution<double> uni(-1.0, 1.0);
     for (Eigen::Index i = 0; i < q.size(); ++i) q.data()[i] = uni(rng);
+    held_.zeroRows(q);
     mw = M * q;
     for (int c = 0; c < 3; ++c) q.col(c) /= std::sqrt(q.col(c).dot(mw.col(c)));
     Eigen::MatrixXd alpha = Eigen::MatrixXd::Zero(kMaxSteps, 3), beta = Eigen::MatrixXd::Zero(kMaxSteps, 3);

@@ -27,6 +27,19 @@ constexpr bool kSanitized = false;
 using namespace hs;
 
 namespace {
+// Waits until `done` holds (polling every millisecond), at most `seconds`; returns whether it held.
+// The loops run slowly under sanitizers and on a loaded machine, so the tests wait for what they
+// need (a grab, a count of steps) instead of sleeping a fixed time.
+template <class Condition>
+bool waitFor(Condition done, double seconds = 30.0) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (!done()) {
+        if (std::chrono::steady_clock::now() > end) return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return true;
+}
+
 std::shared_ptr<DynamicSurface> patch(int controls = 8, int mesh = 24) {
     return std::make_shared<DynamicSurface>(BSplineSurface::plane(controls, controls, 3, 3, 100, 100), mesh, mesh);
 }
@@ -158,8 +171,7 @@ TEST(HapticRuntime, ReplayRunsToTheEndAndCommitsTheStroke) {
     settings.logSeconds = 2;
     HapticRuntime rt(s, lift(0.6, 20.0), settings);
     rt.start();
-    for (int i = 0; i < 400 && rt.running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    EXPECT_FALSE(rt.running());
+    EXPECT_TRUE(waitFor([&] { return !rt.running(); }));  // the replay's end stops it
     rt.stop();
     const RuntimeStatus st = rt.status();
     EXPECT_EQ(st.error, "");
@@ -195,13 +207,11 @@ TEST(HapticRuntime, DeviceLossStopsWithZeroForceAndAClamp) {
     static_cast<RopeTool&>(s->tool()).stiffStiffness = 1000;  // steeper than the device's 40
     HapticRuntime rt(s, dev, RuntimeSettings{});
     rt.start();
-    std::this_thread::sleep_for(std::chrono::milliseconds(400));
+    ASSERT_TRUE(waitFor([&] { return dev->nonZero.load(); }));  // the rope pulls back
     EXPECT_TRUE(rt.running());
-    EXPECT_TRUE(dev->nonZero.load());
     EXPECT_LE(rt.status().force.norm(), 50.0 + 1e-9);  // the device's maximum
     dev->lost = true;
-    for (int i = 0; i < 200 && rt.running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    EXPECT_FALSE(rt.running());
+    EXPECT_TRUE(waitFor([&] { return !rt.running(); }));
     rt.stop();
     EXPECT_EQ(rt.status().error, "device lost");
     EXPECT_EQ(dev->last.load(), 0.0);
@@ -212,15 +222,18 @@ TEST(HapticRuntime, NonFiniteDeviceInputNeverReachesTheSurfaceOrTheForce) {
     auto dev = std::make_shared<GarbageDevice>();
     HapticRuntime rt(s, dev, RuntimeSettings{});
     rt.start();
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    // until the valid samples have lifted the grabbed mesh point (the contact: read race-free)
+    EXPECT_TRUE(waitFor([&] {
+        const RuntimeStatus now = rt.status();
+        return dev->count.load() > 100 && now.contactValid && now.contact.z() > 0.02;
+    }));
     const RuntimeStatus st = rt.status();
     rt.stop();
-    EXPECT_GT(dev->count.load(), kSanitized ? 10 : 100);
     EXPECT_FALSE(dev->nonFinite.load());
     EXPECT_TRUE(st.force.allFinite());
     EXPECT_TRUE(s->poles().allFinite());
     EXPECT_TRUE(s->velocities().allFinite());
-    EXPECT_GT(s->poles().col(2).maxCoeff(), 0.01);  // the valid samples still lifted the surface (any lift: sanitizers are slow)
+    EXPECT_GT(s->poles().col(2).maxCoeff(), 0.01);  // the valid samples still lifted the surface
 }
 
 TEST(HapticRuntime, StatusShowsTheCursorAndTheRopeContactForTheOverlay) {
@@ -228,7 +241,10 @@ TEST(HapticRuntime, StatusShowsTheCursorAndTheRopeContactForTheOverlay) {
     auto dev = std::make_shared<RecordingDevice>();
     HapticRuntime rt(s, dev, RuntimeSettings{});
     rt.start();
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    EXPECT_TRUE(waitFor([&] {
+        const RuntimeStatus now = rt.status();
+        return now.grab && now.contactValid && now.cursor.z() > 1.0;
+    }));
     const RuntimeStatus st = rt.status();
     rt.stop();
     EXPECT_TRUE(st.grab);
@@ -251,7 +267,7 @@ TEST(HapticRuntime, AirbrushSpraysAlongTheCursorAsOneStrokeAndRendersNoForce) {
     a.rate = 100;
     rt.setAirbrush(a);
     rt.start();
-    for (int i = 0; i < 400 && rt.running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    EXPECT_TRUE(waitFor([&] { return !rt.running(); }));  // the replay's end stops it
     rt.stop();
     const RuntimeStatus st = rt.status();
     EXPECT_EQ(st.error, "");
@@ -285,12 +301,14 @@ TEST(HapticRuntime, SwitchingTheAirbrushOnMidGrabReleasesTheTool) {
     auto dev = std::make_shared<RecordingDevice>();  // holds the button and lifts
     HapticRuntime rt(s, dev, RuntimeSettings{});
     rt.start();
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
-    EXPECT_TRUE(rt.status().contactValid);  // the rope holds a mesh point (read through status: race-free)
+    // the rope holds a mesh point (read through status: race-free)
+    EXPECT_TRUE(waitFor([&] { return rt.status().contactValid; }));
     AirbrushSettings a;
     a.map = AirbrushSettings::Map::Mass;
     rt.setAirbrush(a);
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    ASSERT_TRUE(waitFor([&] { return rt.status().spraying; }));
+    const std::uint64_t spraySteps = rt.status().simSteps;
+    EXPECT_TRUE(waitFor([&] { return rt.status().simSteps > spraySteps + 50; }));  // some spraying done
     const RuntimeStatus st = rt.status();
     rt.stop();
     EXPECT_TRUE(st.spraying);
@@ -305,16 +323,6 @@ TEST(HapticRuntime, SwitchingTheAirbrushOnMidGrabReleasesTheTool) {
 }
 
 namespace {
-template <class Condition>
-bool waitFor(Condition done, double seconds = 20.0) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (!done()) {
-        if (std::chrono::steady_clock::now() > end) return false;
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
-    return true;
-}
-
 bool takeEvent(HapticRuntime& rt, StrokeSnapshot& out) {
     return waitFor([&] { return rt.takeStroke(out); });
 }
@@ -458,15 +466,16 @@ TEST(HapticRuntime, LoopsDoNotAllocateOnceRunning) {
     RuntimeSettings settings;
     HapticRuntime rt(s, lift(3.0, 25.0, false), settings);
     rt.start();
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // grab and first factorisation
+    // past the grab and the first factorisation
+    ASSERT_TRUE(waitFor([&] { return rt.status().contactValid && rt.status().simSteps > 20; }));
     const long before = allocationCount();
     const std::uint64_t stepsBefore = rt.status().simSteps;
-    std::this_thread::sleep_for(std::chrono::milliseconds(700));
+    // a window that really covers stepping (sanitizers are slow: fewer steps there)
+    const bool stepped = waitFor([&] { return rt.status().simSteps > stepsBefore + (kSanitized ? 50u : 500u); });
     const long after = allocationCount();
-    const std::uint64_t steps = rt.status().simSteps - stepsBefore;
     rt.stop();
+    EXPECT_TRUE(stepped);
     EXPECT_EQ(after - before, 0);
-    EXPECT_GT(steps, kSanitized ? 5u : 500u);  // the window really covered stepping (sanitizers are slow)
 }
 
 TEST(HapticRuntime, RefusesBadSettings) {

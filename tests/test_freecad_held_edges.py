@@ -1,0 +1,102 @@
+"""Held edges (hs.hold_boundary): a sculpt's edges kept exactly (G0) or with their tangent planes
+(G1) through strokes, as hard constraints; undo, redo, save and reopen; clear errors."""
+from __future__ import annotations
+
+import math
+import os
+
+import FreeCAD
+import numpy as np
+from freecad_support import DocumentTestCase
+
+import HapticSculpt as hs
+
+
+def stroke(obj, lift=25.0):
+    dev = hs.ReplayDevice.stroke((0.0, 0.0, 0.0), (0.0, 0.0, lift), seconds=1.0, hold=0.5)
+    return hs.run(obj, 1.5, device=dev, tool="rope")
+
+
+def edge_samples(face, n=100):
+    """Points and unit normals at n points along each of the face's four edges, by edge."""
+    (u0, u1, v0, v1) = face.ParameterRange
+    lines = {"u0": [(u0, v0 + (v1 - v0) * k / (n - 1)) for k in range(n)],
+             "u1": [(u1, v0 + (v1 - v0) * k / (n - 1)) for k in range(n)],
+             "v0": [(u0 + (u1 - u0) * k / (n - 1), v0) for k in range(n)],
+             "v1": [(u0 + (u1 - u0) * k / (n - 1), v1) for k in range(n)]}
+    surface = face.Surface
+    return {edge: (np.array([tuple(surface.value(u, v)) for u, v in uvs]),
+                   np.array([tuple(surface.normal(u, v)) for u, v in uvs])) for edge, uvs in lines.items()}
+
+
+def seams(before, after):
+    """Per edge: the largest gap (mm) and normal angle (degrees) between two samplings."""
+    out = {}
+    for edge in before:
+        gap = float(np.max(np.linalg.norm(after[edge][0] - before[edge][0], axis=1)))
+        cos = np.clip(np.sum(after[edge][1] * before[edge][1], axis=1), -1.0, 1.0)
+        out[edge] = (gap, float(np.degrees(np.max(np.arccos(cos)))))
+    return out
+
+
+class TestHeldEdges(DocumentTestCase):
+    def test_g1_keeps_edges_and_tangent_planes_through_a_stroke(self):
+        obj = hs.make_sculpt(self.doc, controls=(8, 8), mesh=(30, 30))
+        held = hs.hold_boundary(obj, "G1")
+        self.assertEqual(len(held), 64 - 16)  # two rings of an 8 x 8 net
+        before = edge_samples(obj.Shape.Faces[0])
+        middle = obj.Shape.Faces[0].Surface.value(0.5, 0.5).z
+        stroke(obj)
+        after = edge_samples(obj.Shape.Faces[0])
+        for edge, (gap, angle) in seams(before, after).items():
+            self.assertLessEqual(gap, 1e-9, edge)
+            self.assertLessEqual(angle, 0.01, edge)
+        self.assertGreater(obj.Shape.Faces[0].Surface.value(0.5, 0.5).z - middle, 2.0)  # the inside moved
+        self.assertEqual(hs.held_boundary(obj), {"u0": "G1", "u1": "G1", "v0": "G1", "v1": "G1"})
+
+    def test_g0_on_some_edges_keeps_those_and_frees_the_others(self):
+        obj = hs.make_sculpt(self.doc, controls=(8, 8), mesh=(30, 30))
+        hs.hold_boundary(obj, {"u0": "G0", "v1": "G1"})
+        self.assertEqual(hs.held_boundary(obj), {"u0": "G0", "u1": "free", "v0": "free", "v1": "G1"})
+        before = edge_samples(obj.Shape.Faces[0])
+        stroke(obj)
+        result = seams(before, edge_samples(obj.Shape.Faces[0]))
+        self.assertLessEqual(result["u0"][0], 1e-9)
+        self.assertGreater(result["u0"][1], 0.01)  # G0 only: the surface turns along the edge
+        self.assertLessEqual(result["v1"][0], 1e-9)
+        self.assertLessEqual(result["v1"][1], 0.01)
+        self.assertGreater(result["u1"][0], 0.1)  # a free edge follows the stroke
+
+    def test_undo_redo_save_and_reopen(self):
+        obj = hs.make_sculpt(self.doc, controls=(8, 8), mesh=(24, 24))
+        n = self.doc.UndoCount
+        hs.hold_boundary(obj, "G0")
+        self.assertEqual(self.doc.UndoCount, n + 1)
+        self.assertEqual(self.doc.UndoNames[0], "Hold edges")
+        self.doc.undo()
+        self.assertEqual(list(obj.Proxy.surface.held_poles), [])
+        self.doc.redo()
+        self.assertEqual(len(obj.Proxy.surface.held_poles), 28)
+        stroke(obj)
+        poles, name = np.array(obj.Proxy.surface.poles), obj.Name
+        path = os.path.join(self.tmp, "held.FCStd")
+        self.doc.saveAs(path)
+        FreeCAD.closeDocument(self.doc.Name)
+        self.doc = FreeCAD.openDocument(path)
+        back = self.doc.getObject(name)
+        self.assertEqual(hs.held_boundary(back), {"u0": "G0", "u1": "G0", "v0": "G0", "v1": "G0"})
+        self.assertTrue(np.array_equal(np.array(back.Proxy.surface.poles), poles))
+        stroke(back, lift=-10.0)  # still held after reopening
+        self.assertTrue(np.array_equal(np.array(back.Proxy.surface.poles)[0], poles[0]))
+
+    def test_bad_boundaries_are_refused_by_name_and_change_nothing(self):
+        obj = hs.make_sculpt(self.doc, controls=(4, 8), mesh=(20, 20))
+        n = self.doc.UndoCount
+        for boundary, message in (("G2", "one of free, G0, G1"), ({"w0": "G0"}, "unknown edge 'w0'"),
+                                  ({"u0": "G1", "u1": "G1"}, "too few to leave any free"), (3, "boundary: one of")):
+            with self.assertRaises((ValueError, TypeError)) as ctx:
+                hs.hold_boundary(obj, boundary)
+            self.assertIn(message, str(ctx.exception))
+        self.assertEqual(self.doc.UndoCount, n)
+        self.assertEqual(list(obj.Proxy.surface.held_poles), [])
+        self.assertTrue(math.isfinite(obj.Shape.Area))
