@@ -104,6 +104,7 @@ _INVALID = (
     ("value", lambda s: s.stiffness_map.set_uniform(math.nan)),
     ("value", lambda s: s.mass_map.set_uniform(-1.0)),
     ("poles", lambda s: s.set_poles(np.full(s.poles.shape, math.nan))),
+    ("indices", lambda s: s.hold_poles([-1])),
 )
 
 
@@ -175,6 +176,15 @@ def run_scene(seed: int, steps: int = STEPS) -> SceneResult:
                 res.failure = msg
                 return res
         s.set_tool(core.TOOLS[int(rng.integers(0, 4))])
+        # Held poles (hard constraints) in a quarter of the scenes, from a stream of their own so the
+        # other scenes stay what they were: any subset, up to all of them.
+        held_rng = np.random.default_rng([seed, 1])
+        held: list[int] = []
+        if held_rng.random() < 0.25:
+            n_poles = controls[0] * controls[1]
+            held = sorted(int(i) for i in held_rng.choice(n_poles, int(held_rng.integers(1, n_poles + 1)), replace=False))
+            s.hold_poles(held)
+        held_at = np.array(s.poles).reshape(-1, 3)[held].copy()
         energy0 = _energy(s)
         work_in = 0.0
         last_work = s.work_done
@@ -201,6 +211,9 @@ def run_scene(seed: int, steps: int = STEPS) -> SceneResult:
             res.substeps += rep.substeps
             if not _finite(s):
                 res.failure = f"non-finite state after step {k}"
+                return res
+            if held and not np.array_equal(np.array(s.poles).reshape(-1, 3)[held], held_at):
+                res.failure = f"a held pole moved in step {k}"
                 return res
             work = s.work_done
             work_in += max(0.0, work - last_work)
