@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import os
+import time
 
 import FreeCAD
 import numpy as np
@@ -100,3 +101,35 @@ class TestHeldEdges(DocumentTestCase):
         self.assertEqual(self.doc.UndoCount, n)
         self.assertEqual(list(obj.Proxy.surface.held_poles), [])
         self.assertTrue(math.isfinite(obj.Shape.Area))
+
+
+class TestHeldEdgesInSessions(DocumentTestCase):
+    def test_a_session_keeps_held_edges_and_takes_a_hold_made_during_it(self):
+        obj = hs.make_sculpt(self.doc, controls=(8, 8), mesh=(24, 24), material="clay")
+        hs.hold_boundary(obj, {"u0": "G0"})
+        rows = np.array(obj.Proxy.surface.poles)
+        pull = hs.ReplayDevice.stroke((10.0, 10.0, 0.0), (10.0, 10.0, 20.0), seconds=0.5, hold=30.0)
+        session = hs.Session().start(obj, pull)
+        try:
+            end = time.monotonic() + 30
+            while np.linalg.norm(session.status()["force"]) < 1.0 or session.status()["elapsed"] < 0.8:
+                self.assertLess(time.monotonic(), end, "the rope never pulled")
+                time.sleep(0.01)
+            hs.hold_boundary(obj, {"u0": "G0", "u1": "G1"})  # through the session's edit queue
+            while not session.applied_edits:
+                self.assertLess(time.monotonic(), end, "the hold never applied")
+                session.poll()
+                time.sleep(0.01)
+        finally:
+            session.stop()
+        poles = np.array(obj.Proxy.surface.poles)
+        self.assertTrue(np.array_equal(poles[0], rows[0]))  # held before the session: never moved
+        self.assertGreater(np.abs(poles[3:5] - rows[3:5]).max(), 0.5)  # the rope pulled the inside
+        self.assertEqual(hs.held_boundary(obj), {"u0": "G0", "u1": "G1", "v0": "free", "v1": "free"})
+        # the hold made during the session stays: another stroke moves the inside, not the u1 rows
+        again = hs.ReplayDevice.stroke((-10.0, 0.0, 0.0), (-10.0, 0.0, 15.0), seconds=0.5, hold=0.3)
+        hs.Session().start(obj, again, stop_when_finished=True).wait(timeout=30)
+        after = np.array(obj.Proxy.surface.poles)
+        self.assertTrue(np.array_equal(after[-2:], poles[-2:]))
+        self.assertTrue(np.array_equal(after[0], rows[0]))
+        self.assertGreater(np.abs(after[2:6] - poles[2:6]).max(), 0.5)
