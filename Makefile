@@ -105,7 +105,7 @@ test-freecad: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
 	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python FREECAD_USER_HOME=$(CURDIR)/$(FC_HOME) \
 	  freecadcmd -t TestHapticSculpt
 
-test: test-cpp test-asan test-tsan test-python test-addon test-other-debian
+test: test-cpp test-asan test-tsan test-python test-addon demo test-other-debian
 
 # The same against the other Debian's FreeCAD: on Debian 12 (FreeCAD 0.20.2, Python 3.11) that is
 # Debian 13's FreeCAD 1.0 (Python 3.13, GCC 14), on Debian 13 it is Debian 12's 0.20.2. It runs in
