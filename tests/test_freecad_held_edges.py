@@ -9,13 +9,9 @@ import time
 import FreeCAD
 import numpy as np
 from freecad_support import DocumentTestCase
+from test_freecad_layer import stroke
 
 import HapticSculpt as hs
-
-
-def stroke(obj, lift=25.0):
-    dev = hs.ReplayDevice.stroke((0.0, 0.0, 0.0), (0.0, 0.0, lift), seconds=1.0, hold=0.5)
-    return hs.run(obj, 1.5, device=dev, tool="rope")
 
 
 def edge_samples(face, n=100):
