@@ -18,6 +18,7 @@ from .. import core
 from . import recorded_state, sculpt_state
 from .sculpt_feature import SculptFeature, attach_view_provider, is_sculpt
 from .sculpt_properties import face_of, read_state
+from .sculpted_solid import is_sculpted_solid, sculpt_of
 from .source_surface import source_surface
 from .undo import transaction
 
@@ -57,9 +58,13 @@ def _document(doc: Any) -> Any:
     return doc
 
 
-def _sculpt(obj: Any, name: str = "obj") -> Any:
+def _sculpt(obj: Any, name: str = "obj", solids: bool = False) -> Any:
+    """The Sculpt ``obj`` is, or (``solids``) the one a SculptedSolid sculpts its faces with."""
+    if solids and is_sculpted_solid(obj):
+        return sculpt_of(obj)
     if not is_sculpt(obj):
-        raise TypeError(f"{name}: expected a HapticSculpt Sculpt object, got {getattr(obj, 'TypeId', type(obj).__name__)}")
+        what = "Sculpt or SculptedSolid" if solids else "Sculpt"
+        raise TypeError(f"{name}: expected a HapticSculpt {what} object, got {getattr(obj, 'TypeId', type(obj).__name__)}")
     return obj
 
 
@@ -79,13 +84,7 @@ def make_sculpt(doc: Any = None, source: Any = None, controls: tuple[int, int] =
     undone.
     """
     doc = _document(doc)
-    degree = _int_pair(degree, "degree", 1)
-    if max(degree) > core.MAX_DEGREE:
-        raise ValueError(f"degree: at most {core.MAX_DEGREE}, got {degree}")
-    controls = _int_pair(controls, "controls", 2)
-    if controls[0] < degree[0] + 1 or controls[1] < degree[1] + 1:
-        raise ValueError(f"controls: need at least degree+1 = {(degree[0] + 1, degree[1] + 1)}, got {controls}")
-    mesh = _int_pair(mesh, "mesh", 2)
+    controls, degree, mesh = _checked_resolution(controls, degree, mesh)
     try:
         sx, sy = size
     except (TypeError, ValueError):
@@ -95,20 +94,42 @@ def make_sculpt(doc: Any = None, source: Any = None, controls: tuple[int, int] =
         raise TypeError("name: expected a non-empty string")
     _material(material)
     made = source_surface(source, controls, degree, size, doc)
+    state = _sculpt_state(made, mesh, material)
+    if doc.UndoMode == 0:
+        doc.UndoMode = 1
+    with transaction(doc, "Create sculpt"):
+        return _add_sculpt(doc, name, made, state)
+
+
+def _checked_resolution(controls: Any, degree: Any, mesh: Any) -> tuple[tuple[int, int], ...]:
+    degree = _int_pair(degree, "degree", 1)
+    if max(degree) > core.MAX_DEGREE:
+        raise ValueError(f"degree: at most {core.MAX_DEGREE}, got {degree}")
+    controls = _int_pair(controls, "controls", 2)
+    if controls[0] < degree[0] + 1 or controls[1] < degree[1] + 1:
+        raise ValueError(f"controls: need at least degree+1 = {(degree[0] + 1, degree[1] + 1)}, got {controls}")
+    return controls, degree, _int_pair(mesh, "mesh", 2)
+
+
+def _sculpt_state(made: Any, mesh: tuple[int, int], material: str, held: Sequence[int] = ()) -> sculpt_state.SculptState:
+    """The state of a new sculpt of ``made`` (a SourceSurface) sampled at ``mesh``, poles ``held``."""
     nu, nv = made.surface.controls
     if mesh[0] < nu or mesh[1] < nv:
         raise ValueError(f"mesh: must be at least the control resolution {(nu, nv)}, got {mesh}")
     surface = core.DynamicSurface(made.surface, mesh)
     _apply_material(surface, material)
-    state = sculpt_state.capture(surface)
-    if doc.UndoMode == 0:
-        doc.UndoMode = 1
-    with transaction(doc, "Create sculpt"):
-        obj = doc.addObject("Part::FeaturePython", name)
-        SculptFeature(obj, state, made.method, made.error, made.description)
-        attach_view_provider(obj)
-        obj.Shape = face_of(state)
-        obj.purgeTouched()
+    if held:
+        surface.hold_poles(list(held))
+    return sculpt_state.capture(surface)
+
+
+def _add_sculpt(doc: Any, name: str, made: Any, state: sculpt_state.SculptState) -> Any:
+    """A new Sculpt object with ``state`` (the caller holds the transaction)."""
+    obj = doc.addObject("Part::FeaturePython", name)
+    SculptFeature(obj, state, made.method, made.error, made.description)
+    attach_view_provider(obj)
+    obj.Shape = face_of(state)
+    obj.purgeTouched()
     return obj
 
 
@@ -141,20 +162,20 @@ def set_material(obj: Any, material: str) -> None:
     """Makes the sculpt "elastic" (springs back to its rest shape; damping 1) or "clay" (plastic
     and damped: what a stroke pulls stays where it is left; damping 10). Sets the damping map
     uniformly. One undo step; a running session takes it at once."""
-    _sculpt(obj)
+    obj = _sculpt(obj, solids=True)
     _material(material)
     obj.Proxy.live.edit(lambda s: _apply_material(s, material), f"Material: {material}")
 
 
 def material_of(obj: Any) -> str:
     """"clay" if the sculpt is plastic, else "elastic"."""
-    return "clay" if _sculpt(obj).Proxy.live.snapshot().plasticity[0] else "elastic"
+    return "clay" if _sculpt(obj, solids=True).Proxy.live.snapshot().plasticity[0] else "elastic"
 
 
 def keep_shape(obj: Any) -> None:
     """Makes the current shape the rest shape, so an elastic sculpt stays as it is. One undo
     step; a running session takes it at once, also while the tool is held."""
-    _sculpt(obj)
+    obj = _sculpt(obj, solids=True)
     obj.Proxy.live.edit(lambda s: None, "Keep shape", keep_shape=True)
 
 
@@ -164,7 +185,7 @@ def record_state(obj: Any, packed: str, title: str = "Sculpt stroke", strokes: i
     undo step named ``title``, counting ``strokes``. Returns False and does nothing if ``obj``
     holds that state already: the GUI echoes this call after each stroke it commits, so FreeCAD's
     macro recorder records the stroke, and a recorded macro replays it exactly in console mode."""
-    _sculpt(obj)
+    obj = _sculpt(obj, solids=True)
     if not isinstance(title, str) or not title:
         raise TypeError("title: expected a non-empty string")
     if isinstance(strokes, bool) or not isinstance(strokes, int) or strokes < 0:
@@ -190,7 +211,7 @@ def set_tool(obj: Any, tool: str, falloff: str | None = None) -> None:
     """Selects the sculpting tool ("rope", "magnet", "orientation", "smooth"); ``falloff`` sets the
     magnet's or smooth tool's ("constant", "spherical", "cylindrical", "conical"). One undo step; a
     running session takes it at once."""
-    _sculpt(obj)
+    obj = _sculpt(obj, solids=True)
     if tool not in core.TOOLS:
         raise ValueError(f"tool: unknown tool {tool!r} (one of {', '.join(core.TOOLS)})")
     if falloff is not None and falloff not in core.FALLOFFS:
@@ -208,7 +229,7 @@ def set_tool(obj: Any, tool: str, falloff: str | None = None) -> None:
 def set_uniform(obj: Any, map: str, value: float) -> None:
     """Sets material map ``map`` ("mass", "damping", "stiffness") to ``value`` everywhere (the
     slider panel's edit). One undo step; a running session takes it at once."""
-    _sculpt(obj)
+    obj = _sculpt(obj, solids=True)
     sculpt_state.map_property(map)  # validates the name
     value = _finite(value, "value", nonnegative=map == "damping", positive=map != "damping")
     obj.Proxy.live.edit(lambda s: getattr(s, map + "_map").set_uniform(value), f"Set {map}")
@@ -217,7 +238,7 @@ def set_uniform(obj: Any, map: str, value: float) -> None:
 def set_curvature_target(obj: Any, u: float | None = None, v: float | None = None) -> None:
     """Sets the target curvature along u and/or v (1/mm) of the newest curvature constraint (the
     slider panel's edit). One undo step; a running session takes it at once."""
-    _sculpt(obj)
+    obj = _sculpt(obj, solids=True)
     curv = [c for c in obj.Proxy.live.snapshot().constraints if c["kind"] == "curvature"]
     if not curv:
         raise ValueError("obj: has no curvature constraint to set")
@@ -244,7 +265,7 @@ def paint(obj: Any, map: str, path: Sequence[Sequence[float]], radius: float = 0
     """An airbrush stroke on material map ``map`` along ``path`` ((u, v) points in map coordinates,
     the unit square): dabs half a radius apart move the map toward ``factor`` times its mean at the
     stroke's start. One undo step ("Paint <map>"); the GUI's airbrush records its strokes so."""
-    _sculpt(obj)
+    obj = _sculpt(obj, solids=True)
     sculpt_state.map_property(map)
     points = np.asarray(path, dtype=float)
     if points.ndim != 2 or points.shape[1] != 2 or len(points) == 0:
@@ -297,7 +318,7 @@ def run(obj: Any, seconds: float, device: CursorSource | None = None, tool: str 
     1 held = grab); without a device the surface just evolves. The tool (None keeps the current
     one) releases at the end; the result is written back to the object as one undo transaction.
     """
-    _sculpt(obj)
+    obj = _sculpt(obj, solids=True)
     seconds = _finite(seconds, "seconds", nonnegative=True)
     dt = _finite(dt, "dt", positive=True)
     if device is not None and not hasattr(device, "sample"):
@@ -339,7 +360,7 @@ def add_constraint(obj: Any, kind: str, uv: tuple[float, float] | None = None,
     (``curvature=(ku, kv)``); each defaults to the current value. ``stiffness=`` overrides the
     default penalty stiffness. One undo transaction; returns the constraint id.
     """
-    _sculpt(obj)
+    obj = _sculpt(obj, solids=True)
     if kind not in core.CONSTRAINTS:
         raise ValueError(f"kind: unknown constraint {kind!r} (one of {', '.join(core.CONSTRAINTS)})")
     if (uv is None) == (near is None):
@@ -372,7 +393,7 @@ def add_constraint(obj: Any, kind: str, uv: tuple[float, float] | None = None,
 
 def remove_constraint(obj: Any, cid: int) -> None:
     """Removes constraint ``cid`` (one undo transaction)."""
-    _sculpt(obj)
+    obj = _sculpt(obj, solids=True)
     obj.Proxy.live.edit(lambda s: s.remove_constraint(cid), "Remove constraint")
 
 

@@ -188,6 +188,8 @@ class LiveSurface:
         finally:
             self.writing = False
         self._shadow_stale = True
+        if geometry:
+            notify_dependents(obj)
 
     def show_poles(self, poles: np.ndarray, base: sculpt_state.SculptState) -> None:
         """Redraws the Shape from intermediate poles on the knots and weights of ``base`` (a GUI
@@ -251,3 +253,12 @@ class LiveSurface:
 
 def _maps(surface: core.DynamicSurface) -> dict[str, np.ndarray]:
     return {name: np.array(getattr(surface, name + "_map").values) for name in core.MAPS}
+
+
+def notify_dependents(obj: Any) -> None:
+    """Objects built from this sculpt (a SculptedSolid: their proxy has ``sculpt_changed``) rebuild
+    now, in the caller's transaction, so one undo step restores both."""
+    for parent in obj.InList:
+        hook = getattr(getattr(parent, "Proxy", None), "sculpt_changed", None)
+        if hook is not None:
+            hook(parent)

@@ -97,6 +97,21 @@ def _refine(bs: Any, controls: tuple[int, int], degree: tuple[int, int]) -> None
                 bs.insertVKnot(mid, 1, 0.0)
 
 
+def _insert_knots(bs: Any, extra: tuple[Any, Any]) -> None:
+    """Exact refinement in place: one more knot at each of ``extra`` = (u values, v values) inside
+    the domain that is not (within a millionth of a span) a knot already."""
+    for direction, values in enumerate(extra):
+        for x in sorted(float(x) for x in values):
+            knots = np.asarray(bs.getUKnots() if direction == 0 else bs.getVKnots())
+            close = 1e-6 * float(np.min(np.diff(knots)))
+            if not knots[0] + close < x < knots[-1] - close or np.min(np.abs(knots - x)) <= close:
+                continue
+            if direction == 0:
+                bs.insertUKnot(x, 1, 0.0)
+            else:
+                bs.insertVKnot(x, 1, 0.0)
+
+
 def _to_core(bs: Any) -> core.BSplineSurface:
     nu, nv = bs.NbUPoles, bs.NbVPoles
     poles = np.array([[tuple(p) for p in row] for row in bs.getPoles()], dtype=float).reshape(nu, nv, 3)
@@ -156,8 +171,9 @@ def _fit(geom: Any, controls: tuple[int, int], degree: tuple[int, int]) -> core.
 
 
 def source_surface(source: Any, controls: tuple[int, int], degree: tuple[int, int],
-                   size: tuple[float, float], doc: Any = None) -> SourceSurface:
-    """The core surface for ``source`` (None: a flat ``size`` patch) at the requested resolution."""
+                   size: tuple[float, float], doc: Any = None, extra_knots: tuple[Any, Any] = ((), ())) -> SourceSurface:
+    """The core surface for ``source`` (None: a flat ``size`` patch) at the requested resolution;
+    ``extra_knots`` (u values, v values) refine an exactly converted source further where asked."""
     if source is None:
         return SourceSurface(core.BSplineSurface.plane(controls, degree, size), "plane", 0.0,
                              f"plane {size[0]:g} x {size[1]:g}")
@@ -165,6 +181,7 @@ def source_surface(source: Any, controls: tuple[int, int], degree: tuple[int, in
     bs = _exact_bspline(geom)
     if bs is not None and max(bs.UDegree, bs.VDegree) <= core.MAX_DEGREE:
         _refine(bs, controls, degree)
+        _insert_knots(bs, extra_knots)
         if max(bs.UDegree, bs.VDegree) <= core.MAX_DEGREE:
             surface = _to_core(bs)
             _, _, pts = _check_points(surface)

@@ -1,0 +1,246 @@
+"""A face of a solid seen from its own parameter space, so it can be sculpted in place: its edges
+as curves in (u, v), the poles that hold them (G0: the surface stays on the edge; G1: its tangent
+planes along it too), the sculpted surface bounded by the face's own wires (outer wire and holes,
+mapped through (u, v): the mass points move, the parameterisation does not), and the solid sewn
+back around it, with a report of how well each seam holds.
+
+All of it works on the face's exact B-spline form (``Face.toNurbs``), whose parameter space is the
+one the sculpt surface is made in (see :mod:`source_surface`), so a trim curve in (u, v) is valid on
+the sculpted surface as it is.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+#: Points per edge where the held poles are found (every basis function that is not zero at one
+#: of them is held), and where the seams are measured (the issue's 100 per seam).
+HOLD_SAMPLES = 400
+SEAM_SAMPLES = 100
+SIDES = ("u0", "u1", "v0", "v1")
+#: How an edge may be held: not at all, in place (G0), in place with its tangent planes (G1).
+KINDS = ("free", "G0", "G1")
+
+
+@dataclass(frozen=True)
+class FaceEdge:
+    """One edge of a face, as the face sees it."""
+
+    name: str                    #: the solid's name for it ("Edge3")
+    side: str | None             #: "u0", "u1", "v0" or "v1" when it lies on that side of the
+    #:                              face's parameter rectangle; None for a trim inside it
+    uv: np.ndarray               #: (n, 2) points of its curve(s) in the face's (u, v) (a seam: both)
+    neighbours: tuple[str, ...]  #: the other faces of the solid on it; the face itself for a seam
+
+
+def nurbs_face(face: Any) -> Any:
+    """The face in its exact B-spline form, with its pcurves (the parameter space sculpted in)."""
+    return face.toNurbs().Faces[0]
+
+
+def edge_name(shape: Any, edge: Any) -> str:
+    """The solid's name of one of its edges."""
+    for k, e in enumerate(shape.Edges):
+        if e.isSame(edge):
+            return f"Edge{k + 1}"
+    raise ValueError("the edge is not part of the shape")
+
+
+def _matching_edge(edges: list[Any], converted: Any) -> Any:
+    """The original edge the B-spline conversion made ``converted`` from (same points)."""
+    a, b = converted.ParameterRange
+    probe = [converted.valueAt(a + (b - a) * t) for t in (0.0, 0.37, 1.0)]
+    best, err = None, np.inf
+    for e in edges:
+        d = max(e.distToShape(_vertex(p))[0] for p in probe)
+        if d < err:
+            best, err = e, d
+    return best
+
+
+def _vertex(p: Any) -> Any:
+    import Part
+    return Part.Vertex(p)
+
+
+def named_occurrences(shape: Any, face_name: str, nface: Any) -> list[tuple[str, Any]]:
+    """Every edge occurrence of the converted face's wires, oriented as in the face (a seam
+    appears twice), with the solid's name of the edge it was converted from."""
+    originals = list(shape.getElement(face_name).Edges)
+    return [(edge_name(shape, _matching_edge(originals, occ)), occ) for w in nface.Wires for occ in w.OrderedEdges]
+
+
+def _pcurve_points(nface: Any, edge: Any, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(n, 2) points of the edge's curve in the face's (u, v), and the curve parameters they are at."""
+    c2d, a, b = nface.curveOnSurface(edge)
+    ts = np.linspace(a, b, n)
+    points = [c2d.value(t) for t in ts]
+    return np.array([(p.x, p.y) for p in points], float), ts
+
+
+def face_edges(shape: Any, face_name: str) -> list[FaceEdge]:
+    """The edges of ``shape``'s face ``face_name``, in (u, v), with the faces on their other side."""
+    nface = nurbs_face(shape.getElement(face_name))
+    u0, u1, v0, v1 = nface.ParameterRange
+    tol_u, tol_v = 1e-9 * max(1.0, u1 - u0), 1e-9 * max(1.0, v1 - v0)
+    found: dict[str, list[np.ndarray]] = {}
+    for name, occ in named_occurrences(shape, face_name, nface):
+        found.setdefault(name, []).append(_pcurve_points(nface, occ, HOLD_SAMPLES)[0])
+    edges = []
+    faces = [(f"Face{k + 1}", f) for k, f in enumerate(shape.Faces)]
+    for name, parts in found.items():
+        uv = np.concatenate(parts)
+        side = None
+        if len(parts) == 1:
+            for s, col, at, tol in (("u0", 0, u0, tol_u), ("u1", 0, u1, tol_u), ("v0", 1, v0, tol_v), ("v1", 1, v1, tol_v)):
+                if np.all(np.abs(uv[:, col] - at) <= tol):
+                    side = s
+        edge = shape.getElement(name)
+        others = tuple(n for n, f in faces if n != face_name and any(e.isSame(edge) for e in f.Edges))
+        edges.append(FaceEdge(name, side, uv, others if others else (face_name,)))
+    return sorted(edges, key=lambda e: int(e.name[4:]))
+
+
+# --- the poles that hold an edge -------------------------------------------------------------------
+def _basis(knots: np.ndarray, p: int, x: float, k: int | None = None) -> tuple[int, np.ndarray, np.ndarray]:
+    """The span index k (knots[k] <= x < knots[k + 1], the last span closed; or the given one, whose
+    polynomials are then evaluated at x) and the values and first derivatives of the p + 1 basis
+    functions N_{k-p..k} at x (Cox-de Boor)."""
+    n = len(knots) - p - 1
+    if k is None:
+        k = int(np.searchsorted(knots, x, side="right") - 1)
+        k = min(max(k, p), n - 1)
+    left, right = np.zeros(p + 1), np.zeros(p + 1)
+    table = np.zeros((p + 1, p + 1))  # table[j][r]: degree-j values; table[r][j] (r > j): knot differences
+    table[0, 0] = 1.0
+    for j in range(1, p + 1):
+        left[j] = x - knots[k + 1 - j]
+        right[j] = knots[k + j] - x
+        saved = 0.0
+        for r in range(j):
+            table[j, r] = right[r + 1] + left[j - r]
+            temp = table[r, j - 1] / table[j, r] if table[j, r] != 0 else 0.0
+            table[r, j] = saved + right[r + 1] * temp
+            saved = left[j - r] * temp
+        table[j, j] = saved
+    values = table[:, p].copy()
+    deriv = np.zeros(p + 1)
+    if p > 0:  # N'_{i,p} = p (N_{i,p-1} / (t_{i+p} - t_i) - N_{i+1,p-1} / (t_{i+p+1} - t_{i+1}))
+        lower = np.concatenate([[0.0], table[:p, p - 1], [0.0]])
+        for r in range(p + 1):
+            i = k - p + r
+            a = knots[i + p] - knots[i]
+            b = knots[i + p + 1] - knots[i + 1]
+            deriv[r] = p * ((lower[r] / a if a else 0.0) - (lower[r + 1] / b if b else 0.0))
+    return k, values, deriv
+
+
+def _active(knots: np.ndarray, p: int, x: float, with_derivative: bool) -> set[int]:
+    """Basis functions not zero at x (and, with_derivative, those whose derivative is not zero);
+    at an interior knot from both sides (a derivative may jump there)."""
+    n = len(knots) - p - 1
+    right = min(max(int(np.searchsorted(knots, x, side="right") - 1), p), n - 1)
+    spans = {right}
+    left = int(np.searchsorted(knots, x, side="left") - 1)
+    if p <= left < right:
+        spans.add(left)
+    out: set[int] = set()
+    for k in spans:
+        _, values, deriv = _basis(knots, p, x, k)
+        scale = max(1.0, float(np.max(np.abs(deriv))))
+        out.update(k - p + r for r in range(p + 1)
+                   if abs(values[r]) > 1e-12 or (with_derivative and abs(deriv[r]) > 1e-12 * scale))
+    return out
+
+
+def held_poles(knots_u: np.ndarray, knots_v: np.ndarray, degree: tuple[int, int], controls: tuple[int, int],
+               edges: list[FaceEdge], kinds: dict[str, str]) -> list[int]:
+    """The pole indices (i * nv + j) to hold so that each edge keeps its kind exactly: G0 holds every
+    pole whose basis function is not zero somewhere on the edge (the surface there depends on those
+    alone), G1 also those whose derivative is not zero there (the tangent plane along it)."""
+    nv = controls[1]
+    p, q = degree
+    held: set[int] = set()
+    for e in edges:
+        kind = kinds[e.name]
+        if kind == "free":
+            continue
+        g1 = kind == "G1"
+        for u, v in e.uv:
+            iu = _active(knots_u, p, float(u), g1)
+            jv = _active(knots_v, q, float(v), g1)
+            held.update(i * nv + j for i in iu for j in jv)
+    return sorted(held)
+
+
+# --- the sculpted face and the solid around it --------------------------------------------------
+def trimmed_face(surface: Any, nface: Any) -> Any:
+    """A face on ``surface`` (a Part.BSplineSurface in ``nface``'s parameter space) bounded by
+    ``nface``'s wires: each edge rebuilt from its curve in (u, v), holes kept, orientation kept."""
+    import Part
+    wires = []
+    for w in nface.Wires:
+        edges = []
+        for occ in w.OrderedEdges:
+            c2d, a, b = nface.curveOnSurface(occ)
+            edge = c2d.toShape(surface, a, b)
+            if occ.Orientation == "Reversed":
+                edge.reverse()
+            edges.append(edge)
+        wires.append(Part.Wire(edges))
+    outer = nface.OuterWire
+    order = sorted(range(len(wires)), key=lambda k: not nface.Wires[k].isSame(outer))
+    face = Part.Face(surface, wires[order[0]])
+    if len(order) > 1:
+        face.cutHoles([wires[k] for k in order[1:]])
+    face.fix(1e-7, 1e-7, 1e-4)
+    if nface.Orientation == "Reversed":
+        face.reverse()
+    if not face.isValid():
+        raise RuntimeError("the sculpted face bounded by the original wires is not a valid face")
+    return face
+
+
+def solid_with(shape: Any, replaced: dict[str, Any], tolerance: float = 1e-6) -> Any:
+    """``shape`` (a solid) with faces ``replaced`` ({"FaceN": new face}), sewn into one closed
+    shell and made a valid solid again; raises RuntimeError saying what did not close."""
+    import Part
+    kept = [f for k, f in enumerate(shape.Faces) if f"Face{k + 1}" not in replaced]
+    sewn = Part.Compound(kept + list(replaced.values()))
+    sewn.sewShape(tolerance)
+    shells = sewn.Shells
+    if len(shells) != 1 or not shells[0].isClosed():
+        free = [] if not shells else [e for e in shells[0].Edges if len(shells[0].ancestorsOfType(e, Part.Face)) < 2]
+        raise RuntimeError(f"the sculpted faces do not close the solid: {len(shells)} shell(s), "
+                           f"{len(free)} free edge(s) after sewing at {tolerance:g} mm")
+    solid = Part.Solid(shells[0])
+    if solid.Volume < 0:
+        solid.reverse()
+    if not solid.isValid():
+        raise RuntimeError("the rebuilt solid is not valid")
+    if len(solid.Faces) != len(shape.Faces):
+        raise RuntimeError(f"the rebuilt solid has {len(solid.Faces)} faces, the base {len(shape.Faces)}")
+    return solid
+
+
+def seam_report(surface: Any, shape: Any, face_name: str, kinds: dict[str, str]) -> list[dict[str, Any]]:
+    """For each edge of ``shape``'s face ``face_name`` sculpted to ``surface``: the largest distance
+    (mm) between the sculpted surface along the edge's (u, v) curve and the edge itself (``g0_mm``:
+    the neighbours still meet the edge), and for G1 edges the largest angle (degrees) between the
+    sculpted and the original normal there (``g1_deg``; None for the others), at SEAM_SAMPLES
+    points per edge (per side of a seam)."""
+    nface = nurbs_face(shape.getElement(face_name))
+    original = nface.Surface
+    report: dict[str, dict[str, Any]] = {}
+    for name, occ in named_occurrences(shape, face_name, nface):
+        uv, ts = _pcurve_points(nface, occ, SEAM_SAMPLES)
+        gap = max((surface.value(u, v) - occ.valueAt(t)).Length for (u, v), t in zip(uv, ts))
+        entry = report.setdefault(name, {"edge": name, "g0_mm": 0.0, "g1_deg": None})
+        entry["g0_mm"] = max(entry["g0_mm"], float(gap))
+        if kinds.get(name) == "G1":
+            cosines = [surface.normal(u, v).dot(original.normal(u, v)) for u, v in uv]
+            angle = float(np.degrees(np.arccos(max(-1.0, min(1.0, min(cosines))))))
+            entry["g1_deg"] = max(entry["g1_deg"] or 0.0, angle)
+    return sorted(report.values(), key=lambda r: int(r["edge"][4:]))

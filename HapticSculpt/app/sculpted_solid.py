@@ -1,0 +1,163 @@
+"""The SculptedSolid document object: a ``Part::FeaturePython`` whose Shape is a solid (its Base)
+with some of its faces replaced by their sculpted surfaces, bounded by the faces' own wires and
+sewn back into one closed solid.
+
+The sculpting itself is a Sculpt object (see :mod:`sculpt_feature`), hidden, made from the face
+in its exact B-spline form with the poles that hold its edges fixed (see :mod:`face_in_solid`);
+everything that works on a Sculpt (sessions, strokes, constraints, Undo) works on it. Each time
+the sculpt's geometry is written, the solid rebuilds in the same transaction, so one Undo restores
+both; a recompute (the Base changed, a file was opened) rebuilds it too. All state is in the
+properties: the base link, the face names, the boundary per edge (JSON), the seam report (JSON).
+"""
+from __future__ import annotations
+
+import json
+from typing import Any, Callable
+
+from . import face_in_solid
+from .part_surface import part_bspline
+from .sculpt_properties import read_state
+
+TYPE = "HapticSculpt::SculptedSolid"
+GROUP = "SculptedSolid"
+_view_providers: list[Callable[[Any], Any]] = []
+
+
+def set_view_provider(factory: Callable[[Any], Any]) -> None:
+    """Installs ``factory(view_object)``, called for each new SculptedSolid while the GUI is up."""
+    _view_providers[:] = [factory]
+
+
+def attach_view_provider(obj: Any) -> None:
+    """Gives ``obj`` its view provider if FreeCAD's GUI runs (a no-op in console mode)."""
+    import FreeCAD
+    if FreeCAD.GuiUp and _view_providers:
+        _view_providers[0](obj.ViewObject)
+
+
+def ensure_properties(obj: Any) -> None:
+    """The properties of a SculptedSolid (older files gain the ones they lack)."""
+    for kind, name, doc, mode in (
+            ("App::PropertyLink", "Base", "The solid whose faces are sculpted", 0),
+            ("App::PropertyStringList", "SculptFaces", "The faces of the base that are sculpted (FaceN)", 1),
+            ("App::PropertyString", "Boundary", "How each edge of those faces is held: free, G0 or G1 (JSON)", 1),
+            ("App::PropertyLinkList", "Sculpts", "The sculpts of those faces (hidden)", 1),
+            ("App::PropertyString", "SeamReport", "Per edge: the largest gap (mm) and, for G1 edges, the largest "
+                                                  "normal angle (degrees) between the sculpted face and the seam (JSON)", 1),
+            ("App::PropertyString", "RebuildError", "Why the solid could not be rebuilt (empty when it could)", 1)):
+        if name not in obj.PropertiesList:
+            obj.addProperty(kind, name, GROUP, doc)
+        obj.setEditorMode(name, mode)
+
+
+class SculptedSolidFeature:
+    """Proxy of a SculptedSolid object; no state of its own (see the module docstring)."""
+
+    def __init__(self, obj: Any) -> None:
+        self.Type = TYPE
+        ensure_properties(obj)
+        obj.Proxy = self
+
+    def execute(self, obj: Any) -> None:
+        """Recompute: the solid from the base and the sculpts (raises, marking the object, if it
+        cannot be rebuilt)."""
+        rebuild(obj)
+
+    def sculpt_changed(self, obj: Any) -> None:
+        """A sculpt's geometry was written (a stroke, Undo's counterpart, an edit): rebuild now, in
+        the same transaction. A solid that cannot be rebuilt keeps its last shape and says why in
+        ``RebuildError`` (the stroke itself is kept)."""
+        try:
+            rebuild(obj)
+        except (RuntimeError, ValueError) as exc:
+            import FreeCAD
+            FreeCAD.Console.PrintError(f"HapticSculpt: {obj.Label}: {exc}\n")
+
+    def onDocumentRestored(self, obj: Any) -> None:
+        ensure_properties(obj)
+
+    def dumps(self) -> dict[str, Any]:
+        """Proxy state for the file: only the type tag (everything else is in the properties)."""
+        return {"Type": TYPE}
+
+    def loads(self, state: Any) -> None:
+        self.Type = TYPE
+
+    def __getstate__(self) -> dict[str, Any]:
+        return self.dumps()
+
+    def __setstate__(self, state: Any) -> None:
+        self.loads(state)
+
+
+def is_sculpted_solid(obj: Any) -> bool:
+    """True for a SculptedSolid document object."""
+    return getattr(getattr(obj, "Proxy", None), "Type", None) == TYPE
+
+
+def sculpt_of(obj: Any) -> Any:
+    """The Sculpt a SculptedSolid sculpts its faces with."""
+    if not obj.Sculpts:
+        raise ValueError(f"{obj.Label} has no sculpt")
+    return obj.Sculpts[0]
+
+
+def boundary_of(obj: Any) -> dict[str, str]:
+    """How each edge of the sculpted faces is held ({"EdgeN": "free" | "G0" | "G1"})."""
+    return json.loads(obj.Boundary) if obj.Boundary else {}
+
+
+def seam_report_of(obj: Any) -> list[dict[str, Any]]:
+    """The parsed ``SeamReport``."""
+    return json.loads(obj.SeamReport) if obj.SeamReport else []
+
+
+def base_solid(base: Any) -> Any:
+    """The one valid closed solid of ``base``'s Shape (ValueError saying what it is instead)."""
+    shape = getattr(base, "Shape", None)
+    if shape is None or shape.isNull():
+        raise ValueError(f"{getattr(base, 'Label', base)} has no shape")
+    if len(shape.Solids) != 1:
+        raise ValueError(f"{base.Label} has {len(shape.Solids)} solids, not one")
+    if not shape.isValid() or not all(s.isClosed() for s in shape.Solids[0].Shells):
+        raise ValueError(f"{base.Label} is not a valid closed solid")
+    return shape
+
+
+def sculpted_surface(sculpt: Any) -> Any:
+    """The Part.BSplineSurface of a Sculpt's stored state."""
+    state = read_state(sculpt)
+    s, a = state.settings, state.arrays
+    nu, nv = s["controls"]
+    weights = a["Weights"].reshape(nu, nv) if a["Weights"].size else None
+    return part_bspline(a["Poles"].reshape(nu, nv, 3), a["KnotsU"], a["KnotsV"], tuple(s["degree"]), weights)
+
+
+def rebuild(obj: Any) -> None:
+    """Sets the Shape (the base with the sculpted faces in) and the SeamReport; RuntimeError or
+    ValueError (recorded in ``RebuildError``) when the solid cannot be made."""
+    try:
+        if obj.Base is None:
+            raise ValueError("no base solid")
+        shape = base_solid(obj.Base)
+        kinds = boundary_of(obj)
+        replaced, report = {}, []
+        for face_name, sculpt in zip(obj.SculptFaces, obj.Sculpts):
+            try:
+                face = shape.getElement(face_name)
+            except Exception as exc:  # noqa: BLE001 - FreeCAD raises several types for a missing element
+                raise ValueError(f"{obj.Base.Label} has no {face_name} any more") from exc
+            surface = sculpted_surface(sculpt)
+            replaced[face_name] = face_in_solid.trimmed_face(surface, face_in_solid.nurbs_face(face))
+            report += face_in_solid.seam_report(surface, shape, face_name, kinds)
+        solid = face_in_solid.solid_with(shape, replaced)
+    except (RuntimeError, ValueError) as exc:
+        if obj.RebuildError != str(exc):
+            obj.RebuildError = str(exc)
+        raise
+    obj.Shape = solid
+    text = json.dumps(report)
+    if obj.SeamReport != text:
+        obj.SeamReport = text
+    if obj.RebuildError:
+        obj.RebuildError = ""

@@ -1,0 +1,132 @@
+"""The scripting API for sculpting faces of a solid in place (part of the contract in :mod:`api`):
+:func:`sculpt_solid` makes a SculptedSolid; :func:`HapticSculpt.run`, ``add_constraint`` and the
+other sculpt functions accept it as they accept a Sculpt, and ``export_step`` writes its solid."""
+from __future__ import annotations
+
+import json
+from typing import Any, Sequence
+
+import numpy as np
+
+from . import face_in_solid
+from .api import _add_sculpt, _checked_resolution, _document, _material, _sculpt_state
+from .sculpted_solid import SculptedSolidFeature, attach_view_provider, base_solid, rebuild
+from .source_surface import source_surface
+from .undo import transaction
+
+#: Extra knots around a trim inside the face (a hole, an edge cut by a fillet), per direction, over
+#: the trim's extent: poles whose support crosses the trim are held for G0, so on the coarse net
+#: a hole freezes most of a face (54 % of a 40 x 30 plate's area with a 10 mm hole on 8 x 8 poles);
+#: two more spans across the trim and two on each side bring that to 1 %.
+TRIM_SPANS = 2
+
+
+def _boundary_kinds(boundary: Any, edges: list[face_in_solid.FaceEdge], faces: Sequence[str]) -> dict[str, str]:
+    """Every edge of the faces to "free", "G0" or "G1" (G0 where ``boundary`` does not say)."""
+    names = [e.name for e in edges]
+    if isinstance(boundary, str):
+        if boundary not in face_in_solid.KINDS:
+            raise ValueError(f"boundary: one of {', '.join(face_in_solid.KINDS)}, not {boundary!r}")
+        kinds = {n: boundary for n in names}
+    elif isinstance(boundary, dict):
+        kinds = {n: "G0" for n in names}
+        for edge, kind in boundary.items():
+            if edge not in names:
+                raise ValueError(f"boundary: {edge!r} is not an edge of {', '.join(faces)} "
+                                 f"(their edges: {', '.join(names)})")
+            if kind not in face_in_solid.KINDS:
+                raise ValueError(f"boundary: {edge} must be one of {', '.join(face_in_solid.KINDS)}, not {kind!r}")
+            kinds[edge] = kind
+    else:
+        raise TypeError(f"boundary: one of {', '.join(face_in_solid.KINDS)} or a dict from edge name to one "
+                        f"of them, not {boundary!r}")
+    for e in edges:
+        if kinds[e.name] == "free" and not set(e.neighbours) <= set(faces):
+            what = "the seam of " + e.neighbours[0] if e.neighbours == (faces[0],) else \
+                "shared with " + ", ".join(n for n in e.neighbours if n not in faces)
+            raise ValueError(f"boundary: {e.name} is {what}, which is not sculpted with it: a free edge would "
+                             f"open the solid there (hold it G0 or G1)")
+    return kinds
+
+
+def _trim_knots(edges: list[face_in_solid.FaceEdge]) -> tuple[list[float], list[float]]:
+    """Knots that refine the net around each trim inside the face (see TRIM_SPANS)."""
+    extra: tuple[list[float], list[float]] = ([], [])
+    for e in edges:
+        if e.side is not None:
+            continue
+        for d in (0, 1):
+            lo, hi = float(e.uv[:, d].min()), float(e.uv[:, d].max())
+            if hi - lo <= 0:
+                continue
+            h = (hi - lo) / TRIM_SPANS
+            extra[d].extend(lo + h * k for k in range(-2, TRIM_SPANS + 3))
+    return extra
+
+
+def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0", symmetry: Any = None,
+                 controls: tuple[int, int] = (8, 8), degree: tuple[int, int] = (3, 3),
+                 mesh: tuple[int, int] = (40, 40), name: str = "SculptedSolid", material: str = "clay") -> Any:
+    """A new SculptedSolid in ``doc``: ``base``'s solid with ``faces`` (names like ``["Face6"]``)
+    sculptable in place, their trims kept.
+
+    ``boundary``: how the faces' edges are held while sculpting, "G0" (they stay where they are, so
+    the neighbour faces still meet them: the poles that shape the surface along them do not move),
+    "G1" (their tangent planes too) or "free", for all edges or as a dict from edge name ("Edge3")
+    to one of them, G0 for the others. A free edge must not border a face that is not sculpted (it
+    would open the solid). ``controls``/``degree`` are the least net (the face is converted
+    exactly, then refined; trims inside the face get extra knots around them), ``mesh`` the mass
+    points, ``material`` "clay" (strokes stay) or "elastic". One undo step; the base is hidden in
+    the GUI. ``symmetry`` and more than one face are not supported yet (ValueError).
+    """
+    doc = _document(doc)
+    if not hasattr(base, "Shape") or getattr(base, "Document", None) is not doc:
+        raise TypeError(f"base: expected a document object of {doc.Name} with a solid Shape, got {base!r}")
+    try:
+        shape = base_solid(base)
+    except ValueError as exc:
+        raise ValueError(f"base: {exc}") from None
+    if isinstance(faces, str) or not isinstance(faces, Sequence) or not faces:
+        raise TypeError(f"faces: expected a non-empty list of face names like ['Face6'], got {faces!r}")
+    faces = list(faces)
+    for f in faces:
+        if not isinstance(f, str) or not f.startswith("Face") or not f[4:].isdigit() or not 1 <= int(f[4:]) <= len(shape.Faces):
+            raise ValueError(f"faces: {f!r} is not a face of {base.Label} (Face1 .. Face{len(shape.Faces)})")
+    if len(set(faces)) != len(faces):
+        raise ValueError(f"faces: {faces} names a face twice")
+    if len(faces) > 1:
+        raise ValueError("faces: one face per SculptedSolid in this version (several faces sculpted as one "
+                         "system are not built yet)")
+    if symmetry is not None:
+        raise ValueError("symmetry: not built yet in this version (give None)")
+    controls, degree, mesh = _checked_resolution(controls, degree, mesh)
+    if not isinstance(name, str) or not name:
+        raise TypeError("name: expected a non-empty string")
+    _material(material)
+    face_name = faces[0]
+    edges = face_in_solid.face_edges(shape, face_name)
+    kinds = _boundary_kinds(boundary, edges, faces)
+    made = source_surface((base, face_name), controls, degree, (1.0, 1.0), doc, _trim_knots(edges))
+    if made.method != "exact":
+        raise ValueError(f"faces: {face_name} has no exact B-spline form (its trims could not be kept on a fitted "
+                         f"surface); sculpt it as a separate patch with make_sculpt")
+    s = made.surface
+    held = face_in_solid.held_poles(np.asarray(s.knots_u), np.asarray(s.knots_v), tuple(s.degree),
+                                    tuple(s.controls), edges, kinds)
+    if len(held) == s.controls[0] * s.controls[1]:
+        raise ValueError(f"boundary: holding the edges as asked holds every pole of {face_name}'s "
+                         f"{s.controls[0]} x {s.controls[1]} net (give more controls)")
+    state = _sculpt_state(made, mesh, material, held)
+    if doc.UndoMode == 0:
+        doc.UndoMode = 1
+    with transaction(doc, "Sculpt solid"):
+        sculpt = _add_sculpt(doc, name + "Face", made, state)
+        obj = doc.addObject("Part::FeaturePython", name)
+        SculptedSolidFeature(obj)
+        obj.Base = base
+        obj.SculptFaces = faces
+        obj.Boundary = json.dumps(kinds)
+        obj.Sculpts = [sculpt]
+        rebuild(obj)
+        attach_view_provider(obj)
+    return obj
