@@ -29,14 +29,14 @@ from .app.api import (
                       to_cadquery,
 )
 from .app.sculpted_solid import boundary_of, seam_report_of
-from .app.solid_api import sculpt_solid
+from .app.solid_api import sculpt_solid, set_boundary
 from .runtime.replay_device import CursorSample, ReplayDevice
 from .runtime.session import Session, stop_all
 from .version import __version__
 
 legacy_paths.install()
 
-__all__ = ["make_sculpt", "sculpt_solid", "boundary_of", "seam_report_of", "run", "add_constraint", "remove_constraint", "hold_boundary", "held_boundary",
+__all__ = ["make_sculpt", "sculpt_solid", "set_boundary", "boundary_of", "seam_report_of", "run", "add_constraint", "remove_constraint", "hold_boundary", "held_boundary",
            "set_material", "material_of", "keep_shape",
            "set_tool", "set_uniform", "set_curvature_target", "paint", "record_state",
            "export_step", "thicken",

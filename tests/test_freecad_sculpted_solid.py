@@ -267,6 +267,24 @@ class TestSculptedSolidDocument(SolidChecks):
         self.doc.undo()  # the SculptedSolid's creation
         self.assertEqual([o.Name for o in self.doc.Objects], ["Box"])
 
+    def test_set_boundary_is_one_undo_step(self):
+        box, obj = self.make()
+        edge = hs.seam_report_of(obj)[0]["edge"]
+        held = len(obj.Sculpts[0].Proxy.live.snapshot().held_poles)
+        kinds = hs.set_boundary(obj, {edge: "G1"})
+        self.assertEqual(kinds[edge], "G1")
+        self.assertEqual(hs.boundary_of(obj), kinds)
+        self.assertGreater(len(obj.Sculpts[0].Proxy.live.snapshot().held_poles), held)
+        self.assertIsNotNone(next(r for r in hs.seam_report_of(obj) if r["edge"] == edge)["g1_deg"])
+        self.assertEqual(self.doc.UndoNames[0], "Hold edges")
+        self.doc.undo()
+        self.assertEqual(hs.boundary_of(obj)[edge], "G0")
+        self.assertEqual(len(obj.Sculpts[0].Proxy.live.snapshot().held_poles), held)
+        with self.assertRaises(ValueError):
+            hs.set_boundary(obj, {edge: "free"})  # (it borders a face that is not sculpted)
+        with self.assertRaises(TypeError):
+            hs.set_boundary(box, "G1")
+
     def test_save_and_reopen(self):
         box, obj = self.make()
         pull(obj, (20, 15, 10), (0, 0, 6))

@@ -200,6 +200,7 @@ class LiveSurface:
             self._obj.Shape = face_of(frame)
         finally:
             self.writing = False
+        notify_dependents(self._obj, frame)
 
     def reset_shape(self) -> None:
         """Puts the Shape back to the stored state's face after a session's frames redrew it. Done
@@ -209,6 +210,7 @@ class LiveSurface:
             self._obj.Shape = face_of(read_state(self._obj))
         finally:
             self.writing = False
+        notify_dependents(self._obj)
 
     def revert_map(self, name: str) -> None:
         """Puts material map ``name`` back to its stored values, dropping a preview painted on the
@@ -255,10 +257,12 @@ def _maps(surface: core.DynamicSurface) -> dict[str, np.ndarray]:
     return {name: np.array(getattr(surface, name + "_map").values) for name in core.MAPS}
 
 
-def notify_dependents(obj: Any) -> None:
+def notify_dependents(obj: Any, frame: sculpt_state.SculptState | None = None) -> None:
     """Objects built from this sculpt (a SculptedSolid: their proxy has ``sculpt_changed``) rebuild
-    now, in the caller's transaction, so one undo step restores both."""
+    now, in the caller's transaction, so one undo step restores both; given a session's ``frame``
+    (not stored), they show a preview of it instead."""
     for parent in obj.InList:
-        hook = getattr(getattr(parent, "Proxy", None), "sculpt_changed", None)
+        proxy = getattr(parent, "Proxy", None)
+        hook = getattr(proxy, "sculpt_changed" if frame is None else "sculpt_frame", None)
         if hook is not None:
-            hook(parent)
+            hook(parent) if frame is None else hook(parent, frame)

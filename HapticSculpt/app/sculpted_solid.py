@@ -73,6 +73,14 @@ class SculptedSolidFeature:
             import FreeCAD
             FreeCAD.Console.PrintError(f"HapticSculpt: {obj.Label}: {exc}\n")
 
+    def sculpt_frame(self, obj: Any, frame: Any) -> None:
+        """A session's frame (GUI): show the solid's faces with the sculpted ones from the frame,
+        as a compound, not sewn and not stored (the commit at the stroke's end rebuilds the solid)."""
+        try:
+            obj.Shape = preview(obj, frame)
+        except (RuntimeError, ValueError):
+            pass  # (the last frame stays; the commit says what is wrong)
+
     def onDocumentRestored(self, obj: Any) -> None:
         ensure_properties(obj)
 
@@ -102,6 +110,33 @@ def sculpt_of(obj: Any) -> Any:
     return obj.Sculpts[0]
 
 
+def sculpt_for(obj: Any) -> Any:
+    """The Sculpt to sculpt when ``obj`` is picked: itself, a SculptedSolid's sculpt, or None."""
+    from .sculpt_feature import is_sculpt
+    if is_sculpt(obj):
+        return obj
+    if is_sculpted_solid(obj) and obj.Sculpts:
+        return obj.Sculpts[0]
+    return None
+
+
+def solid_of(sculpt: Any) -> Any:
+    """The SculptedSolid that sculpts its faces with ``sculpt``, or None."""
+    return next((o for o in getattr(sculpt, "InList", []) if is_sculpted_solid(o)), None)
+
+
+def trim_mask(sculpt: Any, us: Any, vs: Any) -> Any:
+    """Which points of the (us x vs) parameter grid lie on the face ``sculpt`` sculpts in its solid
+    (inside its outer wire, outside its holes): a (len(us), len(vs)) bool array; None for a sculpt
+    that is not part of a SculptedSolid (all of its domain is the face)."""
+    import numpy as np
+    solid = solid_of(sculpt)
+    if solid is None or solid.Base is None:
+        return None
+    nface = face_in_solid.nurbs_face(solid.Base.Shape.getElement(solid.SculptFaces[0]))
+    return np.array([[nface.isPartOfDomain(float(u), float(v)) for v in vs] for u in us], dtype=bool)
+
+
 def boundary_of(obj: Any) -> dict[str, str]:
     """How each edge of the sculpted faces is held ({"EdgeN": "free" | "G0" | "G1"})."""
     return json.loads(obj.Boundary) if obj.Boundary else {}
@@ -124,13 +159,24 @@ def base_solid(base: Any) -> Any:
     return shape
 
 
-def sculpted_surface(sculpt: Any) -> Any:
-    """The Part.BSplineSurface of a Sculpt's stored state."""
-    state = read_state(sculpt)
+def sculpted_surface(sculpt: Any, state: Any = None) -> Any:
+    """The Part.BSplineSurface of a Sculpt's stored state (or of ``state``, a SculptState)."""
+    state = read_state(sculpt) if state is None else state
     s, a = state.settings, state.arrays
     nu, nv = s["controls"]
     weights = a["Weights"].reshape(nu, nv) if a["Weights"].size else None
     return part_bspline(a["Poles"].reshape(nu, nv, 3), a["KnotsU"], a["KnotsV"], tuple(s["degree"]), weights)
+
+
+def preview(obj: Any, frame: Any) -> Any:
+    """The base's faces with the (one) sculpted face from ``frame`` (a SculptState), as a compound."""
+    import Part
+    shape = base_solid(obj.Base)
+    face_name = obj.SculptFaces[0]
+    face = shape.getElement(face_name)
+    kept = [f for f in shape.Faces if not f.isSame(face)]
+    new = face_in_solid.trimmed_face(sculpted_surface(obj.Sculpts[0], frame), face_in_solid.nurbs_face(face))
+    return Part.Compound(kept + [new])
 
 
 def rebuild(obj: Any) -> None:

@@ -8,9 +8,17 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from . import face_in_solid
+from . import face_in_solid, sculpt_state
 from .api import _add_sculpt, _checked_resolution, _document, _material, _sculpt_state
-from .sculpted_solid import SculptedSolidFeature, attach_view_provider, base_solid, rebuild
+from .sculpted_solid import (
+    SculptedSolidFeature,
+    attach_view_provider,
+    base_solid,
+    boundary_of,
+    is_sculpted_solid,
+    rebuild,
+    sculpt_of,
+)
 from .source_surface import source_surface
 from .undo import transaction
 
@@ -130,3 +138,35 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
         rebuild(obj)
         attach_view_provider(obj)
     return obj
+
+
+def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
+    """Changes how a SculptedSolid's edges are held (``boundary`` as in :func:`sculpt_solid`: one
+    kind for all, or a dict from edge name to kind, the others kept). One undo step (not during a
+    session: RuntimeError); returns the kind of every edge."""
+    if not is_sculpted_solid(obj):
+        raise TypeError(f"obj: expected a HapticSculpt SculptedSolid, got {getattr(obj, 'TypeId', type(obj).__name__)}")
+    shape = base_solid(obj.Base)
+    faces = list(obj.SculptFaces)
+    edges = face_in_solid.face_edges(shape, faces[0])
+    if isinstance(boundary, dict):
+        boundary = {**boundary_of(obj), **boundary}
+    kinds = _boundary_kinds(boundary, edges, faces)
+    sculpt = sculpt_of(obj)
+    s = sculpt.Proxy.live.snapshot().surface
+    held = face_in_solid.held_poles(np.asarray(s.knots_u), np.asarray(s.knots_v), tuple(s.degree),
+                                    tuple(s.controls), edges, kinds)
+    if len(held) == s.controls[0] * s.controls[1]:
+        raise ValueError(f"boundary: holding the edges as asked holds every pole of the {s.controls[0]} x "
+                         f"{s.controls[1]} net")
+
+    live = sculpt.Proxy.live
+    if live.session is not None:
+        raise RuntimeError(f"{obj.Label}: stop the sculpting session before changing how its edges are held")
+    surface = live.surface
+    with transaction(obj.Document, "Hold edges"):
+        surface.hold_poles(held)
+        live.write(sculpt_state.capture(surface))
+        obj.Boundary = json.dumps(kinds)
+        rebuild(obj)
+    return kinds

@@ -89,9 +89,9 @@ def frame(du: np.ndarray, dv: np.ndarray) -> np.ndarray:
     return np.column_stack([u, v, n])
 
 
-def coloured_mesh(mesh: np.ndarray, colours: np.ndarray) -> Any:
+def coloured_mesh(mesh: np.ndarray, colours: np.ndarray, quads: list[int] | None = None) -> Any:
     """The mesh as triangles with per-vertex colours, unlit, pulled a hair toward the viewer so it
-    covers the shaded face."""
+    covers the shaded face (``quads``: the grid's cells to draw, all when None)."""
     from pivy import coin
     g, h = mesh.shape[:2]
     sep = coin.SoSeparator()
@@ -111,11 +111,19 @@ def coloured_mesh(mesh: np.ndarray, colours: np.ndarray) -> Any:
     coords = coin.SoCoordinate3()
     coords.point.setValues(0, g * h, mesh.reshape(-1, 3).tolist())
     sep.addChild(coords)
-    quads = quad_indices(g, h)
+    quads = quad_indices(g, h) if quads is None else quads
     faces = coin.SoIndexedFaceSet()
     faces.coordIndex.setValues(0, len(quads), quads)  # (materialIndex empty: colours follow coordIndex)
     sep.addChild(faces)
     return sep
+
+
+def masked_quad_indices(inside: np.ndarray) -> list[int]:
+    """Face indices (as :func:`quad_indices`) of the cells of a grid whose four corners are all
+    ``inside`` (a g x h bool array: the points on a trimmed face)."""
+    g, h = inside.shape
+    keep = (inside[:-1, :-1] & inside[1:, :-1] & inside[1:, 1:] & inside[:-1, 1:]).ravel()
+    return np.asarray(quad_indices(g, h)).reshape(-1, 5)[keep].ravel().tolist()
 
 
 @functools.lru_cache(maxsize=8)

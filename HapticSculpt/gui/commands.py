@@ -46,11 +46,13 @@ class NewPatch:
 
 
 class SculptFace:
-    """Turn the selected face (of any solid) into a sculpt surface."""
+    """Sculpt the selected face in place: a face of a solid becomes a SculptedSolid (its edges held
+    G0, its trims kept, the solid rebuilt around it); a face of anything else a separate patch."""
 
     def GetResources(self) -> dict[str, str]:
         return {"Pixmap": icon("HapticSculpt"), "MenuText": "Sculpt selected face",
-                "ToolTip": "Convert the selected face to a sculptable B-spline surface (exact where possible)"}
+                "ToolTip": "Sculpt the selected face: in place in its solid (edges held G0, holes kept; "
+                           "Hold edges switches G0/G1), or as a separate B-spline patch"}
 
     def IsActive(self) -> bool:
         sel = Gui.Selection.getSelectionEx()
@@ -59,9 +61,17 @@ class SculptFace:
     def Activated(self) -> None:
         from .echo import ref, run_echoed
         sel = Gui.Selection.getSelectionEx()[0]
-        face = next(n for n in sel.SubElementNames if n.startswith("Face"))
+        faces = [n for n in sel.SubElementNames if n.startswith("Face")]
         doc = sel.Object.Document
-        run_echoed(f"HapticSculpt.make_sculpt(App.getDocument({doc.Name!r}), source=({ref(sel.Object)}, {face!r}), "
+        if len(sel.Object.Shape.Solids) == 1:
+            run_echoed(f"HapticSculpt.sculpt_solid(App.getDocument({doc.Name!r}), {ref(sel.Object)}, {faces!r})")
+            obj = doc.Objects[-1]
+            FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label}: {', '.join(faces)} of {sel.Object.Label} "
+                                         "sculpted in place, edges held G0\n")
+            Gui.Selection.clearSelection()
+            Gui.Selection.addSelection(obj)
+            return
+        run_echoed(f"HapticSculpt.make_sculpt(App.getDocument({doc.Name!r}), source=({ref(sel.Object)}, {faces[0]!r}), "
                    "material='clay')")
         obj = doc.Objects[-1]
         FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label} from {obj.SourceDescription}, "
@@ -93,14 +103,17 @@ class Thicken:
 
 
 class ExportStep:
-    """Export the selected sculpts with FreeCAD's own export dialog (it asks before overwriting)."""
+    """Export the selected sculpts and sculpted solids with FreeCAD's own export dialog (it asks
+    before overwriting)."""
 
     def GetResources(self) -> dict[str, str]:
         return {"Pixmap": icon("HapticSculpt"), "MenuText": "Export STEP",
-                "ToolTip": "Export the selected sculpt surfaces (FreeCAD's export dialog: choose STEP and a file name)"}
+                "ToolTip": "Export the selected sculpt surfaces and sculpted solids (FreeCAD's export dialog: "
+                           "choose STEP and a file name)"}
 
     def IsActive(self) -> bool:
-        return bool(_selected_sculpts())
+        from ..app.sculpted_solid import is_sculpted_solid
+        return bool(_selected_sculpts()) or any(is_sculpted_solid(o) for o in Gui.Selection.getSelection())
 
     def Activated(self) -> None:
         Gui.runCommand("Std_Export")
@@ -173,13 +186,19 @@ class KeepShape(_SculptCommand):
 
 class HoldEdges(_SculptCommand):
     icon_name, menu = "Session", "Hold edges: free / G0 / G1"
-    tip = ("Hold the sculpt's four edges exactly (hard constraints): G0 keeps them where they are, G1 their "
-           "tangent planes too; each press goes free, G0, G1, free")
+    tip = ("Hold the sculpt's edges exactly (hard constraints): G0 keeps them where they are, G1 their "
+           "tangent planes too; each press goes free, G0, G1, free (a face sculpted in its solid: G0, G1)")
 
     def Activated(self) -> None:
         from ..app.api import held_boundary
+        from ..app.sculpted_solid import boundary_of, solid_of
         from .echo import ref, run_echoed
         obj = _ctl().active_sculpt()
+        solid = solid_of(obj)
+        if solid is not None:
+            following = "G1" if set(boundary_of(solid).values()) == {"G0"} else "G0"
+            run_echoed(f"HapticSculpt.set_boundary({ref(solid)}, {following!r})")
+            return
         now = set(held_boundary(obj).values())
         following = "G0" if now == {"free"} else "G1" if now == {"G0"} else "free"
         run_echoed(f"HapticSculpt.hold_boundary({ref(obj)}, {following!r})")

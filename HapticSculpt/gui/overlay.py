@@ -51,6 +51,7 @@ class Overlay:
         self.stripe_angle = 0.0  # reflection: the light strips' angle from the view's up direction (degrees)
         self.per_pixel = True  # zebra per pixel where the driver runs GLSL (False: per mesh vertex)
         self._sampled: tuple[bytes, np.ndarray, tuple[bytes, bytes], int] | None = None  # poles, points, texture, size
+        self._trims: dict[tuple[int, int], list[int] | None] = {}  # grid size -> cells on the trimmed face
         self.hud: Hud | None = None  # the screen-space layer, made when the overlay first draws
         self._root = coin.SoSeparator()
         self._root.setName("HapticSculptOverlay")
@@ -145,7 +146,8 @@ class Overlay:
             legend = (self.display, (0.0, 1.0))
         elif self.display != "shading":
             colours, rng = self._colours(s, mesh)
-            scene.addChild(shapes.coloured_mesh(mesh, colours))
+            scene.addChild(shapes.coloured_mesh(mesh, colours, self._cells(mesh.shape[:2], s.mesh_parameters_u,
+                                                                           s.mesh_parameters_v)))
             legend = (self.display, rng)
         decor = coin.SoSeparator()
         decor.addChild(light)
@@ -180,8 +182,21 @@ class Overlay:
             self._sampled = (key, points, texture, size)
         _, points, texture, size = self._sampled
         g, h = points.shape[:2]
+        (u0, u1), (v0, v1) = s.surface.domain
+        cells = self._cells((g, h), np.linspace(u0, u1, g), np.linspace(v0, v1, h))
         return stripe_shading.stripe_mesh(points, texture, size, self.stripe_mode, self.stripes,
-                                          self.stripe_direction, shapes.quad_indices(g, h), self.stripe_angle)
+                                          self.stripe_direction, shapes.quad_indices(g, h) if cells is None else cells,
+                                          self.stripe_angle)
+
+    def _cells(self, shape: tuple[int, int], us: Any, vs: Any) -> list[int] | None:
+        """The cells of a grid over the domain that lie on the face when the sculpt is a face of a
+        solid with trims (a hole stays open in the displays); None: all (found once per grid size)."""
+        from ..app.sculpted_solid import trim_mask
+        key = (int(shape[0]), int(shape[1]))
+        if key not in self._trims:
+            inside = trim_mask(self.obj, us, vs)
+            self._trims[key] = None if inside is None or inside.all() else shapes.masked_quad_indices(inside)
+        return self._trims[key]
 
     def _status(self, s: core.DynamicSurface) -> str:
         """The tool, the material and what goes on, for the HUD's status line."""

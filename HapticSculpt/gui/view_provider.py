@@ -1,4 +1,4 @@
-"""View provider of Sculpt objects (imported only when FreeCAD.GuiUp)."""
+"""View providers of Sculpt and SculptedSolid objects (imported only when FreeCAD.GuiUp)."""
 from __future__ import annotations
 
 import os
@@ -23,6 +23,46 @@ class SculptViewProvider:
 
     def getIcon(self) -> str:
         return icon("HapticSculpt")
+
+    def dumps(self) -> None:
+        return None
+
+    def loads(self, state: Any) -> None:
+        return None
+
+    def __getstate__(self) -> None:
+        return None
+
+    def __setstate__(self, state: Any) -> None:
+        return None
+
+
+class SolidViewProvider:
+    """A SculptedSolid shows as Part shows a solid; its base and its sculpts are its children in the
+    tree, hidden, as FreeCAD's own features show theirs (shown again when it is deleted)."""
+
+    def __init__(self, vobj: Any) -> None:
+        vobj.Proxy = self
+        obj = vobj.Object
+        for child in [obj.Base, *obj.Sculpts]:
+            if child is not None and child.ViewObject is not None:
+                child.ViewObject.Visibility = False
+
+    def attach(self, vobj: Any) -> None:
+        self.Object = vobj.Object
+
+    def getIcon(self) -> str:
+        return icon("HapticSculpt")
+
+    def claimChildren(self) -> list[Any]:
+        obj = self.Object
+        return [o for o in [getattr(obj, "Base", None), *getattr(obj, "Sculpts", [])] if o is not None]
+
+    def onDelete(self, vobj: Any, subelements: Any) -> bool:
+        base = getattr(vobj.Object, "Base", None)
+        if base is not None and base.ViewObject is not None:
+            base.ViewObject.Visibility = True
+        return True
 
     def dumps(self) -> None:
         return None
