@@ -131,6 +131,7 @@ test-gui-repeat: build ocp-venv
 	  ctest --test-dir $(BUILD)/release --output-on-failure -R "HapticRuntime" | tail -1; \
 	  HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) -m pytest -q -p no:cacheprovider \
 	    tests/test_gui_real_input.py tests/test_gui_overlay.py tests/test_gui_workbench.py tests/test_gui_undo.py \
+	    tests/test_gui_sculpted_solid.py \
 	    tests/test_freecad_session.py -rfE | tail -n 15; \
 	done
 

@@ -134,16 +134,22 @@ class Desktop:
         subprocess.run(["import", "-window", "root", path], env=self.env, check=True)
         return mpimg.imread(path)[..., :3]
 
+    def click_button(self, button: str) -> None:
+        """Clicks a toolbar button once."""
+        x0, step, y = TOOLBAR[tuple(self.version)]
+        self.xdo("mousemove", str(int(round(x0 + step * BUTTONS.index(button)))), str(y), "click", "1")
+
     def press_button(self, button: str, condition, what: str) -> dict:
         """Clicks a toolbar button until ``condition`` holds (FreeCAD enables a command's button on
         its next update after the command becomes usable: a click before that does nothing, for a
-        user too, who clicks again)."""
+        user too, who clicks again). Each click gets 5 s to show: most buttons toggle, and a second
+        click while a loaded machine still works on the first would undo it."""
         x0, step, y = TOOLBAR[tuple(self.version)]
         x = int(round(x0 + step * BUTTONS.index(button)))
-        for _ in range(10):
+        for _ in range(6):
             self.xdo("mousemove", str(x), str(y), "click", "1")
             try:
-                return self.wait(condition, what, timeout=1.5, shot=False)
+                return self.wait(condition, what, timeout=5.0, shot=False)
             except AssertionError:
                 continue
         return self.wait(condition, what)

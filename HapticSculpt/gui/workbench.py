@@ -159,7 +159,8 @@ class Controller:
         import FreeCADGui as Gui
 
         from ..app.sculpt_feature import is_sculpt
-        sel = [o for o in Gui.Selection.getSelection() if is_sculpt(o)]
+        from ..app.sculpted_solid import sculpt_for
+        sel = [sculpt_for(o) for o in Gui.Selection.getSelection() if sculpt_for(o) is not None]
         if sel:
             return sel[0]
         if self.mouse_object is not None and _alive(self.mouse_object):
@@ -195,14 +196,13 @@ class Controller:
         which sculpt is under the mouse."""
         import FreeCAD
 
-        from ..app.sculpt_feature import is_sculpt
+        from ..app.sculpted_solid import sculpt_for
         info = view.getObjectInfo((x, y))
         self.mouse_object = None
         if info and all(k in info for k in ("x", "y", "z")):
             doc = FreeCAD.getDocument(info["Document"]) if info.get("Document") else None
             obj = doc.getObject(info["Object"]) if doc is not None and info.get("Object") else None
-            if is_sculpt(obj):
-                self.mouse_object = obj
+            self.mouse_object = sculpt_for(obj)
             return np.array([info["x"], info["y"], info["z"]], float)
         p = view.getPoint(x, y)
         return np.array([p.x, p.y, p.z], float)

@@ -3,13 +3,13 @@
 # are) to $HS_OBSERVER_OUT as JSON. It only reads: every action in those tests is a real X event.
 import json
 import os
-
 import sys
 
 import FreeCAD
 import FreeCADGui as Gui
-import HapticSculpt
 from pivy import coin
+
+import HapticSculpt
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(HapticSculpt.__file__)), "tests", "gui_input"))
 from observer_digest import digest  # noqa: E402
@@ -32,6 +32,20 @@ def _sculpts(doc):
                     "stiffness_values": list(o.StiffnessMap),
                     "session": o.Proxy.live.session is not None if getattr(o.Proxy, "live", None) else False,
                     "selected": o in Gui.Selection.getSelection(), "screen": _on_screen(o), "digest": digest(o)})
+    return out
+
+
+def _solids(doc):
+    out = []
+    for o in doc.Objects:
+        if getattr(getattr(o, "Proxy", None), "Type", None) != "HapticSculpt::SculptedSolid":
+            continue
+        shape = o.Shape
+        out.append({"name": o.Name, "valid": shape.isValid(), "solids": len(shape.Solids),
+                    "closed": all(sh.isClosed() for sh in shape.Shells), "volume": shape.Volume,
+                    "faces": len(shape.Faces), "wires": sorted(len(f.Wires) for f in shape.Faces),
+                    "seams": json.loads(o.SeamReport or "[]"), "error": o.RebuildError,
+                    "base_visible": bool(o.Base.ViewObject.Visibility) if o.Base is not None else None})
     return out
 
 
@@ -70,7 +84,9 @@ def write(*_):
     for name, doc in FreeCAD.listDocuments().items():
         state["docs"][name] = {"undo": list(doc.UndoNames), "redo": list(doc.RedoNames), "file": doc.FileName,
                                "modified": bool(getattr(doc, "isTouched", lambda: False)()),
-                               "sculpts": _sculpts(doc), "objects": [o.Name for o in doc.Objects]}
+                               "sculpts": _sculpts(doc), "objects": [o.Name for o in doc.Objects],
+                               "solids": _solids(doc),
+                               "screen": {o.Name: _on_screen(o) for o in doc.Objects if hasattr(o, "Shape")}}
     try:
         import HapticSculpt.gui.workbench as hg
         ctl = hg.controller()

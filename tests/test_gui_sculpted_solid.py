@@ -1,0 +1,91 @@
+"""A face of a real part sculpted in place, as a designer does it in FreeCAD's GUI with real X
+events: open a file with a housing (a hole through its top, a fillet along one edge), click its top
+face, "Sculpt selected face", start a session, drag, stop; the part stays one valid closed solid
+with its hole, Undo puts it back at once, the zebra display keeps the hole open. Screenshots in
+build/screenshots/real_solid_*.png."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from freecad_support import run_freecad_gui
+from test_gui_real_input import NEEDS, Desktop, undo
+
+#: The part, made and saved by FreeCAD's GUI (a file saved by freecadcmd has no view data: FreeCAD
+#: opens it with nothing shown).
+HOUSING = """
+import json, os
+import FreeCAD, FreeCADGui, Part
+doc = FreeCAD.newDocument("Housing")
+part = doc.addObject("Part::Feature", "Housing")
+shape = Part.makeBox(60, 40, 15)
+edge = [e for e in shape.Edges if abs(e.CenterOfMass.z - 15) < 1e-9 and abs(e.CenterOfMass.y) < 1e-9][0]
+part.Shape = shape.makeFillet(4, [edge]).cut(Part.makeCylinder(6, 40, FreeCAD.Vector(42, 20, -5)))
+doc.recompute()
+doc.saveAs(PATH)
+json.dump({"volume": part.Shape.Volume, "faces": len(part.Shape.Faces)}, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+def solid(s: dict) -> dict:
+    return s["docs"][s["active"]]["solids"][0]
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_a_face_of_a_part_sculpted_in_place(tmp_path):
+    path = str(tmp_path / "housing.FCStd")
+    part = run_freecad_gui(f"PATH = {path!r}\n" + HOUSING, str(tmp_path))
+    d = Desktop(str(tmp_path), "CAD", open_file=path)
+    try:
+        s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["screen"].get("Housing"), "the file to open")
+        d.xdo("mousemove", "640", "500", "click", "1")  # (the view has the keys and the mouse)
+        d.xdo("key", "0")  # isometric
+        d.xdo("key", "--delay", "150", "v", "f")  # fit all (FreeCAD's V, F)
+        size = s["views"][0]["size"]
+        s = d.wait(lambda s: all(0 < p[0] < size[0] and 0 < p[1] < size[1]
+                                 for p in s["docs"][s["active"]]["screen"]["Housing"]), "the part in view")
+        d.calibrate()
+        # the top face between the fillet and the hole: the bounding box's west point (x = 15 mm)
+        west = d.to_screen(s["docs"][s["active"]]["screen"]["Housing"][2])
+        d.xdo("mousemove", str(west[0]), str(west[1]))
+        d.wait(lambda s: s["mouse_point"] is not None and abs(s["mouse_point"][2] - 15) < 0.5, "the mouse on the top")
+        d.xdo("click", "1")
+        s = d.press_button("SculptFace", lambda s: s["docs"][s["active"]]["solids"], "the SculptedSolid")
+        made = solid(s)
+        assert made["valid"] and made["solids"] == 1 and made["closed"], made
+        assert abs(made["volume"] - part["volume"]) < 1e-3 * part["volume"]
+        assert made["faces"] == part["faces"] and made["base_visible"] is False
+        assert max(r["g0_mm"] for r in made["seams"]) <= 1e-7
+        d.press_button("Session", lambda s: s["docs"][s["active"]]["sculpts"][0]["session"], "the session")
+        d.drag([west] + [(west[0], west[1] - 8 * k) for k in range(1, 13)], seconds=0.8)
+        d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
+        d.click_button("Session")  # once: stopping commits and rebuilds the solid, a second click would start again
+        s = d.wait(lambda s: not s["docs"][s["active"]]["sculpts"][0]["session"], "the session to stop")
+        picture = d.shot("solid_pulled")
+        assert abs(solid(s)["volume"] - made["volume"]) > 1.0, "the stroke changed the part"
+        pulled = solid(s)
+        assert pulled["valid"] and pulled["solids"] == 1 and pulled["closed"] and not pulled["error"], pulled
+        assert pulled["wires"] == made["wires"], "the hole is still a hole"
+        assert max(r["g0_mm"] for r in pulled["seams"]) <= 1e-7, pulled["seams"]
+        if undo(d.state())[0] == "Sculpt session end":  # (what moved after the stroke, until the session stopped)
+            d.xdo("key", "ctrl+z")
+            d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "Undo of the session end")
+        d.xdo("key", "ctrl+z")
+        s = d.wait(lambda s: undo(s)[0] == "Sculpt solid" and
+                   abs(solid(s)["volume"] - made["volume"]) < 1e-6 * made["volume"], "Undo of the stroke to show")
+        assert np.mean(np.abs(d.shot("solid_undone") - picture) > 0.1) > 1e-3, "Undo did not change the picture"
+        d.xdo("key", "ctrl+shift+z")
+        d.wait(lambda s: undo(s)[0] == "Sculpt stroke" and abs(solid(s)["volume"] - made["volume"]) > 1.0, "Redo to show")
+        frames = sum(o["frames"] for o in d.state()["overlays"])
+        d.click_button("Zebra")  # (once: it toggles; the first frame finds which cells are on the face)
+        d.wait(lambda s: any(o["display"] == "zebra" for o in s["overlays"]) and
+               sum(o["frames"] for o in s["overlays"]) > frames + 10, "the zebra stripes drawn")
+        zebra = d.shot("solid_zebra")
+        top = d.to_screen(d.state()["docs"][s["active"]]["screen"]["Housing"][3])  # (30, 30): striped
+        assert np.abs(zebra[top[1] - 40:top[1] + 40, top[0] - 40:top[0] + 40] -
+                      picture[top[1] - 40:top[1] + 40, top[0] - 40:top[0] + 40]).max() > 0.3, "no stripes"
+        # the hole stays open in the display: the pixels at its centre are the same colour as without stripes
+        hole = d.to_screen(d.state()["docs"][s["active"]]["screen"]["Housing"][1])  # x = 45 mm: in the hole
+        assert np.allclose(zebra[hole[1], hole[0]], picture[hole[1], hole[0]], atol=0.1)
+    finally:
+        d.close()
