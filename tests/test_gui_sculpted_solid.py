@@ -5,10 +5,12 @@ with its hole, Undo puts it back at once, the zebra display keeps the hole open.
 build/screenshots/real_solid_*.png."""
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 from freecad_support import run_freecad_gui
-from test_gui_real_input import NEEDS, Desktop, undo
+from test_gui_real_input import NEEDS, SHOTS, Desktop, undo
 
 #: The part, made and saved by FreeCAD's GUI (a file saved by freecadcmd has no view data: FreeCAD
 #: opens it with nothing shown).
@@ -33,6 +35,7 @@ def solid(s: dict) -> dict:
 
 @pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
 def test_a_face_of_a_part_sculpted_in_place(tmp_path):
+    os.makedirs(SHOTS, exist_ok=True)
     path = str(tmp_path / "housing.FCStd")
     part = run_freecad_gui(f"PATH = {path!r}\n" + HOUSING, str(tmp_path))
     d = Desktop(str(tmp_path), "CAD", open_file=path)
