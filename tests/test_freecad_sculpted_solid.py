@@ -215,6 +215,14 @@ class TestSculptedSolid(SolidChecks):
         pull(obj, (15, 20, 12), (0, 0, 6))
         change = self.check_sculpted(obj, pocket, top)
         self.assertGreater(change, 20.0)
+        # the pad made taller: the sculpted top, hole and all, follows (the sketch of the hole stays at z = 12,
+        # the pocket goes through all)
+        pad.Length = 18
+        self.doc.recompute()
+        self.assertEqual(obj.RebuildError, "")
+        top = face_named(pocket.Shape, lambda f: abs(f.CenterOfMass.z - 18) < 1e-6)
+        self.assertEqual(obj.SculptFaces, [top])
+        self.check_sculpted(obj, pocket, top)
 
     def test_face_next_to_a_fillet(self):
         box = Part.makeBox(40, 30, 10)
@@ -231,6 +239,29 @@ class TestSculptedSolid(SolidChecks):
         pull(obj, (20, 17, 10), (0, 0, -4))
         change = self.check_sculpted(obj, part, top)
         self.assertLess(change, -10.0)  # pushed in
+
+    def test_the_sculpt_follows_a_changed_base(self):
+        box = self.doc.addObject("Part::Box", "Box")
+        box.Length, box.Width, box.Height = 40, 30, 10
+        self.doc.recompute()
+        top = face_named(box.Shape, lambda f: abs(f.CenterOfMass.z - 10) < 1e-9)
+        obj = hs.sculpt_solid(self.doc, box, [top])
+        pull(obj, (20, 15, 10), (0, 0, 8))
+        before = self.check_sculpted(obj, box, top)
+        bump = obj.Shape.BoundBox.ZMax - 10
+        self.doc.openTransaction("Taller")
+        box.Height, box.Length = 25, 50
+        self.doc.commitTransaction()
+        self.doc.recompute()
+        self.assertEqual(obj.RebuildError, "")
+        self.assertAlmostEqual(obj.Shape.BoundBox.ZMax - 25, bump, delta=0.02 * bump)  # the bump, on the new top
+        self.assertAlmostEqual(obj.Shape.BoundBox.XMax, 50, delta=1e-6)
+        after = self.check_sculpted(obj, box, top)  # valid, seams hold on the new neighbours
+        # the displacement moves with the face's relative parameters: 25 % longer, 25 % more volume
+        self.assertAlmostEqual(after, before * 50 / 40, delta=0.02 * abs(before))
+        self.doc.undo()
+        self.doc.recompute()
+        self.assertAlmostEqual(obj.Shape.BoundBox.ZMax - 10, bump, delta=0.02 * bump)
 
     def test_run_and_constraints_accept_the_solid(self):
         box = self.part(Part.makeBox(40, 30, 10))

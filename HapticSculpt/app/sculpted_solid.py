@@ -44,7 +44,10 @@ def ensure_properties(obj: Any) -> None:
             ("App::PropertyLinkList", "Sculpts", "The sculpts of those faces (hidden)", 1),
             ("App::PropertyString", "SeamReport", "Per edge: the largest gap (mm) and, for G1 edges, the largest "
                                                   "normal angle (degrees) between the sculpted face and the seam (JSON)", 1),
-            ("App::PropertyString", "RebuildError", "Why the solid could not be rebuilt (empty when it could)", 1)):
+            ("App::PropertyString", "RebuildError", "Why the solid could not be rebuilt (empty when it could)", 1),
+            ("App::PropertyString", "Resolution", "The least net the faces were converted to (JSON)", 2),
+            ("App::PropertyFloatList", "SourcePoles", "The poles of the face the sculpt was made from (the base "
+                                                     "changed: the sculpt follows it)", 2)):
         if name not in obj.PropertiesList:
             obj.addProperty(kind, name, GROUP, doc)
         obj.setEditorMode(name, mode)
@@ -59,8 +62,14 @@ class SculptedSolidFeature:
         obj.Proxy = self
 
     def execute(self, obj: Any) -> None:
-        """Recompute: the solid from the base and the sculpts (raises, marking the object, if it
-        cannot be rebuilt)."""
+        """Recompute: the sculpt follows the base if its face changed, then the solid from the base
+        and the sculpt (raises, marking the object, if it cannot be rebuilt)."""
+        from .follow_base import follow_base
+        try:
+            follow_base(obj, base_solid(obj.Base))
+        except (RuntimeError, ValueError) as exc:
+            obj.RebuildError = f"the sculpt cannot follow the changed base: {exc}"
+            raise
         rebuild(obj)
 
     def sculpt_changed(self, obj: Any) -> None:

@@ -10,6 +10,7 @@ import numpy as np
 
 from . import face_in_solid, sculpt_state
 from .api import _add_sculpt, _checked_resolution, _document, _material, _sculpt_state
+from .follow_base import trim_knots
 from .sculpted_solid import (
     SculptedSolidFeature,
     attach_view_provider,
@@ -57,21 +58,6 @@ def _boundary_kinds(boundary: Any, edges: list[face_in_solid.FaceEdge], faces: S
     return kinds
 
 
-def _trim_knots(edges: list[face_in_solid.FaceEdge]) -> tuple[list[float], list[float]]:
-    """Knots that refine the net around each trim inside the face (see TRIM_SPANS)."""
-    extra: tuple[list[float], list[float]] = ([], [])
-    for e in edges:
-        if e.side is not None:
-            continue
-        for d in (0, 1):
-            lo, hi = float(e.uv[:, d].min()), float(e.uv[:, d].max())
-            if hi - lo <= 0:
-                continue
-            h = (hi - lo) / TRIM_SPANS
-            extra[d].extend(lo + h * k for k in range(-2, TRIM_SPANS + 3))
-    return extra
-
-
 def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0", symmetry: Any = None,
                  controls: tuple[int, int] = (8, 8), degree: tuple[int, int] = (3, 3),
                  mesh: tuple[int, int] = (40, 40), name: str = "SculptedSolid", material: str = "clay") -> Any:
@@ -114,7 +100,7 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
     face_name = faces[0]
     edges = face_in_solid.face_edges(shape, face_name)
     kinds = _boundary_kinds(boundary, edges, faces)
-    made = source_surface((base, face_name), controls, degree, (1.0, 1.0), doc, _trim_knots(edges))
+    made = source_surface((base, face_name), controls, degree, (1.0, 1.0), doc, trim_knots(edges, TRIM_SPANS))
     if made.method != "exact":
         raise ValueError(f"faces: {face_name} has no exact B-spline form (its trims could not be kept on a fitted "
                          f"surface); sculpt it as a separate patch with make_sculpt")
@@ -135,6 +121,8 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
         obj.SculptFaces = faces
         obj.Boundary = json.dumps(kinds)
         obj.Sculpts = [sculpt]
+        obj.Resolution = json.dumps({"controls": list(controls), "degree": list(degree), "trim_spans": TRIM_SPANS})
+        obj.SourcePoles = np.asarray(s.poles, float).ravel().tolist()
         rebuild(obj)
         attach_view_provider(obj)
     return obj

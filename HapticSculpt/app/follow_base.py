@@ -1,0 +1,136 @@
+"""A SculptedSolid follows its base: when the base's face changes (a pad made taller, a box made
+wider), the sculpt is carried over to the new face as a displacement from it, so what was sculpted
+stays sculpted on the changed part.
+
+The displacement (sculpted surface minus the face it was made from, kept in ``SourcePoles``) is
+sampled at the same relative parameters on both, fitted on the new face's net by least squares
+with its held poles not displaced (the edges stay exactly on the new neighbours), and added to the
+new face's poles. Spring rest lengths scale with the source's, so clay keeps its set; the material
+maps and the tool carry over. Constraints were placed in the old part's space: they are dropped,
+and the report view says how many.
+"""
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import numpy as np
+
+from .. import core
+from . import face_in_solid, sculpt_state
+from .sculpt_properties import face_of, read_state, write_state
+from .source_surface import source_surface
+
+#: Grid (per direction) on which the displacement is sampled and fitted.
+FIT_SAMPLES = 48
+
+
+def trim_knots(edges: list[face_in_solid.FaceEdge], spans: int) -> tuple[list[float], list[float]]:
+    """Knots that refine the net around each trim inside the face: ``spans`` spans across its
+    extent and two on each side (see solid_api.TRIM_SPANS)."""
+    extra: tuple[list[float], list[float]] = ([], [])
+    for e in edges:
+        if e.side is not None:
+            continue
+        for d in (0, 1):
+            lo, hi = float(e.uv[:, d].min()), float(e.uv[:, d].max())
+            if hi - lo <= 0:
+                continue
+            h = (hi - lo) / spans
+            extra[d].extend(lo + h * k for k in range(-2, spans + 3))
+    return extra
+
+
+def source_of(obj: Any, shape: Any, edges: list[face_in_solid.FaceEdge]) -> Any:
+    """The base face's exact B-spline surface at the SculptedSolid's resolution (a SourceSurface)."""
+    res = json.loads(obj.Resolution)
+    return source_surface((obj.Base, obj.SculptFaces[0]), tuple(res["controls"]), tuple(res["degree"]), (1.0, 1.0),
+                          obj.Document, trim_knots(edges, int(res["trim_spans"])))
+
+
+def _basis_matrix(surface: core.BSplineSurface, n: int) -> np.ndarray:
+    """(n*n, poles) matrix: the surface's points on its n x n grid are this times its poles (linear
+    in the poles for fixed weights)."""
+    poles = np.zeros(np.asarray(surface.poles).shape)
+    columns = []
+    for k in range(poles.shape[0] * poles.shape[1]):
+        unit = poles.copy()
+        unit.reshape(-1, 3)[k, 0] = 1.0
+        probe = core.BSplineSurface(unit, surface.degree, surface.knots_u, surface.knots_v, surface.weights)
+        columns.append(np.asarray(probe.grid(n, n)[0])[..., 0].ravel())
+    return np.stack(columns, axis=1)
+
+
+def carried_poles(old_source: core.BSplineSurface, sculpted: core.BSplineSurface, new_source: core.BSplineSurface,
+                  held: list[int]) -> np.ndarray:
+    """The new face's poles plus the old sculpt's displacement, fitted with the held poles fixed."""
+    n = FIT_SAMPLES
+    displacement = (np.asarray(sculpted.grid(n, n)[0]) - np.asarray(old_source.grid(n, n)[0])).reshape(-1, 3)
+    basis = _basis_matrix(new_source, n)
+    free = np.setdiff1d(np.arange(basis.shape[1]), np.asarray(held, dtype=int))
+    delta = np.zeros((basis.shape[1], 3))
+    delta[free], *_ = np.linalg.lstsq(basis[:, free], displacement, rcond=None)
+    return np.asarray(new_source.poles).reshape(-1, 3) + delta
+
+
+def follow_base(obj: Any, shape: Any) -> bool:
+    """Carries the sculpt over to the base's face if it changed since the sculpt was made from it
+    (or last followed it); True if it did. The caller holds the transaction (a recompute)."""
+    if not obj.Resolution or not obj.SourcePoles:
+        return False  # (made before sculpts followed their base: nothing to compare with)
+    sculpt = obj.Sculpts[0]
+    face_name = obj.SculptFaces[0]
+    edges = face_in_solid.face_edges(shape, face_name)
+    made = source_of(obj, shape, edges)
+    new_source = made.surface
+    old = read_state(sculpt)
+    nu, nv = old.settings["controls"]
+    old_poles = np.asarray(obj.SourcePoles, float)
+    same_net = (tuple(new_source.controls) == (nu, nv)
+                and np.array_equal(np.asarray(new_source.knots_u), old.arrays["KnotsU"])
+                and np.array_equal(np.asarray(new_source.knots_v), old.arrays["KnotsV"]))
+    size = float(np.ptp(np.asarray(new_source.poles).reshape(-1, 3), axis=0).max())
+    if same_net and old_poles.size == nu * nv * 3 and \
+            np.abs(np.asarray(new_source.poles).ravel() - old_poles).max() <= 1e-12 * max(size, 1.0):
+        return False
+    weights = old.arrays["Weights"].reshape(nu, nv) if old.arrays["Weights"].size else None
+    old_source = core.BSplineSurface(old_poles.reshape(nu, nv, 3), tuple(old.settings["degree"]),
+                                     old.arrays["KnotsU"], old.arrays["KnotsV"], weights)
+    sculpted = core.BSplineSurface(old.arrays["Poles"].reshape(nu, nv, 3), tuple(old.settings["degree"]),
+                                   old.arrays["KnotsU"], old.arrays["KnotsV"], weights)
+    kinds = {e.name: json.loads(obj.Boundary).get(e.name, "G0") for e in edges}
+    held = face_in_solid.held_poles(np.asarray(new_source.knots_u), np.asarray(new_source.knots_v),
+                                    tuple(new_source.degree), tuple(new_source.controls), edges, kinds)
+    poles = carried_poles(old_source, sculpted, new_source, held)
+    mesh = tuple(old.settings["mesh"])
+    carried = core.BSplineSurface(poles.reshape(*new_source.controls, 3), new_source.degree, new_source.knots_u,
+                                  new_source.knots_v, new_source.weights)
+    # rest lengths: the old ones, scaled spring by spring as the source's lengths scaled
+    old_lengths = np.asarray(core.DynamicSurface(old_source, mesh).rest_lengths)
+    new_lengths = np.asarray(core.DynamicSurface(new_source, mesh).rest_lengths)
+    rest = old.arrays["RestLengths"] * np.divide(new_lengths, old_lengths, out=np.ones_like(new_lengths),
+                                                 where=old_lengths > 0)
+    moved = sculpt_state.capture(core.DynamicSurface(carried, mesh))
+    arrays = dict(old.arrays, Poles=moved.arrays["Poles"], Velocities=np.zeros_like(moved.arrays["Poles"]),
+                  KnotsU=moved.arrays["KnotsU"], KnotsV=moved.arrays["KnotsV"], Weights=moved.arrays["Weights"],
+                  RestLengths=rest)
+    dropped = len(old.settings.get("constraints", []))
+    settings = dict(old.settings, controls=list(new_source.controls), held_poles=held, constraints=[],
+                    reference=moved.settings["reference"])
+    state = sculpt_state.SculptState(arrays, settings)
+    sculpt_state.restore(state)  # (validates before anything is written)
+    live = sculpt.Proxy.live
+    live.writing = True
+    try:
+        write_state(sculpt, state)
+        sculpt.Shape = face_of(state)
+    finally:
+        live.writing = False
+    live.document_changed()
+    obj.SourcePoles = np.asarray(new_source.poles, float).ravel().tolist()
+    obj.Boundary = json.dumps(kinds)
+    if dropped:
+        import FreeCAD
+        FreeCAD.Console.PrintWarning(f"HapticSculpt: {obj.Label}: the base changed; the sculpt follows it, its "
+                                     f"{dropped} constraint(s) (placed on the old part) were dropped\n")
+    return True
