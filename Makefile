@@ -185,6 +185,7 @@ bench: build wheel
 	$(PY) bench/time_vs_error.py
 	$(PY) bench/discretisation.py
 	$(PY) bench/builds.py
+	$(PY) bench/solids.py
 
 # Peers run in their own virtual environment (optional benchmark dependencies, not test ones).
 BENCH_VENV := $(BUILD)/bench-venv
