@@ -263,6 +263,19 @@ class TestSculptedSolid(SolidChecks):
         self.doc.recompute()
         self.assertAlmostEqual(obj.Shape.BoundBox.ZMax - 10, bump, delta=0.02 * bump)
 
+    def test_extreme_sizes_stay_valid_solids(self):
+        """A 40 um and a 400 m box: the solid is valid and closed after a stroke scaled with it, the
+        seams hold to round-off of the part's size."""
+        for scale in (1e-3, 1e4):
+            box = self.part(Part.makeBox(40 * scale, 30 * scale, 10 * scale), f"Box{len(self.doc.Objects)}")
+            top = face_named(box.Shape, lambda f: abs(f.CenterOfMass.z - 10 * scale) < 1e-9 * scale)
+            obj = hs.sculpt_solid(self.doc, box, [top], controls=(6, 6), mesh=(24, 24), name=f"S{len(self.doc.Objects)}")
+            pull(obj, (20 * scale, 15 * scale, 10 * scale), (0, 0, 6 * scale))
+            self.assertEqual(obj.RebuildError, "")
+            self.assertTrue(obj.Shape.isValid() and len(obj.Shape.Solids) == 1, scale)
+            self.assertLessEqual(max(r["g0_mm"] for r in hs.seam_report_of(obj)), 1e-12 * 40 * scale)
+            self.assertNotEqual(obj.Shape.Volume, box.Shape.Volume)
+
     def test_run_and_constraints_accept_the_solid(self):
         box = self.part(Part.makeBox(40, 30, 10))
         top = face_named(box.Shape, lambda f: abs(f.CenterOfMass.z - 10) < 1e-9)
