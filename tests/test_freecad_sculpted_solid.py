@@ -311,6 +311,22 @@ class TestSculptedSolidDocument(SolidChecks):
         self.doc.undo()  # the SculptedSolid's creation
         self.assertEqual([o.Name for o in self.doc.Objects], ["Box"])
 
+    def test_a_file_saved_during_a_session_opens_as_the_solid(self):
+        from HapticSculpt.app.sculpt_properties import read_state
+        from HapticSculpt.app.sculpted_solid import preview
+        box, obj = self.make()
+        pull(obj, (20, 15, 10), (0, 0, 6))
+        volume, name = obj.Shape.Volume, obj.Name
+        obj.Shape = preview(obj, read_state(obj.Sculpts[0]))  # what a GUI session's frame shows
+        self.assertEqual(len(obj.Shape.Solids), 0)
+        path = os.path.join(self.tmp, "during.FCStd")
+        self.doc.saveAs(path)
+        FreeCAD.closeDocument(self.doc.Name)
+        self.doc = FreeCAD.openDocument(path)
+        again = self.doc.getObject(name)
+        self.assertEqual(len(again.Shape.Solids), 1)
+        self.assertAlmostEqual(again.Shape.Volume, volume, delta=1e-9 * volume)
+
     def test_set_boundary_is_one_undo_step(self):
         box, obj = self.make()
         edge = hs.seam_report_of(obj)[0]["edge"]

@@ -91,7 +91,15 @@ class SculptedSolidFeature:
             pass  # (the last frame stays; the commit says what is wrong)
 
     def onDocumentRestored(self, obj: Any) -> None:
+        """Opening a file: add properties older files lack; a file saved while a session ran holds
+        that session's preview (faces, not a solid): it is rebuilt from the stored sculpt."""
         ensure_properties(obj)
+        if obj.Sculpts and obj.Base is not None and len(obj.Shape.Solids) != 1:
+            try:
+                rebuild(obj)
+            except (RuntimeError, ValueError) as exc:
+                import FreeCAD
+                FreeCAD.Console.PrintError(f"HapticSculpt: {obj.Label}: {exc}\n")
 
     def dumps(self) -> dict[str, Any]:
         """Proxy state for the file: only the type tag (everything else is in the properties)."""
