@@ -8,30 +8,20 @@ exactly, and the one way to read or edit the surface while a session runs.
 """
 from __future__ import annotations
 
-from typing import Any, Callable
+from typing import Any
 
 from .. import core
 from . import sculpt_state
 from .live_surface import LiveSurface
 from .sculpt_properties import STATE_PROPERTIES, ensure_properties, face_of, read_state, set_error, write_state
+from .view_provider_hook import ViewProviderHook
 
 TYPE = "HapticSculpt::Sculpt"
 
-#: What gives a new Sculpt object its view provider while FreeCAD's GUI runs: the GUI layer
-#: installs it when it loads (see HapticSculpt.gui), so this layer never imports a GUI module.
-_view_providers: list[Callable[[Any], Any]] = []
-
-
-def set_view_provider(factory: Callable[[Any], Any]) -> None:
-    """Installs ``factory(view_object)``, called for each new Sculpt object while the GUI is up."""
-    _view_providers[:] = [factory]
-
-
-def attach_view_provider(obj: Any) -> None:
-    """Gives ``obj`` its view provider if FreeCAD's GUI runs (a no-op in console mode)."""
-    import FreeCAD
-    if FreeCAD.GuiUp and _view_providers:
-        _view_providers[0](obj.ViewObject)
+#: What gives a new Sculpt its view provider while the GUI runs (installed by HapticSculpt.gui).
+_VIEW_PROVIDER = ViewProviderHook()
+set_view_provider = _VIEW_PROVIDER.install
+attach_view_provider = _VIEW_PROVIDER.attach
 
 
 class SculptFeature:

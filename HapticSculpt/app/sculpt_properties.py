@@ -58,13 +58,17 @@ def write_state(obj: Any, state: sculpt_state.SculptState) -> None:
         obj.SculptSettings = text
 
 
-def face_of(state: sculpt_state.SculptState) -> Any:
-    """The Part face for a state: exactly its poles, knots, degrees and weights."""
+def surface_of(state: sculpt_state.SculptState) -> Any:
+    """The Part.BSplineSurface of a state: exactly its poles, knots, degrees and weights."""
     s, a = state.settings, state.arrays
     nu, nv = s["controls"]
     weights = a["Weights"].reshape(nu, nv) if a["Weights"].size else None
-    bs = part_bspline(a["Poles"].reshape(nu, nv, 3), a["KnotsU"], a["KnotsV"], tuple(s["degree"]), weights)
-    return bs.toShape()
+    return part_bspline(a["Poles"].reshape(nu, nv, 3), a["KnotsU"], a["KnotsV"], tuple(s["degree"]), weights)
+
+
+def face_of(state: sculpt_state.SculptState) -> Any:
+    """The Part face for a state (see :func:`surface_of`)."""
+    return surface_of(state).toShape()
 
 
 def set_error(obj: Any, message: str, live: Any) -> None:

@@ -12,27 +12,18 @@ properties: the base link, the face names, the boundary per edge (JSON), the sea
 from __future__ import annotations
 
 import json
-from typing import Any, Callable
+from typing import Any
 
 from . import face_in_solid
-from .part_surface import part_bspline
-from .sculpt_properties import read_state
+from .sculpt_properties import read_state, surface_of
+from .view_provider_hook import ViewProviderHook
 
 TYPE = "HapticSculpt::SculptedSolid"
 GROUP = "SculptedSolid"
-_view_providers: list[Callable[[Any], Any]] = []
-
-
-def set_view_provider(factory: Callable[[Any], Any]) -> None:
-    """Installs ``factory(view_object)``, called for each new SculptedSolid while the GUI is up."""
-    _view_providers[:] = [factory]
-
-
-def attach_view_provider(obj: Any) -> None:
-    """Gives ``obj`` its view provider if FreeCAD's GUI runs (a no-op in console mode)."""
-    import FreeCAD
-    if FreeCAD.GuiUp and _view_providers:
-        _view_providers[0](obj.ViewObject)
+#: What gives a new SculptedSolid its view provider while the GUI runs (installed by HapticSculpt.gui).
+_VIEW_PROVIDER = ViewProviderHook()
+set_view_provider = _VIEW_PROVIDER.install
+attach_view_provider = _VIEW_PROVIDER.attach
 
 
 def ensure_properties(obj: Any) -> None:
@@ -187,11 +178,7 @@ def base_solid(base: Any) -> Any:
 
 def sculpted_surface(sculpt: Any, state: Any = None) -> Any:
     """The Part.BSplineSurface of a Sculpt's stored state (or of ``state``, a SculptState)."""
-    state = read_state(sculpt) if state is None else state
-    s, a = state.settings, state.arrays
-    nu, nv = s["controls"]
-    weights = a["Weights"].reshape(nu, nv) if a["Weights"].size else None
-    return part_bspline(a["Poles"].reshape(nu, nv, 3), a["KnotsU"], a["KnotsV"], tuple(s["degree"]), weights)
+    return surface_of(read_state(sculpt) if state is None else state)
 
 
 def preview(obj: Any, frame: Any) -> Any:

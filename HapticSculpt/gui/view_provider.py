@@ -12,17 +12,8 @@ def icon(name: str) -> str:
     return os.path.join(ICONS, name + ".svg")
 
 
-class SculptViewProvider:
-    """Shows the sculpt face with Part's own shape display; adds the icon."""
-
-    def __init__(self, vobj: Any) -> None:
-        vobj.Proxy = self
-
-    def attach(self, vobj: Any) -> None:
-        self.Object = vobj.Object
-
-    def getIcon(self) -> str:
-        return icon("HapticSculpt")
+class _Stateless:
+    """A view provider keeps nothing in the file (the object's properties hold everything)."""
 
     def dumps(self) -> None:
         return None
@@ -37,7 +28,20 @@ class SculptViewProvider:
         return None
 
 
-class SolidViewProvider:
+class SculptViewProvider(_Stateless):
+    """Shows the sculpt face with Part's own shape display; adds the icon."""
+
+    def __init__(self, vobj: Any) -> None:
+        vobj.Proxy = self
+
+    def attach(self, vobj: Any) -> None:
+        self.Object = vobj.Object
+
+    def getIcon(self) -> str:
+        return icon("HapticSculpt")
+
+
+class SolidViewProvider(_Stateless):
     """A SculptedSolid shows as Part shows a solid; its base and its sculpts are its children in the
     tree, hidden, as FreeCAD's own features show theirs (shown again when it is deleted)."""
 
@@ -63,15 +67,3 @@ class SolidViewProvider:
         if base is not None and base.ViewObject is not None:
             base.ViewObject.Visibility = True
         return True
-
-    def dumps(self) -> None:
-        return None
-
-    def loads(self, state: Any) -> None:
-        return None
-
-    def __getstate__(self) -> None:
-        return None
-
-    def __setstate__(self, state: Any) -> None:
-        return None
