@@ -288,6 +288,85 @@ class TestSculptedSolid(SolidChecks):
         self.check_sculpted(obj, box, top)
 
 
+def mirror_distance(surface, point, normal, direction, n=61):
+    """Largest distance between the sculpted surface's mirror image in the plane and the surface
+    itself with u (direction 0) or v reversed, on an n x n grid."""
+    point, normal = np.asarray(point, float), np.asarray(normal, float) / np.linalg.norm(normal)
+    u0, u1, v0, v1 = surface.bounds()
+    worst = 0.0
+    for u in np.linspace(u0, u1, n):
+        for v in np.linspace(v0, v1, n):
+            p = np.array(tuple(surface.value(u, v)))
+            q = surface.value(u0 + u1 - u, v) if direction == 0 else surface.value(u, v0 + v1 - v)
+            worst = max(worst, float(np.linalg.norm(p - 2 * (p - point).dot(normal) * normal - np.array(tuple(q)))))
+    return worst
+
+
+class TestSymmetricSculpt(SolidChecks):
+    def test_a_stroke_on_one_side_acts_mirrored_and_the_result_is_exactly_symmetric(self):
+        box = self.part(Part.makeBox(40, 30, 10))
+        top = face_named(box.Shape, lambda f: abs(f.CenterOfMass.z - 10) < 1e-9)
+        obj = hs.sculpt_solid(self.doc, box, [top], symmetry=(FreeCAD.Vector(20, 0, 0), (1, 0, 0)))
+        sym = json.loads(obj.Symmetry)
+        self.assertEqual((sym["point"], sym["normal"]), ([20.0, 0.0, 0.0], [1.0, 0.0, 0.0]))
+        pull(obj, (30, 12, 10), (0, 0, 6))
+        change = self.check_sculpted(obj, box, top)
+        self.assertGreater(change, 50.0)
+        surface = sculpted_surface(obj.Sculpts[0])
+        self.assertLessEqual(mirror_distance(surface, (20, 0, 0), (1, 0, 0), sym["direction"]), 1e-9)
+        # the far side was pulled as much as the side the stroke was on
+        here, there = mass_point_near(obj, 30, 12), mass_point_near(obj, 10, 12)
+        self.assertGreater(here[2], 11.5)
+        self.assertAlmostEqual(there[2], here[2], delta=1e-9)
+        # and it stays so through undo/redo, save and reopen, and strokes after reopening
+        volume = obj.Shape.Volume
+        self.doc.undo()
+        self.doc.redo()
+        self.assertEqual(obj.Shape.Volume, volume)
+        path = os.path.join(self.tmp, "symmetric.FCStd")
+        self.doc.saveAs(path)
+        name = obj.Name
+        FreeCAD.closeDocument(self.doc.Name)
+        self.doc = FreeCAD.openDocument(path)
+        again = self.doc.getObject(name)
+        self.assertEqual(again.Sculpts[0].Proxy.live.snapshot().symmetry[0], sym["direction"])
+        pull(again, mass_point_near(again, 8, 20), (0, 0, -3))
+        surface = sculpted_surface(again.Sculpts[0])
+        self.assertLessEqual(mirror_distance(surface, (20, 0, 0), (1, 0, 0), sym["direction"]), 1e-9)
+        self.check_sculpted(again, self.doc.getObject("Part"), top, min_volume=0.0)
+
+    def test_a_cylinder_mirrored_in_a_plane_of_the_document(self):
+        cyl = self.part(Part.makeCylinder(10, 30), "Cylinder")
+        side = face_named(cyl.Shape, lambda f: isinstance(f.Surface, Part.Cylinder))
+        # a plane feature through the axis, at the seam's angle: the side is symmetric in it
+        plane = self.doc.addObject("Part::Plane", "Mirror")
+        plane.Length, plane.Width = 40, 40
+        plane.Placement = FreeCAD.Placement(FreeCAD.Vector(-20, 0, -5), FreeCAD.Rotation(FreeCAD.Vector(1, 0, 0), 90))
+        self.doc.recompute()
+        obj = hs.sculpt_solid(self.doc, cyl, [side], symmetry=plane)
+        pull(obj, (6, 8, 15), (3, 4, 0))
+        self.check_sculpted(obj, cyl, side)
+        sym = json.loads(obj.Symmetry)
+        self.assertLessEqual(mirror_distance(sculpted_surface(obj.Sculpts[0]), sym["point"], sym["normal"],
+                                             sym["direction"]), 1e-9)
+
+    def test_what_is_not_symmetric_is_refused(self):
+        box = self.part(Part.makeBox(40, 30, 10), "Box")
+        top = face_named(box.Shape, lambda f: abs(f.CenterOfMass.z - 10) < 1e-9)
+        count = len(self.doc.Objects)
+        for symmetry, error, words in (((FreeCAD.Vector(15, 0, 0), (1, 0, 0)), ValueError, "is not symmetric"),
+                                       (((20, 0, 0), (0, 0, 0)), ValueError, "normal must not be zero"),
+                                       (((20, 0), (1, 0, 0)), TypeError, "three numbers"),
+                                       (((20, 0, float("nan")), (1, 0, 0)), ValueError, "finite"),
+                                       ("XZ", TypeError, "symmetry: expected"),
+                                       (box, ValueError, "Box is not a plane")):
+            with self.assertRaises(error, msg=symmetry) as caught:
+                hs.sculpt_solid(self.doc, box, [top], symmetry=symmetry)
+            self.assertIn(words, str(caught.exception))
+            self.assertIn("symmetry", str(caught.exception))
+        self.assertEqual(len(self.doc.Objects), count)
+
+
 class TestSculptedSolidDocument(SolidChecks):
     def make(self):
         box = self.part(Part.makeBox(40, 30, 10), "Box")

@@ -111,8 +111,10 @@ def _checked_resolution(controls: Any, degree: Any, mesh: Any) -> tuple[tuple[in
     return controls, degree, _int_pair(mesh, "mesh", 2)
 
 
-def _sculpt_state(made: Any, mesh: tuple[int, int], material: str, held: Sequence[int] = ()) -> sculpt_state.SculptState:
-    """The state of a new sculpt of ``made`` (a SourceSurface) sampled at ``mesh``, poles ``held``."""
+def _sculpt_state(made: Any, mesh: tuple[int, int], material: str, held: Sequence[int] = (),
+                  symmetry: dict[str, Any] | None = None) -> sculpt_state.SculptState:
+    """The state of a new sculpt of ``made`` (a SourceSurface) sampled at ``mesh``, poles ``held``,
+    mirror ``symmetry`` (face_net.Mirror.settings()) or none."""
     nu, nv = made.surface.controls
     if mesh[0] < nu or mesh[1] < nv:
         raise ValueError(f"mesh: must be at least the control resolution {(nu, nv)}, got {mesh}")
@@ -120,6 +122,8 @@ def _sculpt_state(made: Any, mesh: tuple[int, int], material: str, held: Sequenc
     _apply_material(surface, material)
     if held:
         surface.hold_poles(list(held))
+    if symmetry is not None:
+        surface.set_symmetry(symmetry["direction"], symmetry["point"], symmetry["normal"])
     return sculpt_state.capture(surface)
 
 

@@ -18,34 +18,18 @@ import numpy as np
 
 from .. import core
 from . import face_in_solid, sculpt_state
+from .face_net import face_held, face_source, mirror_of
 from .sculpt_properties import face_of, read_state, write_state
-from .source_surface import source_surface
 
 #: Grid (per direction) on which the displacement is sampled and fitted.
 FIT_SAMPLES = 48
 
 
-def trim_knots(edges: list[face_in_solid.FaceEdge], spans: int) -> tuple[list[float], list[float]]:
-    """Knots that refine the net around each trim inside the face: ``spans`` spans across its
-    extent and two on each side (see solid_api.TRIM_SPANS)."""
-    extra: tuple[list[float], list[float]] = ([], [])
-    for e in edges:
-        if e.side is not None:
-            continue
-        for d in (0, 1):
-            lo, hi = float(e.uv[:, d].min()), float(e.uv[:, d].max())
-            if hi - lo <= 0:
-                continue
-            h = (hi - lo) / spans
-            extra[d].extend(lo + h * k for k in range(-2, spans + 3))
-    return extra
-
-
 def source_of(obj: Any, shape: Any, edges: list[face_in_solid.FaceEdge]) -> Any:
     """The base face's exact B-spline surface at the SculptedSolid's resolution (a SourceSurface)."""
     res = json.loads(obj.Resolution)
-    return source_surface((obj.Base, obj.SculptFaces[0]), tuple(res["controls"]), tuple(res["degree"]), (1.0, 1.0),
-                          obj.Document, trim_knots(edges, int(res["trim_spans"])))
+    return face_source(obj.Base, obj.SculptFaces[0], edges, tuple(res["controls"]), tuple(res["degree"]),
+                       int(res["trim_spans"]), mirror_of(obj))
 
 
 def _basis_matrix(surface: core.BSplineSurface, n: int) -> np.ndarray:
@@ -99,8 +83,7 @@ def follow_base(obj: Any, shape: Any) -> bool:
     sculpted = core.BSplineSurface(old.arrays["Poles"].reshape(nu, nv, 3), tuple(old.settings["degree"]),
                                    old.arrays["KnotsU"], old.arrays["KnotsV"], weights)
     kinds = {e.name: json.loads(obj.Boundary).get(e.name, "G0") for e in edges}
-    held = face_in_solid.held_poles(np.asarray(new_source.knots_u), np.asarray(new_source.knots_v),
-                                    tuple(new_source.degree), tuple(new_source.controls), edges, kinds)
+    held = face_held(made, edges, kinds, mirror_of(obj))
     poles = carried_poles(old_source, sculpted, new_source, held)
     mesh = tuple(old.settings["mesh"])
     carried = core.BSplineSurface(poles.reshape(*new_source.controls, 3), new_source.degree, new_source.knots_u,

@@ -122,8 +122,17 @@ def capture(surface: core.DynamicSurface) -> SculptState:
         "tool": tool_settings(surface),
         "constraints": constraints,
         "held_poles": list(surface.held_poles),
+        "symmetry": _symmetry_settings(surface),
     }
     return SculptState(arrays, settings)
+
+
+def _symmetry_settings(surface: core.DynamicSurface) -> dict[str, Any] | None:
+    sym = surface.symmetry
+    if sym is None:
+        return None
+    direction, point, normal = sym
+    return {"direction": direction, "point": list(point), "normal": list(normal)}
 
 
 def parse_settings(text: str) -> dict[str, Any]:
@@ -199,6 +208,14 @@ def restore(state: SculptState) -> core.DynamicSurface:
         surface.hold_poles(held)
     except ValueError as exc:
         raise ValueError(f"SculptSettings.held_poles: {exc}") from exc
+    sym = s.get("symmetry")
+    if sym is not None:
+        if not isinstance(sym, dict) or sym.get("direction") not in (0, 1):
+            raise ValueError(f"SculptSettings.symmetry: expected null or {{direction: 0 | 1, point, normal}}, got {sym!r}")
+        try:
+            surface.set_symmetry(sym["direction"], _float_list(sym, "point", 3), _float_list(sym, "normal", 3))
+        except ValueError as exc:
+            raise ValueError(f"SculptSettings.symmetry: {exc}") from exc
     return surface
 
 

@@ -36,6 +36,8 @@ def ensure_properties(obj: Any) -> None:
             ("App::PropertyString", "SeamReport", "Per edge: the largest gap (mm) and, for G1 edges, the largest "
                                                   "normal angle (degrees) between the sculpted face and the seam (JSON)", 1),
             ("App::PropertyString", "RebuildError", "Why the solid could not be rebuilt (empty when it could)", 1),
+            ("App::PropertyString", "Symmetry", "The mirror plane the sculpt stays symmetric in: null, or its point, "
+                                                "normal and the parameter direction it reverses (JSON)", 1),
             ("App::PropertyString", "Resolution", "The least net the faces were converted to (JSON)", 2),
             ("App::PropertyFloatList", "SourcePoles", "The poles of the face the sculpt was made from (the base "
                                                      "changed: the sculpt follows it)", 2)):

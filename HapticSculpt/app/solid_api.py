@@ -8,9 +8,9 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from . import face_in_solid, sculpt_state
+from . import face_in_solid, face_symmetry, sculpt_state
 from .api import _add_sculpt, _checked_resolution, _document, _material, _sculpt_state
-from .follow_base import trim_knots
+from .face_net import TRIM_SPANS, Mirror, face_held, face_source, mirror_of
 from .sculpted_solid import (
     SculptedSolidFeature,
     attach_view_provider,
@@ -20,14 +20,7 @@ from .sculpted_solid import (
     rebuild,
     sculpt_of,
 )
-from .source_surface import source_surface
 from .undo import transaction
-
-#: Extra knots around a trim inside the face (a hole, an edge cut by a fillet), per direction, over
-#: the trim's extent: poles whose support crosses the trim are held for G0, so on the coarse net
-#: a hole freezes most of a face (54 % of a 40 x 30 plate's area with a 10 mm hole on 8 x 8 poles);
-#: two more spans across the trim and two on each side bring that to 1 %.
-TRIM_SPANS = 2
 
 
 def _boundary_kinds(boundary: Any, edges: list[face_in_solid.FaceEdge], faces: Sequence[str]) -> dict[str, str]:
@@ -71,7 +64,9 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
     would open the solid). ``controls``/``degree`` are the least net (the face is converted
     exactly, then refined; trims inside the face get extra knots around them), ``mesh`` the mass
     points, ``material`` "clay" (strokes stay) or "elastic". One undo step; the base is hidden in
-    the GUI. ``symmetry`` and more than one face are not supported yet (ValueError).
+    the GUI. ``symmetry``: None, or a mirror plane (``(point, normal)`` or a plane of the document)
+    the face is symmetric in (with u or v reversed): the sculpt then stays exactly symmetric, a
+    stroke acting mirrored on the other side. More than one face is not supported yet (ValueError).
     """
     doc = _document(doc)
     if not hasattr(base, "Shape") or getattr(base, "Document", None) is not doc:
@@ -91,8 +86,6 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
     if len(faces) > 1:
         raise ValueError("faces: one face per SculptedSolid in this version (several faces sculpted as one "
                          "system are not built yet)")
-    if symmetry is not None:
-        raise ValueError("symmetry: not built yet in this version (give None)")
     controls, degree, mesh = _checked_resolution(controls, degree, mesh)
     if not isinstance(name, str) or not name:
         raise TypeError("name: expected a non-empty string")
@@ -100,17 +93,18 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
     face_name = faces[0]
     edges = face_in_solid.face_edges(shape, face_name)
     kinds = _boundary_kinds(boundary, edges, faces)
-    made = source_surface((base, face_name), controls, degree, (1.0, 1.0), doc, trim_knots(edges, TRIM_SPANS))
-    if made.method != "exact":
-        raise ValueError(f"faces: {face_name} has no exact B-spline form (its trims could not be kept on a fitted "
-                         f"surface); sculpt it as a separate patch with make_sculpt")
+    mirror = None
+    if symmetry is not None:
+        point, normal = face_symmetry.plane_of(symmetry, doc)
+        nface = face_in_solid.nurbs_face(shape.getElement(face_name))
+        mirror = Mirror(face_symmetry.mirror_direction(nface, point, normal, face_name), point, normal)
+    made = face_source(base, face_name, edges, controls, degree, TRIM_SPANS, mirror)
     s = made.surface
-    held = face_in_solid.held_poles(np.asarray(s.knots_u), np.asarray(s.knots_v), tuple(s.degree),
-                                    tuple(s.controls), edges, kinds)
+    held = face_held(made, edges, kinds, mirror)
     if len(held) == s.controls[0] * s.controls[1]:
         raise ValueError(f"boundary: holding the edges as asked holds every pole of {face_name}'s "
                          f"{s.controls[0]} x {s.controls[1]} net (give more controls)")
-    state = _sculpt_state(made, mesh, material, held)
+    state = _sculpt_state(made, mesh, material, held, mirror.settings() if mirror else None)
     if doc.UndoMode == 0:
         doc.UndoMode = 1
     with transaction(doc, "Sculpt solid"):
@@ -121,6 +115,7 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
         obj.SculptFaces = faces
         obj.Boundary = json.dumps(kinds)
         obj.Sculpts = [sculpt]
+        obj.Symmetry = json.dumps(mirror.settings() if mirror else None)
         obj.Resolution = json.dumps({"controls": list(controls), "degree": list(degree), "trim_spans": TRIM_SPANS})
         obj.SourcePoles = np.asarray(s.poles, float).ravel().tolist()
         rebuild(obj)
@@ -144,6 +139,9 @@ def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
     s = sculpt.Proxy.live.snapshot().surface
     held = face_in_solid.held_poles(np.asarray(s.knots_u), np.asarray(s.knots_v), tuple(s.degree),
                                     tuple(s.controls), edges, kinds)
+    mirror = mirror_of(obj)
+    if mirror is not None:
+        held = face_symmetry.symmetric_held(held, mirror.direction, tuple(s.controls))
     if len(held) == s.controls[0] * s.controls[1]:
         raise ValueError(f"boundary: holding the edges as asked holds every pole of the {s.controls[0]} x "
                          f"{s.controls[1]} net")

@@ -104,6 +104,18 @@ void bindDynamicSurface(py::module_& m) {
              "Hard constraints: these poles (index i*nv + j for pole (i, j)) stay exactly where they are, "
              "the others move as if they were walls. Replaces the held set; [] frees them all.")
         .def_property_readonly("held_poles", &DynamicSurface::heldPoles, "Indices of the held poles, ascending.")
+        .def("set_symmetry", [](DynamicSurface& s, int direction, const std::vector<double>& point, const std::vector<double>& normal) {
+            s.setSymmetry(direction, vec3(point, "symmetry point"), vec3(normal, "symmetry normal"));
+        }, py::arg("direction"), py::arg("point"), py::arg("normal"),
+             "Mirror symmetry: the surface is its own mirror image in the plane (point, normal) with parameter "
+             "direction 0 (u) or 1 (v) reversed, and stays exactly so (strokes act mirrored too). Validated: "
+             "ValueError naming symmetry when the net is not symmetric. Direction -1 removes it.")
+        .def_property_readonly("symmetry", [](const DynamicSurface& s) -> py::object {
+            const MirrorSymmetry& sym = s.symmetry();
+            if (sym.empty()) return py::none();
+            return py::make_tuple(sym.direction(), std::vector<double>(sym.point().data(), sym.point().data() + 3),
+                                  std::vector<double>(sym.normal().data(), sym.normal().data() + 3));
+        }, "None, or (direction, point, normal) of the mirror symmetry")
         .def("sampling_matrix", [](const DynamicSurface& s) {
             const CsrMatrix& a = s.sampling().matrix();
             return py::make_tuple(a.rowStart, a.col, a.value, std::make_pair(a.rows, a.cols));

@@ -80,8 +80,9 @@ void DynamicSurface::setPoles(const Points& poles) {
     if (poles.rows() != surface_.poles().rows()) throw std::invalid_argument("poles: wrong number of rows");
     if (!withinRange(poles)) throw std::invalid_argument("poles: must be finite and within +-1e9");
     surface_.mutablePoles() = poles;
-    held_.capture(poles);
     v_.setZero();
+    if (!mirror_.empty()) mirror_.project(surface_.mutablePoles(), v_);
+    held_.capture(surface_.poles());
     avValid_ = history_.valid = false;
     A_.apply(surface_.poles(), d_);
     touch();
@@ -118,8 +119,26 @@ void DynamicSurface::continueFrom(DynamicSurface& live, bool keepMaps) {
 }
 
 void DynamicSurface::holdPoles(const std::vector<int>& indices) {
+    std::vector<int> sorted = indices;
+    std::sort(sorted.begin(), sorted.end());
+    mirror_.requireSymmetric(sorted);
     held_.set(indices, surface_.poles());
     held_.zeroRows(v_);
+    avValid_ = history_.valid = false;
+    accelerationValid_ = verlet_.valid = false;
+    wake();
+}
+
+void DynamicSurface::setSymmetry(int direction, const Vec3& point, const Vec3& normal) {
+    if (direction == -1) {
+        mirror_.clear();
+    } else {
+        mirror_.set(direction, point, normal, surface_, g(), h(), held_.indices());
+        mirror_.project(surface_.mutablePoles(), v_);
+        held_.capture(surface_.poles());
+        A_.apply(surface_.poles(), d_);
+    }
+    clearForces();
     avValid_ = history_.valid = false;
     accelerationValid_ = verlet_.valid = false;
     wake();
@@ -224,7 +243,9 @@ void DynamicSurface::setPointForce(int index, const Vec3& force) {
     if (index < 0 || index >= d_.rows()) throw std::invalid_argument("index: mesh index out of range");
     if (!force.allFinite()) throw std::invalid_argument("force: must be finite");
     const double n = force.norm();
-    fext_.row(index) = (n > maxPointForce ? Vec3(force * (maxPointForce / n)) : force).transpose();
+    const Vec3 f = n > maxPointForce ? Vec3(force * (maxPointForce / n)) : force;
+    if (mirror_.empty()) fext_.row(index) = f.transpose();
+    else mirror_.pointForce(fext_, index, f);
     hasExternal_ = true;
     history_.valid = false;  // the force jumps: BDF2 restarts (see history_.valid)
     touch();
@@ -266,6 +287,7 @@ void DynamicSurface::applyToolForces(double dt, StepReport& r, const Points& at,
     if (tool_->grabbed()) {
         ftool_.setZero();
         r.reaction = tool_->apply({at, g(), h(), spacingU_, spacingV_}, cursor_, dt, ftool_, phase);
+        if (!mirror_.empty()) mirror_.addMirrored(ftool_);
         toolForces_ = true;
         accelerationValid_ = false;
     } else if (toolForces_) {
@@ -329,7 +351,9 @@ StepReport DynamicSurface::step(double dt) {
         r.reason = "the step would produce NaN or Inf; state kept (reduce dt or stiffness)";
         return r;
     }
-    if (!held_.empty() && held_.snap(surface_.mutablePoles(), v_)) {
+    // Symmetry first: the held set is symmetric, so snapping the held poles back keeps it.
+    const bool mirrored = !mirror_.empty() && mirror_.project(surface_.mutablePoles(), v_);
+    if ((!held_.empty() && held_.snap(surface_.mutablePoles(), v_)) || mirrored) {
         A_.apply(surface_.poles(), d_);
         avValid_ = false;
     }

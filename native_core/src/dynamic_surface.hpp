@@ -14,6 +14,7 @@
 #include "held_poles.hpp"
 #include "integrator_state.hpp"
 #include "material_map.hpp"
+#include "mirror_symmetry.hpp"
 #include "prefactored_solver.hpp"
 #include "sampling_operator.hpp"
 #include "sleep_monitor.hpp"
@@ -104,6 +105,13 @@ public:
     /// std::invalid_argument naming "indices" for an index out of range.
     void holdPoles(const std::vector<int>& indices);
     const std::vector<int>& heldPoles() const { return held_.indices(); }
+    /// Mirror symmetry (mirror_symmetry.hpp): the surface is its own mirror image in the plane
+    /// (point, normal) with parameter `direction` (0: u, 1: v) reversed, and stays so: strokes act
+    /// mirrored too, and the poles are put exactly symmetric after every step. Validates (knots,
+    /// weights, poles within 1e-6 of the size, the held poles a symmetric set) and then makes the
+    /// net exactly symmetric; direction -1 removes it.
+    void setSymmetry(int direction, const Vec3& point, const Vec3& normal);
+    const MirrorSymmetry& symmetry() const { return mirror_; }
     /// Mesh index nearest to parameter (u, v), and the parameters of a mesh index.
     int meshIndexAt(double u, double v) const;
     std::pair<double, double> meshParameters(int index) const;
@@ -228,6 +236,8 @@ private:
     bool verletStable(double dt);
     /// The tool's share of Verlet's omega^2 bound; infinite where Verlet is never taken.
     double verletToolTerm() const;
+    /// The tool's slope on a mesh point; twice it with symmetry (the mirrored tool may hold the same point).
+    double toolSlope() const { return (mirror_.empty() ? 1.0 : 2.0) * tool_->slope(); }
     /// Whether omega_max^2 of the springs and penalty terms in control space is provably below
     /// `limit` (verlet_stability_bound.cpp); `tight` makes omega_.upper the computed bound. Allocates
     /// when it recomputes (a new configuration).
@@ -269,6 +279,7 @@ private:
     EnergyGuard guard_;
     SleepMonitor sleep_;
     HeldPoles held_;
+    MirrorSymmetry mirror_;
     // Material: per mesh point masses and damping rates, the maps, springs, constraints, tool.
     Eigen::VectorXd m_, gamma_;
     MaterialMap mass_, damping_, stiffness_;

@@ -89,7 +89,7 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     // at the start, they made the rope scene first order. The tool is explicit, so its own slope
     // limits the prediction as the springs' does (the smooth tool's slope is unknown: none).
     if (w > 0) dd_ = dt * av_ + (0.5 * dt) * (av_ - history_.av);  // the predicted motion over the step (mesh)
-    const double wt = w > 0 && tool_->grabbed() ? std::min(w, extrapolationWeight(dt * dt * tool_->slope() / minMass_)) : 0.0;
+    const double wt = w > 0 && tool_->grabbed() ? std::min(w, extrapolationWeight(dt * dt * toolSlope() / minMass_)) : 0.0;
     if (wt > 0) {
         meshTmp_ = d_ + wt * dd_;
         applyToolForces(dt, r, meshTmp_);

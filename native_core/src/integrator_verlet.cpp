@@ -37,7 +37,7 @@ double DynamicSurface::verletToolTerm() const {
     if (springs_.law.kind != LawKind::Linear || dampingLaw_.kind != LawKind::Linear || constraints_.anyNonConvex())
         return kInf;
     // The tool adds at most slope on each point it holds: omega^2 grows by at most slope / m_min.
-    return tool_->grabbed() ? tool_->slope() / minMass_ : 0.0;
+    return tool_->grabbed() ? toolSlope() / minMass_ : 0.0;
 }
 
 bool DynamicSurface::verletStable(double dt) {
