@@ -2,8 +2,8 @@
 
 This is what a FreeCAD document stores (float lists are saved as binary doubles, JSON floats are
 written with ``repr``), so ``restore(capture(s))`` reproduces ``s`` bit for bit: poles, velocities,
-knots, weights, sampling, rest lengths, material maps, constraints (with their ids), held poles,
-laws, plasticity, tool and integrator settings. No FreeCAD import here.
+knots, weights, sampling, rest lengths, material maps, constraints (with their ids), held and
+linked poles, mirror symmetry, laws, plasticity, tool and integrator settings. No FreeCAD import here.
 """
 from __future__ import annotations
 
@@ -122,6 +122,7 @@ def capture(surface: core.DynamicSurface) -> SculptState:
         "tool": tool_settings(surface),
         "constraints": constraints,
         "held_poles": list(surface.held_poles),
+        "linked_poles": [[pole, [[m, w] for m, w in masters]] for pole, masters in surface.linked_poles],
         "symmetry": _symmetry_settings(surface),
     }
     return SculptState(arrays, settings)
@@ -204,8 +205,14 @@ def restore(state: SculptState) -> core.DynamicSurface:
     held = s.get("held_poles", [])
     if not isinstance(held, list) or not all(isinstance(i, int) and not isinstance(i, bool) for i in held):
         raise ValueError(f"SculptSettings.held_poles: expected a list of pole indices, got {held!r}")
+    links = s.get("linked_poles", [])
     try:
-        surface.hold_poles(held)
+        links = [(int(pole), [(int(m), float(w)) for m, w in masters]) for pole, masters in links]
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"SculptSettings.linked_poles: expected [[pole, [[master, weight], ...]], ...], "
+                         f"got {links!r}") from exc
+    try:
+        surface.hold_poles(held, links)
     except ValueError as exc:
         raise ValueError(f"SculptSettings.held_poles: {exc}") from exc
     sym = s.get("symmetry")

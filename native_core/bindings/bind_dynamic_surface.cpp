@@ -100,10 +100,22 @@ void bindDynamicSurface(py::module_& m) {
         .def("set_velocities", [](DynamicSurface& s, DoubleArray v) {
             s.setVelocities(pointsFrom(v, s.poles().rows(), "velocities"));
         }, py::arg("velocities"))
-        .def("hold_poles", &DynamicSurface::holdPoles, py::arg("indices"),
+        .def("hold_poles", [](DynamicSurface& s, const std::vector<int>& indices,
+                              const std::vector<std::pair<int, std::vector<std::pair<int, double>>>>& links) {
+            std::vector<PoleLink> made;
+            made.reserve(links.size());
+            for (const auto& [pole, masters] : links) made.push_back({pole, masters});
+            s.holdPoles(indices, made);
+        }, py::arg("indices"), py::arg("links") = std::vector<std::pair<int, std::vector<std::pair<int, double>>>>{},
              "Hard constraints: these poles (index i*nv + j for pole (i, j)) stay exactly where they are, "
-             "the others move as if they were walls. Replaces the held set; [] frees them all.")
+             "the others move as if they were walls; each link (pole, [(master, weight), ...]) keeps a pole at "
+             "that combination of its masters (put there at once). Replaces both; [] frees them all.")
         .def_property_readonly("held_poles", &DynamicSurface::heldPoles, "Indices of the held poles, ascending.")
+        .def_property_readonly("linked_poles", [](const DynamicSurface& s) {
+            std::vector<std::pair<int, std::vector<std::pair<int, double>>>> out;
+            for (const PoleLink& l : s.linkedPoles()) out.emplace_back(l.pole, l.masters);
+            return out;
+        }, "The linked poles: [(pole, [(master, weight), ...]), ...]")
         .def("set_symmetry", [](DynamicSurface& s, int direction, const std::vector<double>& point, const std::vector<double>& normal) {
             s.setSymmetry(direction, vec3(point, "symmetry point"), vec3(normal, "symmetry normal"));
         }, py::arg("direction"), py::arg("point"), py::arg("normal"),

@@ -83,6 +83,7 @@ void DynamicSurface::setPoles(const Points& poles) {
     v_.setZero();
     if (!mirror_.empty()) mirror_.project(surface_.mutablePoles(), v_);
     held_.capture(surface_.poles());
+    held_.snap(surface_.mutablePoles(), v_);  // (the linked poles onto their masters)
     avValid_ = history_.valid = false;
     A_.apply(surface_.poles(), d_);
     touch();
@@ -118,12 +119,13 @@ void DynamicSurface::continueFrom(DynamicSurface& live, bool keepMaps) {
     touch();
 }
 
-void DynamicSurface::holdPoles(const std::vector<int>& indices) {
+void DynamicSurface::holdPoles(const std::vector<int>& indices, const std::vector<PoleLink>& links) {
     std::vector<int> sorted = indices;
     std::sort(sorted.begin(), sorted.end());
     mirror_.requireSymmetric(sorted);
-    held_.set(indices, surface_.poles());
-    held_.zeroRows(v_);
+    held_.set(indices, links, surface_.mutablePoles());
+    held_.expand(v_);
+    A_.apply(surface_.poles(), d_);
     avValid_ = history_.valid = false;
     accelerationValid_ = verlet_.valid = false;
     wake();
@@ -148,7 +150,7 @@ void DynamicSurface::setVelocities(const Points& v) {
     if (v.rows() != v_.rows()) throw std::invalid_argument("velocities: wrong number of rows");
     if (!v.allFinite()) throw std::invalid_argument("velocities: contain NaN or Inf");
     v_ = v;
-    held_.zeroRows(v_);
+    held_.expand(v_);
     avValid_ = history_.valid = false;
     touch();
     resetEnergyCeiling();
@@ -425,6 +427,7 @@ void DynamicSurface::checkSleep(double dt) {
     dd_.setZero();
     meshForces(d_, dd_, dt);
     A_.applyTransposed(force_, fp_);
+    held_.reduce(fp_);  // (the held poles' reactions are not motion)
     if (sleep_.settle(fp_.cwiseAbs().maxCoeff(), stiffness_.mean() * size_)) {
         v_.setZero();
         avValid_ = history_.valid = verlet_.valid = false;

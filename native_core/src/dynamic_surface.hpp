@@ -101,10 +101,13 @@ public:
     void setVelocities(const Points& v);
     /// Hard constraints (held_poles.hpp): the poles at `indices` stay exactly where they are now
     /// (also through setPoles, which holds them where the new net puts them), the others move as if
-    /// they were walls. Replaces the held set; an empty list frees them all. Throws
-    /// std::invalid_argument naming "indices" for an index out of range.
-    void holdPoles(const std::vector<int>& indices);
+    /// they were walls; each of `links` stays the combination of its masters it gives (put there at
+    /// once). Replaces both sets; empty lists free them all. Throws std::invalid_argument naming
+    /// "indices" or "links" for what is not valid.
+    void holdPoles(const std::vector<int>& indices, const std::vector<PoleLink>& links = {});
     const std::vector<int>& heldPoles() const { return held_.indices(); }
+    /// Linked poles (held_poles.hpp): each stays the given combination of its masters, exactly.
+    const std::vector<PoleLink>& linkedPoles() const { return held_.links(); }
     /// Mirror symmetry (mirror_symmetry.hpp): the surface is its own mirror image in the plane
     /// (point, normal) with parameter `direction` (0: u, 1: v) reversed, and stays so: strokes act
     /// mirrored too, and the poles are put exactly symmetric after every step. Validates (knots,

@@ -18,8 +18,9 @@ void DynamicSurface::computeAcceleration() {
     A_.apply(v_, dd_);
     explicit_.energy = meshForces(d_, dd_, 0.0) + 0.5 * (m_.asDiagonal() * dd_).cwiseProduct(dd_).sum();
     A_.applyTransposed(force_, fp_);
-    held_.zeroRows(fp_);
+    held_.reduce(fp_);
     massSolver_.solve(fp_, acc_);
+    held_.expand(acc_);
     accelerationValid_ = true;
 }
 

@@ -21,7 +21,7 @@ StepReport DynamicSurface::stepImplicitCG(double dt) {
     stiffnessTimes(dd_, meshTmp2_);
     meshTmp_ = dt * force_ - dt * dt * meshTmp2_;
     A_.applyTransposed(meshTmp_, cg_.r);
-    held_.zeroRows(cg_.r);  // (and of q below: CG stays in the free poles' subspace)
+    held_.reduce(cg_.r);  // (and q below: CG stays in the free poles' subspace, P = T z)
     const double bnorm = std::sqrt(cg_.r.squaredNorm());
     x_.setZero();
     double rnorm = bnorm;
@@ -31,11 +31,17 @@ StepReport DynamicSurface::stepImplicitCG(double dt) {
         double rz = cg_.r.cwiseProduct(cg_.z).sum();
         for (int it = 0; it < solver_.cgIterations; ++it) {
             // q = (Mp + dt Dp + dt^2 Kp) p, applied through the mesh.
-            A_.apply(cg_.p, meshTmp_);
+            if (held_.links().empty()) {
+                A_.apply(cg_.p, meshTmp_);
+            } else {  // T p: the linked poles follow (z is free until the next preconditioning)
+                cg_.z = cg_.p;
+                held_.expand(cg_.z);
+                A_.apply(cg_.z, meshTmp_);
+            }
             stiffnessTimes(meshTmp_, meshTmp2_);
             meshTmp2_ = (m_ + dt * gamma_).asDiagonal() * meshTmp_ + dt * dt * meshTmp2_;
             A_.applyTransposed(meshTmp2_, cg_.q);
-            held_.zeroRows(cg_.q);
+            held_.reduce(cg_.q);
             const double pq = cg_.p.cwiseProduct(cg_.q).sum();
             ++r.iterations;
             if (!(pq > 0)) break;
@@ -51,6 +57,7 @@ StepReport DynamicSurface::stepImplicitCG(double dt) {
         }
     }
     r.residual = bnorm > 0 ? rnorm / bnorm : 0.0;
+    held_.expand(x_);
     v_ += x_;
     Points& p = surface_.mutablePoles();
     p += dt * v_;

@@ -134,8 +134,9 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
         springs_.addProjections(*iterate, meshTmp2_, 0.25 * minMass_ / (h * h), h * h);
         if (!constraints_.empty()) constraints_.addProjections(*iterate, meshTmp2_, terms_, h * h);
         A_.applyTransposed(meshTmp2_, fp_);
-        held_.zeroRows(fp_);
+        held_.reduce(fp_);
         systemSolver_.solve(fp_, acc_);
+        held_.expand(acc_);
         change = acc_.cwiseAbs().maxCoeff();
         x_ += acc_;
         ++r.iterations;

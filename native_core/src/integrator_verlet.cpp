@@ -78,9 +78,11 @@ void DynamicSurface::solveApplied() {
             fp_.row(c) += a.value[static_cast<size_t>(e)] * f.transpose();
         }
     }
+    held_.addMasters(verlet_.appliedPoles, verlet_.poleMark);  // (a linked pole's force goes to its masters)
     for (int c : verlet_.appliedPoles) verlet_.poleMark[static_cast<size_t>(c)] = 0;
-    held_.zeroRows(fp_);
+    held_.reduce(fp_);
     massSolver_.solveSparse(fp_, verlet_.appliedPoles, acc_);
+    held_.expand(acc_);
 }
 
 StepReport DynamicSurface::stepVerlet(double dt) {
@@ -93,8 +95,9 @@ StepReport DynamicSurface::stepVerlet(double dt) {
     if (!verlet_.valid) {
         verletForces(d_, av_);
         A_.applyTransposed(force_, fp_);
-        held_.zeroRows(fp_);
+        held_.reduce(fp_);
         massSolver_.solve(fp_, verlet_.a);
+        held_.expand(verlet_.a);
     }
     if (tool_->grabbed()) {
         meshTmp_ = d_ + (0.5 * h) * av_;
@@ -114,8 +117,9 @@ StepReport DynamicSurface::stepVerlet(double dt) {
     meshTmp_ = (2.0 / h) * (d_ - dPrev_) - av_;
     verlet_.stepPotential = verletForces(d_, meshTmp_);
     A_.applyTransposed(force_, fp_);
-    held_.zeroRows(fp_);
+    held_.reduce(fp_);
     massSolver_.solve(fp_, verlet_.a);
+    held_.expand(verlet_.a);
     v_ += (0.5 * h) * verlet_.a;
     if (applied) v_ += (0.5 * h) * acc_;
     A_.apply(v_, av_);

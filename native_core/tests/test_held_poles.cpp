@@ -3,6 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <array>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "dynamic_surface.hpp"
@@ -217,4 +222,121 @@ TEST(HeldPoles, AnIndexOutOfRangeIsRefusedByName) {
         EXPECT_NE(std::string(e.what()).find("indices: pole index 16 outside 0..15"), std::string::npos) << e.what();
     }
     EXPECT_TRUE(s.heldPoles().empty());  // nothing changed
+}
+
+namespace {
+
+/// Two patches joined along u = 0.5 (a knot of full multiplicity: C0 there), 7 x 8 poles, the
+/// seam's pole row 3. Linking each seam pole to the mean of its neighbours across the seam keeps
+/// the tangent plane continuous (G1).
+std::unique_ptr<DynamicSurface> twoPatches() {
+    const BSplineSurface flat = BSplineSurface::plane(7, 8, 3, 3, 100, 80);
+    BSplineSurface joined(7, 8, 3, 3, {0, 0, 0, 0, 0.5, 0.5, 0.5, 1, 1, 1, 1}, clampedUniformKnots(8, 3), flat.poles(), {});
+    Points poles = flat.poles();  // Greville spacing of the joined knots: even in u
+    for (int i = 0; i < 7; ++i)
+        for (int j = 0; j < 8; ++j) poles(i * 8 + j, 0) = (std::array<double, 7>{0, 1, 2, 3, 4, 5, 6}[i] / 6.0 - 0.5) * 100;
+    joined.mutablePoles() = poles;
+    return std::make_unique<DynamicSurface>(joined, 31, 24);
+}
+
+std::vector<int> outerRing() {
+    std::vector<int> out;
+    for (int i = 0; i < 7; ++i)
+        for (int j = 0; j < 8; ++j)
+            if (i == 0 || i == 6 || j == 0 || j == 7) out.push_back(i * 8 + j);
+    return out;
+}
+
+std::vector<PoleLink> seamLinks() {
+    std::vector<PoleLink> links;
+    for (int j = 1; j < 7; ++j) links.push_back({3 * 8 + j, {{2 * 8 + j, 0.5}, {4 * 8 + j, 0.5}}});
+    return links;
+}
+
+/// Largest angle (radians) between the derivatives across the seam from its two sides.
+double seamKink(const BSplineSurface& s) {
+    double worst = 0;
+    for (int k = 0; k <= 20; ++k) {
+        const double v = k / 20.0;
+        const Vec3 a = s.evaluate(0.5 - 1e-12, v, 1).su, b = s.evaluate(0.5 + 1e-12, v, 1).su;
+        worst = std::max(worst, std::atan2(a.cross(b).norm(), a.dot(b)));
+    }
+    return worst;
+}
+
+}  // namespace
+
+TEST_P(HeldPolesTest, LinkedPolesKeepTheTangentPlaneAcrossASeam) {
+    const Scheme setup = GetParam();
+    for (bool linked : {true, false}) {
+        auto made = twoPatches();
+        DynamicSurface& s = *made;
+        configure(s, setup);
+        s.holdPoles(outerRing(), linked ? seamLinks() : std::vector<PoleLink>{});
+        Cursor c;
+        c.position = Vec3(-20, 0, 0);  // on the left patch, near the seam
+        c.grab = true;
+        for (int k = 0; k < 300; ++k) {
+            c.position.z() = std::min(15.0, 0.1 * k);
+            s.setCursor(c);
+            const StepReport r = s.step(setup.dt);
+            ASSERT_FALSE(r.refused) << setup.name << ": " << r.reason;
+        }
+        if (!linked) {
+            EXPECT_GT(seamKink(s.surface()), 1e-3) << setup.name << ": without links the seam kinks (the test can fail)";
+            continue;
+        }
+        EXPECT_LT(seamKink(s.surface()), 1e-9) << setup.name;  // (rounding of the derivatives)
+        for (int j = 1; j < 7; ++j) {
+            Vec3 mean = Vec3::Zero();
+            mean += 0.5 * s.poles().row(2 * 8 + j).transpose();
+            mean += 0.5 * s.poles().row(4 * 8 + j).transpose();
+            EXPECT_EQ(s.poles().row(3 * 8 + j), mean.transpose()) << setup.name;
+        }
+        EXPECT_GT(s.poles()(3 * 8 + 4, 2), 1.0) << setup.name << ": the seam moved with the stroke";
+    }
+}
+
+TEST_P(HeldPolesTest, SteppingWithLinkedPolesDoesNotAllocate) {
+    const Scheme setup = GetParam();
+    auto made = twoPatches();
+    DynamicSurface& s = *made;
+    configure(s, setup);
+    s.holdPoles(outerRing(), seamLinks());
+    Cursor c;
+    c.grab = true;
+    s.setCursor(c);
+    s.step(setup.dt);
+    s.step(setup.dt);
+    const long before = allocationCount();
+    for (int k = 0; k < 50; ++k) {
+        c.position.z() += 0.05;
+        s.setCursor(c);
+        s.step(setup.dt);
+    }
+    EXPECT_EQ(allocationCount() - before, 0) << setup.name;
+}
+
+TEST(HeldPoles, BadLinksAreRefusedByName) {
+    auto made = twoPatches();
+    DynamicSurface& s = *made;
+    const std::vector<std::pair<std::vector<PoleLink>, std::string>> cases = {
+        {{{99, {{1, 1.0}}}}, "links: pole 99 outside"},
+        {{{0, {{1, 1.0}}}}, "links: pole 0 is held"},
+        {{{26, {{1, 1.0}}}, {26, {{2, 1.0}}}}, "links: pole 26 is linked twice"},
+        {{{26, {}}}, "links: pole 26 has no masters"},
+        {{{26, {{26, 1.0}}}}, "master 26 is not another pole"},
+        {{{26, {{27, 1.0}}}, {27, {{28, 1.0}}}}, "master 27 is linked itself"},
+        {{{26, {{27, std::nan("")}}}}, "weights must be finite"},
+    };
+    for (const auto& [links, text] : cases) {
+        try {
+            s.holdPoles({0}, links);
+            ADD_FAILURE() << "no error, expected " << text;
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+        }
+    }
+    EXPECT_TRUE(s.heldPoles().empty());
+    EXPECT_TRUE(s.linkedPoles().empty());
 }
