@@ -16,7 +16,7 @@ from freecad_support import DocumentTestCase, run_ocp
 
 import HapticSculpt as hs
 from HapticSculpt.app.face_in_solid import face_edges, nurbs_face
-from HapticSculpt.app.sculpted_solid import sculpted_surface
+from HapticSculpt.app.sculpted_solid import chain_of_solid, sculpted_surface
 
 if "/usr/share/freecad/Mod" not in sys.path:
     sys.path.append("/usr/share/freecad/Mod")  # the PartDesign package, on FreeCAD's own path in freecadcmd
@@ -118,7 +118,8 @@ class SolidChecks(DocumentTestCase):
     def check_sculpted(self, obj, base, face_name, min_volume=1.0):
         """Valid closed solid, volume change = displaced volume (1 %), seams within OCCT's precision,
         neighbours untouched, same topology, holes kept; its STEP file read back by OCP is the same
-        solid. Returns the volume change."""
+        solid. ``face_name``: the sculpted face, or a list of them. Returns the volume change."""
+        names = [face_name] if isinstance(face_name, str) else list(face_name)
         shape, before = obj.Shape, base.Shape
         self.assertEqual(obj.RebuildError, "")
         self.assertTrue(shape.isValid())
@@ -128,7 +129,8 @@ class SolidChecks(DocumentTestCase):
         ocp = self.volumes(obj, base)
         change = ocp["solid"]["volume"] - ocp["base"]["volume"]
         self.assertGreater(abs(change), min_volume, "the stroke moved the face")
-        displaced = displaced_volume(before, face_name, sculpted_surface(obj.Sculpts[0]))
+        pieces = chain_of_solid(obj, before).split(sculpted_surface(obj.Sculpts[0]))
+        displaced = sum(displaced_volume(before, f, pieces[f]) for f in names)
         self.assertLess(abs(change - displaced), 0.01 * abs(displaced), (change, displaced))
         report = hs.seam_report_of(obj)
         kinds = hs.boundary_of(obj)
@@ -139,9 +141,9 @@ class SolidChecks(DocumentTestCase):
                 self.assertLessEqual(r["g1_deg"], 0.01, r)
             else:
                 self.assertIsNone(r["g1_deg"])
-        sculpted = before.getElement(face_name)
+        sculpted = [before.getElement(f) for f in names]
         for k, f in enumerate(before.Faces):  # every other face is still there, unchanged
-            if f.isSame(sculpted):
+            if any(f.isSame(g) for g in sculpted):
                 continue
             match = [g for g in shape.Faces if abs(g.Area - f.Area) < 1e-9 * f.Area
                      and g.CenterOfMass.distanceToPoint(f.CenterOfMass) < 1e-9]
@@ -150,8 +152,8 @@ class SolidChecks(DocumentTestCase):
         new = [g for g in shape.Faces if not any(abs(g.Area - f.Area) < 1e-9 * f.Area and
                                                  g.CenterOfMass.distanceToPoint(f.CenterOfMass) < 1e-9
                                                  for f in before.Faces)]
-        self.assertEqual(len(new), 1)
-        self.assertEqual(len(new[0].Wires), len(sculpted.Wires), "holes stay holes")
+        self.assertEqual(len(new), len(names))
+        self.assertEqual(sorted(len(g.Wires) for g in new), sorted(len(f.Wires) for f in sculpted), "holes stay holes")
         step = ocp["step"]
         self.assertEqual((step["solids"], step["valid"], step["faces"]), (1, True, len(shape.Faces)))
         self.assertLess(abs(step["volume"] - ocp["solid"]["volume"]), 1e-6 * ocp["solid"]["volume"])
@@ -300,6 +302,83 @@ def mirror_distance(surface, point, normal, direction, n=61):
             q = surface.value(u0 + u1 - u, v) if direction == 0 else surface.value(u, v0 + v1 - v)
             worst = max(worst, float(np.linalg.norm(p - 2 * (p - point).dot(normal) * normal - np.array(tuple(q)))))
     return worst
+
+
+def displaced_by_face(obj, base, names):
+    """Each sculpted face's displaced volume (see displaced_volume)."""
+    pieces = chain_of_solid(obj, base.Shape).split(sculpted_surface(obj.Sculpts[0]))
+    return {f: displaced_volume(base.Shape, f, pieces[f]) for f in names}
+
+
+class TestSeveralFaces(SolidChecks):
+    def filleted_box(self):
+        box = Part.makeBox(40, 30, 10)
+        edge = next(e for e in box.Edges if abs(e.CenterOfMass.z - 10) < 1e-9 and abs(e.CenterOfMass.y) < 1e-9)
+        part = self.part(box.makeFillet(4, [edge]))
+        top = face_named(part.Shape, lambda f: isinstance(f.Surface, Part.Plane) and abs(f.CenterOfMass.z - 10) < 1e-9)
+        fillet = face_named(part.Shape, lambda f: isinstance(f.Surface, Part.Cylinder))
+        return part, top, fillet
+
+    def test_a_top_and_its_fillet_sculpted_as_one_stay_tangent_across_the_seam(self):
+        part, top, fillet = self.filleted_box()
+        obj = hs.sculpt_solid(self.doc, part, [top, fillet], boundary="G1")
+        seam = next(e.name for e in face_edges(part.Shape, top) if fillet in e.neighbours)
+        self.assertEqual(hs.boundary_of(obj)[seam], "G1")  # they meet tangentially
+        self.assertTrue(obj.Sculpts[0].Proxy.live.snapshot().linked_poles)
+        # a stroke across the seam: grabbed on the top beside it, pulled up and out over the fillet
+        pull(obj, (20, 4.5, 10), (0, -3, 4))
+        self.check_sculpted(obj, part, [top, fillet])
+        moved = displaced_by_face(obj, part, [top, fillet])
+        self.assertGreater(abs(moved[top]), 10.0, moved)
+        self.assertGreater(abs(moved[fillet]), 5.0, moved)  # the stroke pulled both faces
+        angle = next(r for r in hs.seam_report_of(obj) if r["edge"] == seam)["g1_deg"]
+        self.assertLessEqual(angle, 0.01)
+        # undo/redo and save/reopen restore it exactly, links and all
+        volume = obj.Shape.Volume
+        self.doc.undo()
+        self.doc.redo()
+        self.assertEqual(obj.Shape.Volume, volume)
+        path = os.path.join(self.tmp, "two_faces.FCStd")
+        self.doc.saveAs(path)
+        name = obj.Name
+        FreeCAD.closeDocument(self.doc.Name)
+        self.doc = FreeCAD.openDocument(path)
+        again = self.doc.getObject(name)
+        self.assertEqual(again.Shape.Volume, volume)
+        pull(again, mass_point_near(again, 30, 6), (0, 0, -2))
+        self.check_sculpted(again, self.doc.getObject("Part"), [top, fillet], min_volume=0.0)
+
+    def test_two_sides_of_a_loft_keep_their_crease(self):
+        bottom = Part.makePolygon([FreeCAD.Vector(x, y, 0) for x, y in ((0, 0), (40, 0), (40, 30), (0, 30), (0, 0))])
+        upper = Part.makePolygon([FreeCAD.Vector(x, y, 25) for x, y in ((8, 6), (32, 6), (32, 24), (8, 24), (8, 6))])
+        loft = self.part(Part.makeLoft([bottom, upper], True, False), "Loft")
+        sides = [f"Face{k + 1}" for k, f in enumerate(loft.Shape.Faces) if abs(f.normalAt(0.5, 0.5).z) < 0.99]
+        front = next(f for f in sides if loft.Shape.getElement(f).CenterOfMass.y < 5)
+        right = next(f for f in sides if loft.Shape.getElement(f).CenterOfMass.x > 35)
+        obj = hs.sculpt_solid(self.doc, loft, [front, right])
+        seam = next(e.name for e in face_edges(loft.Shape, front) if right in e.neighbours)
+        self.assertEqual(hs.boundary_of(obj)[seam], "G0")  # a crease: it stays joined, not tangent
+        corner = loft.Shape.getElement(seam).valueAt(loft.Shape.getElement(seam).FirstParameter +
+                                                     0.5 * (loft.Shape.getElement(seam).LastParameter -
+                                                            loft.Shape.getElement(seam).FirstParameter))
+        pull(obj, mass_point_near(obj, corner.x - 2, corner.y + 2), (3, -3, 0))
+        self.check_sculpted(obj, loft, [front, right])
+        moved = displaced_by_face(obj, loft, [front, right])
+        self.assertTrue(all(abs(v) > 1.0 for v in moved.values()), moved)
+
+    def test_faces_that_cannot_be_joined_are_refused(self):
+        part, top, fillet = self.filleted_box()
+        bottom = face_named(part.Shape, lambda f: abs(f.CenterOfMass.z) < 1e-9)
+        ends = [f"Face{k + 1}" for k, f in enumerate(part.Shape.Faces) if abs(f.CenterOfMass.x) < 1e-9
+                or abs(f.CenterOfMass.x - 40) < 1e-9]
+        count = len(self.doc.Objects)
+        for faces, kwargs, words in (([top, bottom], {}, "shares no edge"),
+                                     ([top, fillet, ends[0]], {}, "close into a ring"),
+                                     ([top, fillet], {"symmetry": ((20, 0, 0), (1, 0, 0))}, "symmetry: for one face")):
+            with self.assertRaises(ValueError, msg=faces) as caught:
+                hs.sculpt_solid(self.doc, part, faces, **kwargs)
+            self.assertIn(words, str(caught.exception))
+        self.assertEqual(len(self.doc.Objects), count)
 
 
 class TestSymmetricSculpt(SolidChecks):

@@ -112,16 +112,16 @@ def _checked_resolution(controls: Any, degree: Any, mesh: Any) -> tuple[tuple[in
 
 
 def _sculpt_state(made: Any, mesh: tuple[int, int], material: str, held: Sequence[int] = (),
-                  symmetry: dict[str, Any] | None = None) -> sculpt_state.SculptState:
-    """The state of a new sculpt of ``made`` (a SourceSurface) sampled at ``mesh``, poles ``held``,
-    mirror ``symmetry`` (face_net.Mirror.settings()) or none."""
+                  symmetry: dict[str, Any] | None = None, links: Sequence[Any] = ()) -> sculpt_state.SculptState:
+    """The state of a new sculpt of ``made`` (a SourceSurface) sampled at ``mesh``, poles ``held``
+    and ``links`` linked, mirror ``symmetry`` (face_net.Mirror.settings()) or none."""
     nu, nv = made.surface.controls
     if mesh[0] < nu or mesh[1] < nv:
         raise ValueError(f"mesh: must be at least the control resolution {(nu, nv)}, got {mesh}")
     surface = core.DynamicSurface(made.surface, mesh)
     _apply_material(surface, material)
-    if held:
-        surface.hold_poles(list(held))
+    if held or links:
+        surface.hold_poles(list(held), list(links))
     if symmetry is not None:
         surface.set_symmetry(symmetry["direction"], symmetry["point"], symmetry["normal"])
     return sculpt_state.capture(surface)

@@ -225,16 +225,20 @@ def solid_with(shape: Any, replaced: dict[str, Any], tolerance: float = 1e-6) ->
     return solid
 
 
-def seam_report(surface: Any, shape: Any, face_name: str, kinds: dict[str, str]) -> list[dict[str, Any]]:
+def seam_report(surface: Any, shape: Any, face_name: str, kinds: dict[str, str],
+                skip: frozenset[str] = frozenset()) -> list[dict[str, Any]]:
     """For each edge of ``shape``'s face ``face_name`` sculpted to ``surface``: the largest distance
     (mm) between the sculpted surface along the edge's (u, v) curve and the edge itself (``g0_mm``:
     the neighbours still meet the edge), and for G1 edges the largest angle (degrees) between the
     sculpted and the original normal there (``g1_deg``; None for the others), at SEAM_SAMPLES
-    points per edge (per side of a seam)."""
+    points per edge (per side of a seam). Edges in ``skip`` (seams between sculpted faces, see
+    :func:`seam_between`) are left out."""
     nface = nurbs_face(shape.getElement(face_name))
     original = nface.Surface
     report: dict[str, dict[str, Any]] = {}
     for name, occ in named_occurrences(shape, face_name, nface):
+        if name in skip:
+            continue
         uv, ts = _pcurve_points(nface, occ, SEAM_SAMPLES)
         gap = max((surface.value(u, v) - occ.valueAt(t)).Length for (u, v), t in zip(uv, ts))
         entry = report.setdefault(name, {"edge": name, "g0_mm": 0.0, "g1_deg": None})
@@ -244,3 +248,28 @@ def seam_report(surface: Any, shape: Any, face_name: str, kinds: dict[str, str])
             angle = float(np.degrees(np.arccos(max(-1.0, min(1.0, min(cosines))))))
             entry["g1_deg"] = max(entry["g1_deg"] or 0.0, angle)
     return sorted(report.values(), key=lambda r: int(r["edge"][4:]))
+
+
+def seam_between(surfaces: dict[str, Any], shape: Any, faces: tuple[str, str], edge: str, kind: str) -> dict[str, Any]:
+    """The seam ``edge`` between two sculpted faces (``surfaces``: face name to its sculpted surface
+    in its own parameters): the largest distance between the two surfaces along it (``g0_mm``)
+    and, for G1, the largest angle (degrees) between their normals there (``g1_deg``), at
+    SEAM_SAMPLES points (the edge's pcurves on both faces share its parameter)."""
+    sides, originals = [], []
+    for f in faces:
+        nface = nurbs_face(shape.getElement(f))
+        occ = next(o for n, o in named_occurrences(shape, f, nface) if n == edge)
+        uv, ts = _pcurve_points(nface, occ, SEAM_SAMPLES)
+        sign = -1.0 if nface.Orientation == "Reversed" else 1.0
+        surface = surfaces[f]
+        sides.append([(surface.value(u, v), surface.normal(u, v) * sign) for u, v in uv])
+        originals.append([occ.valueAt(t) for t in ts])
+    drift = max((a - b).Length for a, b in zip(*originals))
+    if drift > 1e-7:  # (both faces' conversions keep the edge's parameter; this says if one did not)
+        raise RuntimeError(f"{edge}: the two faces' curves of it are parameterised differently ({drift:.3g} mm apart)")
+    gap = max((a[0] - b[0]).Length for a, b in zip(*sides))
+    angle = None
+    if kind == "G1":
+        cosines = [a[1].dot(b[1]) for a, b in zip(*sides)]
+        angle = float(np.degrees(np.arccos(max(-1.0, min(1.0, min(cosines))))))
+    return {"edge": edge, "g0_mm": float(gap), "g1_deg": angle}

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from . import face_in_solid, face_symmetry
+from .face_chain import FaceChain, g1_links, joined_surface, seam_row
 from .source_surface import SourceSurface, source_surface
 
 #: Extra knots around a trim inside the face (a hole, an edge cut by a fillet), per direction, over
@@ -58,20 +59,26 @@ def trim_knots(edges: list[face_in_solid.FaceEdge], spans: int) -> tuple[list[fl
     return extra
 
 
-def face_source(base: Any, face_name: str, edges: list[face_in_solid.FaceEdge], controls: tuple[int, int],
+def face_source(base: Any, chain: FaceChain, edges: list[face_in_solid.FaceEdge], controls: tuple[int, int],
                 degree: tuple[int, int], trim_spans: int, mirror: Mirror | None) -> SourceSurface:
-    """The face's exact B-spline form on its sculpting net; ValueError if it has none."""
+    """The chain's faces (one face, or several joined) in exact B-spline form on their sculpting
+    net, in the joined parameters; ``edges`` (in them too) give the trims. ValueError if a face
+    has no exact form."""
     extra = trim_knots(edges, trim_spans)
-    made = source_surface((base, face_name), controls, degree, (1.0, 1.0), base.Document, extra)
+    if len(chain.placements) == 1:
+        source: Any = (base, chain.faces[0])
+    else:
+        source = joined_surface(base.Shape, chain, degree)
+    made = source_surface(source, controls, degree, (1.0, 1.0), base.Document, extra)
     if made.method == "exact" and mirror is not None:
         knots = made.surface.knots_u if mirror.direction == 0 else made.surface.knots_v
         missing = face_symmetry.mirrored_knots(knots)
         if missing:
             extra[mirror.direction].extend(list(knots) + missing)
-            made = source_surface((base, face_name), controls, degree, (1.0, 1.0), base.Document, extra)
+            made = source_surface(source, controls, degree, (1.0, 1.0), base.Document, extra)
     if made.method != "exact":
-        raise ValueError(f"faces: {face_name} has no exact B-spline form (its trims could not be kept on a fitted "
-                         f"surface); sculpt it as a separate patch with make_sculpt")
+        raise ValueError(f"faces: {', '.join(chain.faces)} has no exact B-spline form (its trims could not be kept "
+                         f"on a fitted surface); sculpt it as a separate patch with make_sculpt")
     return made
 
 
@@ -84,3 +91,32 @@ def face_held(made: SourceSurface, edges: list[face_in_solid.FaceEdge], kinds: d
     if mirror is not None:
         held = face_symmetry.symmetric_held(held, mirror.direction, tuple(s.controls))
     return held
+
+
+def seam_links(made: SourceSurface, chain: FaceChain, kinds: dict[str, str], held: list[int]) -> list[Any]:
+    """The linked poles that keep the tangent planes matched across each G1 seam of the chain."""
+    s = made.surface
+    nu, nv = s.controls
+    poles = np.asarray(s.poles, float).reshape(nu, nv, 3)
+    weights = np.asarray(s.weights, float).reshape(nu, nv) if s.weights is not None else None
+    links: list[Any] = []
+    for seam in chain.seams:
+        if kinds.get(seam.edge) == "G1":
+            row = seam_row(np.asarray(s.knots_u), seam.u)
+            links += g1_links(poles, weights, row, set(held), seam.edge)
+    return links
+
+
+def seam_kinds(made: SourceSurface, chain: FaceChain, kinds: dict[str, str], asked: set[str]) -> dict[str, str]:
+    """``kinds`` with each seam not ``asked`` about made G1 where its faces meet tangentially (so
+    G1 can hold there) and G0 where they meet at an angle."""
+    out = dict(kinds)
+    for seam in chain.seams:
+        if seam.edge in asked:
+            continue
+        try:
+            seam_links(made, chain, {seam.edge: "G1"}, [])
+            out[seam.edge] = "G1"
+        except ValueError:
+            out[seam.edge] = "G0"
+    return out

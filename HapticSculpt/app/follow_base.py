@@ -18,17 +18,18 @@ import numpy as np
 
 from .. import core
 from . import face_in_solid, sculpt_state
-from .face_net import face_held, face_source, mirror_of
+from .face_chain import FaceChain, chain_of
+from .face_net import face_held, face_source, mirror_of, seam_links
 from .sculpt_properties import face_of, read_state, write_state
 
 #: Grid (per direction) on which the displacement is sampled and fitted.
 FIT_SAMPLES = 48
 
 
-def source_of(obj: Any, shape: Any, edges: list[face_in_solid.FaceEdge]) -> Any:
-    """The base face's exact B-spline surface at the SculptedSolid's resolution (a SourceSurface)."""
+def source_of(obj: Any, chain: FaceChain, edges: list[face_in_solid.FaceEdge]) -> Any:
+    """The base faces' exact B-spline surface at the SculptedSolid's resolution (a SourceSurface)."""
     res = json.loads(obj.Resolution)
-    return face_source(obj.Base, obj.SculptFaces[0], edges, tuple(res["controls"]), tuple(res["degree"]),
+    return face_source(obj.Base, chain, edges, tuple(res["controls"]), tuple(res["degree"]),
                        int(res["trim_spans"]), mirror_of(obj))
 
 
@@ -63,9 +64,9 @@ def follow_base(obj: Any, shape: Any) -> bool:
     if not obj.Resolution or not obj.SourcePoles:
         return False  # (made before sculpts followed their base: nothing to compare with)
     sculpt = obj.Sculpts[0]
-    face_name = obj.SculptFaces[0]
-    edges = face_in_solid.face_edges(shape, face_name)
-    made = source_of(obj, shape, edges)
+    chain = chain_of(shape, list(obj.SculptFaces))
+    edges = chain.edges(shape)
+    made = source_of(obj, chain, edges)
     new_source = made.surface
     old = read_state(sculpt)
     nu, nv = old.settings["controls"]
@@ -82,8 +83,10 @@ def follow_base(obj: Any, shape: Any) -> bool:
                                      old.arrays["KnotsU"], old.arrays["KnotsV"], weights)
     sculpted = core.BSplineSurface(old.arrays["Poles"].reshape(nu, nv, 3), tuple(old.settings["degree"]),
                                    old.arrays["KnotsU"], old.arrays["KnotsV"], weights)
-    kinds = {e.name: json.loads(obj.Boundary).get(e.name, "G0") for e in edges}
+    boundary = json.loads(obj.Boundary)
+    kinds = {name: boundary.get(name, "G0") for name in [e.name for e in edges] + sorted(chain.seam_edges())}
     held = face_held(made, edges, kinds, mirror_of(obj))
+    links = seam_links(made, chain, kinds, held)
     poles = carried_poles(old_source, sculpted, new_source, held)
     mesh = tuple(old.settings["mesh"])
     carried = core.BSplineSurface(poles.reshape(*new_source.controls, 3), new_source.degree, new_source.knots_u,
@@ -99,9 +102,10 @@ def follow_base(obj: Any, shape: Any) -> bool:
                   RestLengths=rest)
     dropped = len(old.settings.get("constraints", []))
     settings = dict(old.settings, controls=list(new_source.controls), held_poles=held, constraints=[],
+                    linked_poles=[[p, [list(m) for m in masters]] for p, masters in links],
                     reference=moved.settings["reference"])
-    state = sculpt_state.SculptState(arrays, settings)
-    sculpt_state.restore(state)  # (validates before anything is written)
+    # (restoring validates before anything is written, and puts the linked poles onto their masters)
+    state = sculpt_state.capture(sculpt_state.restore(sculpt_state.SculptState(arrays, settings)))
     live = sculpt.Proxy.live
     live.writing = True
     try:
@@ -112,6 +116,7 @@ def follow_base(obj: Any, shape: Any) -> bool:
     live.document_changed()
     obj.SourcePoles = np.asarray(new_source.poles, float).ravel().tolist()
     obj.Boundary = json.dumps(kinds)
+    obj.Layout = chain.dumps() if len(chain.placements) > 1 else ""
     if dropped:
         import FreeCAD
         FreeCAD.Console.PrintWarning(f"HapticSculpt: {obj.Label}: the base changed; the sculpt follows it, its "

@@ -15,6 +15,7 @@ import json
 from typing import Any
 
 from . import face_in_solid
+from .face_chain import FaceChain, single
 from .sculpt_properties import read_state, surface_of
 from .view_provider_hook import ViewProviderHook
 
@@ -38,6 +39,8 @@ def ensure_properties(obj: Any) -> None:
             ("App::PropertyString", "RebuildError", "Why the solid could not be rebuilt (empty when it could)", 1),
             ("App::PropertyString", "Symmetry", "The mirror plane the sculpt stays symmetric in: null, or its point, "
                                                 "normal and the parameter direction it reverses (JSON)", 1),
+            ("App::PropertyString", "Layout", "Where each sculpted face sits in the one surface they are sculpted "
+                                              "as, and the seams between them (JSON; empty for one face)", 2),
             ("App::PropertyString", "Resolution", "The least net the faces were converted to (JSON)", 2),
             ("App::PropertyFloatList", "SourcePoles", "The poles of the face the sculpt was made from (the base "
                                                      "changed: the sculpt follows it)", 2)):
@@ -144,16 +147,23 @@ def solid_of(sculpt: Any) -> Any:
     return next((o for o in getattr(sculpt, "InList", []) if is_sculpted_solid(o)), None)
 
 
+def chain_of_solid(obj: Any, shape: Any = None) -> Any:
+    """The FaceChain of a SculptedSolid's faces (one face: placed as it is)."""
+    if getattr(obj, "Layout", ""):
+        return FaceChain.loads(obj.Layout)
+    return single(base_solid(obj.Base) if shape is None else shape, obj.SculptFaces[0])
+
+
 def trim_mask(sculpt: Any, us: Any, vs: Any) -> Any:
-    """Which points of the (us x vs) parameter grid lie on the face ``sculpt`` sculpts in its solid
-    (inside its outer wire, outside its holes): a (len(us), len(vs)) bool array; None for a sculpt
-    that is not part of a SculptedSolid (all of its domain is the face)."""
+    """Which points of the (us x vs) parameter grid lie on the faces ``sculpt`` sculpts in its
+    solid (inside their outer wires, outside their holes): a (len(us), len(vs)) bool array; None
+    for a sculpt that is not part of a SculptedSolid (all of its domain is the face)."""
     import numpy as np
     solid = solid_of(sculpt)
     if solid is None or solid.Base is None:
         return None
-    nface = face_in_solid.nurbs_face(solid.Base.Shape.getElement(solid.SculptFaces[0]))
-    return np.array([[nface.isPartOfDomain(float(u), float(v)) for v in vs] for u in us], dtype=bool)
+    shape = solid.Base.Shape
+    return chain_of_solid(solid, shape).on_faces(shape, np.asarray(us, float), np.asarray(vs, float))
 
 
 def boundary_of(obj: Any) -> dict[str, str]:
@@ -183,15 +193,20 @@ def sculpted_surface(sculpt: Any, state: Any = None) -> Any:
     return surface_of(read_state(sculpt) if state is None else state)
 
 
+def _pieces(obj: Any, shape: Any, state: Any = None) -> tuple[Any, dict[str, Any]]:
+    """The chain and each sculpted face's surface in its own parameters."""
+    chain = chain_of_solid(obj, shape)
+    return chain, chain.split(sculpted_surface(sculpt_of(obj), state))
+
+
 def preview(obj: Any, frame: Any) -> Any:
-    """The base's faces with the (one) sculpted face from ``frame`` (a SculptState), as a compound."""
+    """The base's faces with the sculpted ones from ``frame`` (a SculptState), as a compound."""
     import Part
     shape = base_solid(obj.Base)
-    face_name = obj.SculptFaces[0]
-    face = shape.getElement(face_name)
-    kept = [f for f in shape.Faces if not f.isSame(face)]
-    new = face_in_solid.trimmed_face(sculpted_surface(obj.Sculpts[0], frame), face_in_solid.nurbs_face(face))
-    return Part.Compound(kept + [new])
+    chain, pieces = _pieces(obj, shape, frame)
+    new = {f: face_in_solid.trimmed_face(pieces[f], face_in_solid.nurbs_face(shape.getElement(f))) for f in pieces}
+    kept = [f for k, f in enumerate(shape.Faces) if f"Face{k + 1}" not in new]
+    return Part.Compound(kept + list(new.values()))
 
 
 def rebuild(obj: Any) -> None:
@@ -202,15 +217,21 @@ def rebuild(obj: Any) -> None:
             raise ValueError("no base solid")
         shape = base_solid(obj.Base)
         kinds = boundary_of(obj)
-        replaced, report = {}, []
-        for face_name, sculpt in zip(obj.SculptFaces, obj.Sculpts):
+        for face_name in obj.SculptFaces:
             try:
-                face = shape.getElement(face_name)
+                shape.getElement(face_name)
             except Exception as exc:  # noqa: BLE001 - FreeCAD raises several types for a missing element
                 raise ValueError(f"{obj.Base.Label} has no {face_name} any more") from exc
-            surface = sculpted_surface(sculpt)
-            replaced[face_name] = face_in_solid.trimmed_face(surface, face_in_solid.nurbs_face(face))
-            report += face_in_solid.seam_report(surface, shape, face_name, kinds)
+        chain, pieces = _pieces(obj, shape)
+        seams = frozenset(chain.seam_edges())
+        replaced, report = {}, []
+        for face_name in chain.faces:
+            nface = face_in_solid.nurbs_face(shape.getElement(face_name))
+            replaced[face_name] = face_in_solid.trimmed_face(pieces[face_name], nface)
+            report += face_in_solid.seam_report(pieces[face_name], shape, face_name, kinds, seams)
+        for seam in chain.seams:
+            report.append(face_in_solid.seam_between(pieces, shape, seam.faces, seam.edge, kinds.get(seam.edge, "G0")))
+        report.sort(key=lambda r: int(r["edge"][4:]))
         solid = face_in_solid.solid_with(shape, replaced)
     except (RuntimeError, ValueError) as exc:
         if obj.RebuildError != str(exc):

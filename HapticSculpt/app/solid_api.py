@@ -8,14 +8,15 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from . import face_in_solid, face_symmetry, sculpt_state
+from . import face_chain, face_in_solid, face_symmetry, sculpt_state
 from .api import _add_sculpt, _checked_resolution, _document, _material, _sculpt_state
-from .face_net import TRIM_SPANS, Mirror, face_held, face_source, mirror_of
+from .face_net import TRIM_SPANS, Mirror, face_held, face_source, mirror_of, seam_kinds, seam_links
 from .sculpted_solid import (
     SculptedSolidFeature,
     attach_view_provider,
     base_solid,
     boundary_of,
+    chain_of_solid,
     is_sculpted_solid,
     rebuild,
     sculpt_of,
@@ -51,22 +52,52 @@ def _boundary_kinds(boundary: Any, edges: list[face_in_solid.FaceEdge], faces: S
     return kinds
 
 
+def _seam_edges(shape: Any, chain: face_chain.FaceChain) -> list[face_in_solid.FaceEdge]:
+    """The seams between the chain's faces as edges (for the boundary's names and checks)."""
+    return [face_in_solid.FaceEdge(s.edge, None, np.zeros((0, 2)), s.faces) for s in chain.seams]
+
+
+def made_of(sculpt: Any) -> Any:
+    """A sculpt's current net as a SourceSurface (to find the poles that hold it)."""
+    from .source_surface import SourceSurface
+    return SourceSurface(sculpt.Proxy.live.snapshot().surface, "exact", 0.0, "")
+
+
+def _holds(made: Any, chain: face_chain.FaceChain, edges: list[face_in_solid.FaceEdge], kinds: dict[str, str],
+           mirror: Mirror | None, what: str) -> tuple[list[int], list[Any]]:
+    """The held poles and the seams' linked poles; ValueError if they would hold every pole."""
+    held = face_held(made, edges, kinds, mirror)
+    links = seam_links(made, chain, kinds, held)
+    nu, nv = made.surface.controls
+    if len(held) + len(links) >= nu * nv:
+        raise ValueError(f"boundary: holding the edges as asked holds every pole of {what}'s {nu} x {nv} net "
+                         f"(give more controls)")
+    return held, links
+
+
 def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0", symmetry: Any = None,
                  controls: tuple[int, int] = (8, 8), degree: tuple[int, int] = (3, 3),
                  mesh: tuple[int, int] = (40, 40), name: str = "SculptedSolid", material: str = "clay") -> Any:
     """A new SculptedSolid in ``doc``: ``base``'s solid with ``faces`` (names like ``["Face6"]``)
     sculptable in place, their trims kept.
 
+    Several faces are sculpted together as one surface when they lie in a row, each sharing a
+    whole side of its parameter range with the next (the top of a box and the fillet beside it,
+    the faces of a loft): a stroke across a seam pulls both faces, which stay joined (G0) and,
+    where they meet tangentially, tangent (G1) across it.
+
     ``boundary``: how the faces' edges are held while sculpting, "G0" (they stay where they are, so
     the neighbour faces still meet them: the poles that shape the surface along them do not move),
     "G1" (their tangent planes too) or "free", for all edges or as a dict from edge name ("Edge3")
     to one of them, G0 for the others. A free edge must not border a face that is not sculpted (it
-    would open the solid). ``controls``/``degree`` are the least net (the face is converted
-    exactly, then refined; trims inside the face get extra knots around them), ``mesh`` the mass
-    points, ``material`` "clay" (strokes stay) or "elastic". One undo step; the base is hidden in
-    the GUI. ``symmetry``: None, or a mirror plane (``(point, normal)`` or a plane of the document)
-    the face is symmetric in (with u or v reversed): the sculpt then stays exactly symmetric, a
-    stroke acting mirrored on the other side. More than one face is not supported yet (ValueError).
+    would open the solid). A seam between two of the faces is G1 where they meet tangentially and
+    G0 (a crease that may move) where they meet at an angle, unless the dict says otherwise.
+    ``controls``/``degree`` are the least net per face (each face is converted exactly, then
+    refined; trims inside a face get extra knots around them), ``mesh`` the mass points per face,
+    ``material`` "clay" (strokes stay) or "elastic". One undo step; the base is hidden in the GUI.
+    ``symmetry`` (one face only): None, or a mirror plane (``(point, normal)`` or a plane of the
+    document) the face is symmetric in (with u or v reversed): the sculpt then stays exactly
+    symmetric, a stroke acting mirrored on the other side.
     """
     doc = _document(doc)
     if not hasattr(base, "Shape") or getattr(base, "Document", None) is not doc:
@@ -83,28 +114,28 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
             raise ValueError(f"faces: {f!r} is not a face of {base.Label} (Face1 .. Face{len(shape.Faces)})")
     if len(set(faces)) != len(faces):
         raise ValueError(f"faces: {faces} names a face twice")
-    if len(faces) > 1:
-        raise ValueError("faces: one face per SculptedSolid in this version (several faces sculpted as one "
-                         "system are not built yet)")
+    if len(faces) > 1 and symmetry is not None:
+        raise ValueError("symmetry: for one face (several faces sculpted together have no mirror plane in this version)")
     controls, degree, mesh = _checked_resolution(controls, degree, mesh)
     if not isinstance(name, str) or not name:
         raise TypeError("name: expected a non-empty string")
     _material(material)
-    face_name = faces[0]
-    edges = face_in_solid.face_edges(shape, face_name)
-    kinds = _boundary_kinds(boundary, edges, faces)
+    chain = face_chain.chain_of(shape, faces)
+    if len(faces) > 1:  # (the least net and the mesh are per face: the faces are joined along u)
+        controls, mesh = (controls[0] * len(faces), controls[1]), (mesh[0] * len(faces), mesh[1])
+    edges = chain.edges(shape)
+    seams = chain.seam_edges()
+    kinds = _boundary_kinds(boundary, edges + _seam_edges(shape, chain), faces)
     mirror = None
     if symmetry is not None:
         point, normal = face_symmetry.plane_of(symmetry, doc)
-        nface = face_in_solid.nurbs_face(shape.getElement(face_name))
-        mirror = Mirror(face_symmetry.mirror_direction(nface, point, normal, face_name), point, normal)
-    made = face_source(base, face_name, edges, controls, degree, TRIM_SPANS, mirror)
-    s = made.surface
-    held = face_held(made, edges, kinds, mirror)
-    if len(held) == s.controls[0] * s.controls[1]:
-        raise ValueError(f"boundary: holding the edges as asked holds every pole of {face_name}'s "
-                         f"{s.controls[0]} x {s.controls[1]} net (give more controls)")
-    state = _sculpt_state(made, mesh, material, held, mirror.settings() if mirror else None)
+        nface = face_in_solid.nurbs_face(shape.getElement(faces[0]))
+        mirror = Mirror(face_symmetry.mirror_direction(nface, point, normal, faces[0]), point, normal)
+    made = face_source(base, chain, edges, controls, degree, TRIM_SPANS, mirror)
+    asked = set(boundary) & seams if isinstance(boundary, dict) else set()
+    kinds = seam_kinds(made, chain, kinds, asked)
+    held, links = _holds(made, chain, edges, kinds, mirror, ", ".join(faces))
+    state = _sculpt_state(made, mesh, material, held, mirror.settings() if mirror else None, links)
     if doc.UndoMode == 0:
         doc.UndoMode = 1
     with transaction(doc, "Sculpt solid"):
@@ -116,8 +147,9 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
         obj.Boundary = json.dumps(kinds)
         obj.Sculpts = [sculpt]
         obj.Symmetry = json.dumps(mirror.settings() if mirror else None)
+        obj.Layout = chain.dumps() if len(faces) > 1 else ""
         obj.Resolution = json.dumps({"controls": list(controls), "degree": list(degree), "trim_spans": TRIM_SPANS})
-        obj.SourcePoles = np.asarray(s.poles, float).ravel().tolist()
+        obj.SourcePoles = np.asarray(made.surface.poles, float).ravel().tolist()
         rebuild(obj)
         attach_view_provider(obj)
     return obj
@@ -131,27 +163,21 @@ def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
         raise TypeError(f"obj: expected a HapticSculpt SculptedSolid, got {getattr(obj, 'TypeId', type(obj).__name__)}")
     shape = base_solid(obj.Base)
     faces = list(obj.SculptFaces)
-    edges = face_in_solid.face_edges(shape, faces[0])
+    chain = chain_of_solid(obj, shape)
+    edges = chain.edges(shape)
     if isinstance(boundary, dict):
         boundary = {**boundary_of(obj), **boundary}
-    kinds = _boundary_kinds(boundary, edges, faces)
+    kinds = _boundary_kinds(boundary, edges + _seam_edges(shape, chain), faces)
+    if isinstance(boundary, str):  # (a seam is as tangent as its faces let it be)
+        kinds = seam_kinds(made_of(sculpt_of(obj)), chain, kinds, set())
     sculpt = sculpt_of(obj)
-    s = sculpt.Proxy.live.snapshot().surface
-    held = face_in_solid.held_poles(np.asarray(s.knots_u), np.asarray(s.knots_v), tuple(s.degree),
-                                    tuple(s.controls), edges, kinds)
-    mirror = mirror_of(obj)
-    if mirror is not None:
-        held = face_symmetry.symmetric_held(held, mirror.direction, tuple(s.controls))
-    if len(held) == s.controls[0] * s.controls[1]:
-        raise ValueError(f"boundary: holding the edges as asked holds every pole of the {s.controls[0]} x "
-                         f"{s.controls[1]} net")
-
+    held, links = _holds(made_of(sculpt), chain, edges, kinds, mirror_of(obj), ", ".join(faces))
     live = sculpt.Proxy.live
     if live.session is not None:
         raise RuntimeError(f"{obj.Label}: stop the sculpting session before changing how its edges are held")
     surface = live.surface
     with transaction(obj.Document, "Hold edges"):
-        surface.hold_poles(held)
+        surface.hold_poles(held, links)
         live.write(sculpt_state.capture(surface))
         obj.Boundary = json.dumps(kinds)
         rebuild(obj)
