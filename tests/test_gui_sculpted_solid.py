@@ -1,8 +1,9 @@
-"""A face of a real part sculpted in place, as a designer does it in FreeCAD's GUI with real X
+"""Faces of a real part sculpted in place, as a designer does it in FreeCAD's GUI with real X
 events: open a file with a housing (a hole through its top, a fillet along one edge), click its top
 face, "Sculpt selected face", start a session, drag, stop; the part stays one valid closed solid
-with its hole, Undo puts it back at once, the zebra display keeps the hole open. Screenshots in
-build/screenshots/real_solid_*.png."""
+with its hole, Undo puts it back at once, the zebra display keeps the hole open. Then the top and
+its fillet picked together (click, ctrl+click) and sculpted as one across their seam, which stays
+tangent; the zebra stripes flow across it. Screenshots in build/screenshots/real_solid_*.png."""
 from __future__ import annotations
 
 import os
@@ -90,5 +91,90 @@ def test_a_face_of_a_part_sculpted_in_place(tmp_path):
         # the hole stays open in the display: the pixels at its centre are the same colour as without stripes
         hole = d.to_screen(d.state()["docs"][s["active"]]["screen"]["Housing"][1])  # x = 45 mm: in the hole
         assert np.allclose(zebra[hole[1], hole[0]], picture[hole[1], hole[0]], atol=0.1)
+    finally:
+        d.close()
+
+
+#: A block with a fillet along one top edge (no hole), made and saved by FreeCAD's GUI.
+BLOCK = """
+import json, os
+import FreeCAD, FreeCADGui, Part
+doc = FreeCAD.newDocument("Block")
+part = doc.addObject("Part::Feature", "Block")
+shape = Part.makeBox(60, 40, 15)
+edge = [e for e in shape.Edges if abs(e.CenterOfMass.z - 15) < 1e-9 and abs(e.CenterOfMass.y) < 1e-9][0]
+part.Shape = shape.makeFillet(6, [edge])
+doc.recompute()
+doc.saveAs(PATH)
+json.dump({"volume": part.Shape.Volume, "faces": len(part.Shape.Faces)}, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+def _point(s: dict) -> list[float] | None:
+    return s.get("mouse_point")
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_a_top_and_its_fillet_picked_together_and_sculpted_as_one(tmp_path):
+    os.makedirs(SHOTS, exist_ok=True)
+    path = str(tmp_path / "block.FCStd")
+    part = run_freecad_gui(f"PATH = {path!r}\n" + BLOCK, str(tmp_path))
+    d = Desktop(str(tmp_path), "CAD", open_file=path)
+    try:
+        s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["screen"].get("Block"), "the file to open")
+        d.xdo("mousemove", "640", "500", "click", "1")
+        d.xdo("key", "0")  # isometric
+        d.xdo("key", "--delay", "150", "v", "f")  # fit all
+        size = s["views"][0]["size"]
+        s = d.wait(lambda s: all(0 < p[0] < size[0] and 0 < p[1] < size[1]
+                                 for p in s["docs"][s["active"]]["screen"]["Block"]), "the part in view")
+        d.calibrate()
+        centre, south = (d.to_screen(p) for p in (s["docs"][s["active"]]["screen"]["Block"][k] for k in (0, 4)))
+        # from the top's south point (y = 10 mm) on towards the fillet (y < 6), a few pixels a step
+        # as a hand moves: the last point on the top and the first on the fillet
+        step = np.subtract(south, centre) / max(1.0, float(np.hypot(*np.subtract(south, centre)))) * 3
+        on_top, on_fillet = None, None
+        for k in range(80):
+            at = (int(round(south[0] + step[0] * k)), int(round(south[1] + step[1] * k)))
+            before = d.state().get("mouse_point")
+            d.xdo("mousemove", str(at[0]), str(at[1]))
+            s = d.wait(lambda s: _point(s) is not None and _point(s) != before, "the mouse point to follow")
+            p = _point(s)
+            if abs(p[2] - 15) < 1e-3 and 7 < p[1] < 9:  # (not on the seam: a click there picks the edge)
+                on_top = at
+            if p[1] < 4 and p[2] < 14.5:
+                on_fillet = at
+                break
+        assert on_top and on_fillet, (on_top, on_fillet)
+        d.xdo("mousemove", str(on_top[0]), str(on_top[1]), "click", "1")
+        d.xdo("mousemove", str(on_fillet[0]), str(on_fillet[1]), "keydown", "ctrl", "click", "1", "keyup", "ctrl")
+        s = d.press_button("SculptFace", lambda s: s["docs"][s["active"]]["solids"], "the SculptedSolid")
+        made = solid(s)
+        assert len(made["sculpt_faces"]) == 2, made["sculpt_faces"]
+        assert made["valid"] and made["solids"] == 1 and made["closed"], made
+        assert abs(made["volume"] - part["volume"]) < 1e-6 * part["volume"]
+        seam = [r for r in made["seams"] if r["g1_deg"] is not None]
+        assert seam, "the seam between the top and the fillet is held G1"
+        d.press_button("Session", lambda s: s["docs"][s["active"]]["sculpts"][0]["session"], "the session")
+        # a stroke across the seam: grabbed on the top beside it, pulled up
+        d.drag([on_top] + [(on_top[0], on_top[1] - 10 * k) for k in range(1, 13)], seconds=0.9)
+        d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
+        d.click_button("Session")
+        s = d.wait(lambda s: not s["docs"][s["active"]]["sculpts"][0]["session"], "the session to stop")
+        pulled = solid(s)
+        assert pulled["valid"] and pulled["solids"] == 1 and pulled["closed"] and not pulled["error"], pulled
+        assert abs(pulled["volume"] - made["volume"]) > 1.0, "the stroke changed the part"
+        assert max(r["g0_mm"] for r in pulled["seams"]) <= 1e-7, pulled["seams"]
+        assert max(r["g1_deg"] for r in pulled["seams"] if r["g1_deg"] is not None) <= 0.01, pulled["seams"]
+        picture = d.shot("solid_two_faces_pulled")
+        frames = sum(o["frames"] for o in d.state()["overlays"])
+        d.click_button("Zebra")
+        d.wait(lambda s: any(o["display"] == "zebra" for o in s["overlays"]) and
+               sum(o["frames"] for o in s["overlays"]) > frames + 10, "the zebra stripes drawn")
+        zebra = d.shot("solid_two_faces_zebra")
+        assert np.abs(zebra[on_fillet[1] - 15:on_fillet[1] + 15, on_fillet[0] - 15:on_fillet[0] + 15] -
+                      picture[on_fillet[1] - 15:on_fillet[1] + 15, on_fillet[0] - 15:on_fillet[0] + 15]).max() > 0.3, \
+            "no stripes on the fillet"
     finally:
         d.close()

@@ -28,22 +28,32 @@ def _vector(value: Any, what: str) -> np.ndarray:
     return v
 
 
+def _planar_face(obj: Any) -> Any:
+    shape = getattr(obj, "Shape", None)
+    faces = shape.Faces if shape is not None and not shape.isNull() else []
+    return faces[0] if len(faces) == 1 and type(faces[0].Surface).__name__ == "Plane" else None
+
+
+def is_plane(obj: Any) -> bool:
+    """Whether a document object is a plane a sculpt can be mirrored in: an origin or datum plane,
+    or any object whose shape is one planar face."""
+    return getattr(obj, "TypeId", "") in ("App::Plane", "PartDesign::Plane") or _planar_face(obj) is not None
+
+
 def plane_of(symmetry: Any, doc: Any) -> tuple[np.ndarray, np.ndarray]:
-    """(point, unit normal) of ``symmetry``: a ``(point, normal)`` pair, or a plane of ``doc`` (an
-    origin plane, a datum plane, or any object whose shape is one planar face)."""
+    """(point, unit normal) of ``symmetry``: a ``(point, normal)`` pair, or a plane of ``doc`` (see
+    :func:`is_plane`)."""
     if hasattr(symmetry, "Document"):
         if symmetry.Document is not doc:
             raise ValueError(f"symmetry: {symmetry.Label} is not in document {doc.Name}")
-        shape = getattr(symmetry, "Shape", None)
-        faces = shape.Faces if shape is not None and not shape.isNull() else []
-        if len(faces) == 1 and type(faces[0].Surface).__name__ == "Plane":
-            face = faces[0]
+        face = _planar_face(symmetry)
+        if face is not None:
             u0, u1, v0, v1 = face.ParameterRange
             point = face.valueAt(0.5 * (u0 + u1), 0.5 * (v0 + v1))
             return np.array(tuple(point)), np.array(tuple(face.normalAt(0.5 * (u0 + u1), 0.5 * (v0 + v1))))
-        if symmetry.TypeId in ("App::Plane", "PartDesign::Plane") or hasattr(symmetry, "Placement") and not faces:
-            placement = symmetry.getGlobalPlacement() if hasattr(symmetry, "getGlobalPlacement") else symmetry.Placement
+        if is_plane(symmetry):
             import FreeCAD
+            placement = symmetry.getGlobalPlacement() if hasattr(symmetry, "getGlobalPlacement") else symmetry.Placement
             normal = placement.Rotation.multVec(FreeCAD.Vector(0, 0, 1))
             return np.array(tuple(placement.Base)), np.array(tuple(normal))
         raise ValueError(f"symmetry: {symmetry.Label} is not a plane")

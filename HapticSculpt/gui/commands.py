@@ -45,33 +45,57 @@ class NewPatch:
         Gui.SendMsgToActiveView("ViewFit")
 
 
+def _face_selection() -> tuple[Any, list[str], Any] | None:
+    """(object, its selected faces, a selected plane or None) when the selection is faces of one
+    object, optionally with one plane (a mirror plane for a symmetric sculpt); else None."""
+    from ..app.face_symmetry import is_plane
+    sel = Gui.Selection.getSelectionEx()
+    with_faces = [s for s in sel if any(n.startswith("Face") for n in s.SubElementNames)]
+    if len(with_faces) != 1:
+        return None
+    others = [s.Object for s in sel if s is not with_faces[0]]
+    if len(others) > 1 or (others and not is_plane(others[0])):
+        return None
+    faces = [n for n in with_faces[0].SubElementNames if n.startswith("Face")]
+    return with_faces[0].Object, faces, others[0] if others else None
+
+
 class SculptFace:
-    """Sculpt the selected face in place: a face of a solid becomes a SculptedSolid (its edges held
-    G0, its trims kept, the solid rebuilt around it); a face of anything else a separate patch."""
+    """Sculpt the selected faces in place: faces of a solid become a SculptedSolid (its edges held
+    G0, its trims kept, several faces in a row joined into one surface, the solid rebuilt around
+    them; with a plane selected too, mirrored in it); a face of anything else a separate patch."""
 
     def GetResources(self) -> dict[str, str]:
         return {"Pixmap": icon("HapticSculpt"), "MenuText": "Sculpt selected face",
-                "ToolTip": "Sculpt the selected face: in place in its solid (edges held G0, holes kept; "
-                           "Hold edges switches G0/G1), or as a separate B-spline patch"}
+                "ToolTip": "Sculpt the selected faces: in place in their solid (edges held G0, holes kept, faces "
+                           "in a row sculpted as one, tangent seams held G1; Hold edges switches G0/G1; select a "
+                           "plane too for a mirror-symmetric sculpt), or one face as a separate B-spline patch"}
 
     def IsActive(self) -> bool:
-        sel = Gui.Selection.getSelectionEx()
-        return len(sel) == 1 and any(n.startswith("Face") for n in sel[0].SubElementNames)
+        return _face_selection() is not None
 
     def Activated(self) -> None:
+        from ..app.sculpted_solid import boundary_of, chain_of_solid
         from .echo import ref, run_echoed
-        sel = Gui.Selection.getSelectionEx()[0]
-        faces = [n for n in sel.SubElementNames if n.startswith("Face")]
-        doc = sel.Object.Document
-        if len(sel.Object.Shape.Solids) == 1:
-            run_echoed(f"HapticSculpt.sculpt_solid(App.getDocument({doc.Name!r}), {ref(sel.Object)}, {faces!r})")
+        picked = _face_selection()
+        if picked is None:
+            return
+        base, faces, plane = picked
+        doc = base.Document
+        if len(base.Shape.Solids) == 1:
+            mirror = f", symmetry={ref(plane)}" if plane is not None else ""
+            run_echoed(f"HapticSculpt.sculpt_solid(App.getDocument({doc.Name!r}), {ref(base)}, {faces!r}{mirror})")
             obj = doc.Objects[-1]
-            FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label}: {', '.join(faces)} of {sel.Object.Label} "
-                                         "sculpted in place, edges held G0\n")
+            kinds = boundary_of(obj)
+            seams = [f"{e} {kinds[e]}" for e in sorted(chain_of_solid(obj).seam_edges())]
+            FreeCAD.Console.PrintMessage(
+                f"HapticSculpt: {obj.Label}: {', '.join(faces)} of {base.Label} sculpted in place, edges held G0"
+                + (f", mirrored in {plane.Label}" if plane is not None else "")
+                + (f", seams {', '.join(seams)}" if seams else "") + "\n")
             Gui.Selection.clearSelection()
             Gui.Selection.addSelection(obj)
             return
-        run_echoed(f"HapticSculpt.make_sculpt(App.getDocument({doc.Name!r}), source=({ref(sel.Object)}, {faces[0]!r}), "
+        run_echoed(f"HapticSculpt.make_sculpt(App.getDocument({doc.Name!r}), source=({ref(base)}, {faces[0]!r}), "
                    "material='clay')")
         obj = doc.Objects[-1]
         FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label} from {obj.SourceDescription}, "
@@ -191,12 +215,14 @@ class HoldEdges(_SculptCommand):
 
     def Activated(self) -> None:
         from ..app.api import held_boundary
-        from ..app.sculpted_solid import boundary_of, solid_of
+        from ..app.sculpted_solid import boundary_of, chain_of_solid, solid_of
         from .echo import ref, run_echoed
         obj = _ctl().active_sculpt()
         solid = solid_of(obj)
-        if solid is not None:
-            following = "G1" if set(boundary_of(solid).values()) == {"G0"} else "G0"
+        if solid is not None:  # (the seams between its faces stay as tangent as they can)
+            seams = chain_of_solid(solid).seam_edges()
+            outer = {v for k, v in boundary_of(solid).items() if k not in seams}
+            following = "G1" if outer == {"G0"} else "G0"
             run_echoed(f"HapticSculpt.set_boundary({ref(solid)}, {following!r})")
             return
         now = set(held_boundary(obj).values())

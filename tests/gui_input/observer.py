@@ -45,6 +45,7 @@ def _solids(doc):
                     "closed": all(sh.isClosed() for sh in shape.Shells), "volume": shape.Volume,
                     "faces": len(shape.Faces), "wires": sorted(len(f.Wires) for f in shape.Faces),
                     "seams": json.loads(o.SeamReport or "[]"), "error": o.RebuildError,
+                    "sculpt_faces": list(o.SculptFaces),
                     "base_visible": bool(o.Base.ViewObject.Visibility) if o.Base is not None else None})
     return out
 
