@@ -13,6 +13,10 @@ Scenes (8x8 controls, 24x24 mesh, a 100 mm dome-shaped patch relaxed as its rest
   current half-chord, so its force is not the gradient of a fixed energy and there is no energy
   to minimise (its accuracy at equilibrium is tested in tests/test_core_dynamics.py).
 - oscillation: a pole pushed 3 mm and let go, undamped, 0.2 s.
+- two_faces: the rope scene on two faces sculpted as one (as hs.sculpt_solid joins them): the same
+  dome as two patches joined along u = 0.5 by a knot of full multiplicity, the seam's poles linked
+  to their neighbours across it so it stays tangent (G1; the core's linked poles), grabbed beside
+  the seam. The coupling must not cost the default its lead.
 Rope and oscillation references: the explicit scheme at 1 ms / 1024 and 1 ms / 2048, Richardson-
 extrapolated (first order); their difference says how good the reference is (printed).
 
@@ -28,7 +32,8 @@ Euler alone).
 Writes bench/results/time_vs_error.json (records: scene, solver, dt, iterations,
 seconds_per_sim_second, error) and time_vs_error.png, prints each solver's fastest run at each error
 level 1e-2 .. 1e-6 and the default's speed-up over the paper's schemes. Finished runs are kept if
-interrupted (Ctrl-C writes what is done).
+interrupted (Ctrl-C writes what is done). ``--scenes rope,two_faces`` runs only those scenes and
+replaces their records in the JSON (every scene's solvers are compared within one run).
 """
 from __future__ import annotations
 
@@ -134,10 +139,43 @@ def oscillation_play(s: core.DynamicSurface, dt: float) -> list[np.ndarray]:
     return [np.array(s.mesh)]
 
 
+def two_faces_build() -> core.DynamicSurface:
+    """The dome as two 7 x 8 patches joined along u = 0.5, its seam row linked for G1."""
+    ku = [0, 0, 0, 0, 0.5, 0.5, 0.5, 1, 1, 1, 1]
+    kv = [0, 0, 0, 0, 0.2, 0.4, 0.6, 0.8, 1, 1, 1, 1]
+    gu = [sum(ku[i + 1:i + 4]) / 3 for i in range(7)]  # Greville abscissae: an even parametrisation
+    gv = [sum(kv[j + 1:j + 4]) / 3 for j in range(8)]
+    x, y = np.meshgrid((np.array(gu) - 0.5) * 2, (np.array(gv) - 0.5) * 2, indexing="ij")
+    poles = np.stack([50 * x, 50 * y, 15 * (1 - 0.5 * (x ** 2 + y ** 2))], axis=-1)
+    s = core.DynamicSurface(core.BSplineSurface(poles, (3, 3), ku, kv), (24, 24))
+    s.hold_poles([], [(3 * 8 + j, [(2 * 8 + j, 0.5), (4 * 8 + j, 0.5)]) for j in range(8)])
+    s.relax()
+    s.stiffness_map.set_uniform(1e4)
+    s.damping_map.set_uniform(2.0)
+    s.sleep_enabled = False
+    s.tool.reel_time = 0.1
+    return s
+
+
+def two_faces_play(s: core.DynamicSurface, dt: float) -> list[np.ndarray]:
+    per_ms = round(MS / dt)
+    top = np.array(s.mesh[9, 12]) + [0, 0, 2.0]  # beside the seam (mesh column 11.5)
+    snaps = []
+    for k in range(300):
+        grab = k < 150
+        s.set_cursor(list(top + [0, 0, 15.0 * min(k, 150) / 150]), grab=grab)
+        s.step(dt, per_ms)
+        if k == 149:
+            snaps.append(np.array(s.mesh))
+    snaps.append(np.array(s.mesh))
+    return snaps
+
+
 # name: (build, play, simulated seconds, (shortest, longest) time step)
 SCENES = {"rope": (rope_build, rope_play, 0.3, (MS / 1024, MS)),
           "equilibrium": (equilibrium_build, equilibrium_play, 1.5, (MS / 16, 8 * MS)),
-          "oscillation": (oscillation_build, oscillation_play, 0.2, (MS / 1024, 8 * MS))}
+          "oscillation": (oscillation_build, oscillation_play, 0.2, (MS / 1024, 8 * MS)),
+          "two_faces": (two_faces_build, two_faces_play, 0.3, (MS / 1024, MS))}
 
 
 def shortest_step(label: str, settings: dict) -> float:
@@ -260,14 +298,25 @@ def plot(records: list[dict], path: str) -> None:
 def main() -> None:
     out_dir = os.path.join(ROOT, "bench", "results")
     os.makedirs(out_dir, exist_ok=True)
-    refs, notes = {}, {}
-    for scene in progress(list(SCENES), "references"):
+    chosen = list(SCENES)
+    if "--scenes" in sys.argv:
+        chosen = sys.argv[sys.argv.index("--scenes") + 1].split(",")
+        unknown = [c for c in chosen if c not in SCENES]
+        if unknown:
+            sys.exit(f"--scenes: no scene {', '.join(unknown)} (scenes: {', '.join(SCENES)})")
+    path = os.path.join(out_dir, "time_vs_error.json")
+    kept: dict = {"references": {}, "records": []}
+    if chosen != list(SCENES) and os.path.exists(path):
+        with open(path) as f:
+            kept = json.load(f)
+    refs, notes = {}, {k: v for k, v in kept["references"].items() if k not in chosen}
+    for scene in progress(chosen, "references"):
         refs[scene], notes[scene] = static_reference() if scene == "equilibrium" else richardson_reference(scene)
     print("reference quality: " + ", ".join(
         f"{k}: {'relative gradient left' if k == 'equilibrium' else 'Richardson spread / size'} {v:.1e}" for k, v in notes.items()))
-    jobs = [(scene, label, integ, settings, dt) for scene in SCENES for label, integ, settings in SOLVERS
+    jobs = [(scene, label, integ, settings, dt) for scene in chosen for label, integ, settings in SOLVERS
             for dt in DTS if max(SCENES[scene][3][0], shortest_step(label, settings)) <= dt <= SCENES[scene][3][1]]
-    records: list[dict] = []
+    records: list[dict] = [r for r in kept["records"] if r["scene"] not in chosen]
     try:
         for scene, label, integ, settings, dt in progress(jobs, "runs"):
             sps, snaps = timed_run(scene, integ, settings, dt)
@@ -277,7 +326,7 @@ def main() -> None:
                             "seconds_per_sim_second": sps, "error": err if math.isfinite(err) else float("inf")})
     except KeyboardInterrupt:
         print(f"\ninterrupted after {len(records)} of {len(jobs)} runs; writing those", file=sys.stderr)
-    with open(os.path.join(out_dir, "time_vs_error.json"), "w") as f:
+    with open(path, "w") as f:
         json.dump({"references": notes, "records": records}, f, indent=1)
     rows = pareto_table(records)
     print("\nfastest run (wall s per simulated s) reaching each error level; '-' = never reached")

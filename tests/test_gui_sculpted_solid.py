@@ -178,3 +178,63 @@ def test_a_top_and_its_fillet_picked_together_and_sculpted_as_one(tmp_path):
             "no stripes on the fillet"
     finally:
         d.close()
+
+
+#: The block and a plane through its middle (x = 30) to mirror in.
+MIRRORED = """
+import json, os
+import FreeCAD, FreeCADGui, Part
+doc = FreeCAD.newDocument("Mirrored")
+part = doc.addObject("Part::Feature", "Block")
+part.Shape = Part.makeBox(60, 40, 15)
+plane = doc.addObject("Part::Plane", "Mirror")
+plane.Length, plane.Width = 35, 60
+plane.Placement = FreeCAD.Placement(FreeCAD.Vector(30, -10, 25), FreeCAD.Rotation(FreeCAD.Vector(0, 1, 0), 90))
+doc.recompute()
+doc.saveAs(PATH)
+json.dump({"volume": part.Shape.Volume}, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_a_top_picked_with_a_plane_is_sculpted_mirrored(tmp_path):
+    os.makedirs(SHOTS, exist_ok=True)
+    path = str(tmp_path / "mirrored.FCStd")
+    part = run_freecad_gui(f"PATH = {path!r}\n" + MIRRORED, str(tmp_path))
+    d = Desktop(str(tmp_path), "CAD", open_file=path)
+    try:
+        s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["screen"].get("Mirror"), "the file to open")
+        d.xdo("mousemove", "640", "500", "click", "1")
+        d.xdo("key", "0")  # isometric
+        d.xdo("key", "--delay", "150", "v", "f")  # fit all
+        size = s["views"][0]["size"]
+        s = d.wait(lambda s: all(0 < p[0] < size[0] and 0 < p[1] < size[1]
+                                 for p in s["docs"][s["active"]]["screen"]["Block"]), "the part in view")
+        d.calibrate()
+        screen = s["docs"][s["active"]]["screen"]
+        east = d.to_screen(screen["Block"][1])  # (45, 20, 15): on the top, on the camera's side of the plane
+        # (30, 20, 20) on the plane above the block: halfway between its top edge's middle and the block's top
+        # centre (the camera is orthographic)
+        above = d.to_screen([(a + b) / 2 for a, b in zip(screen["Mirror"][0], screen["Block"][0])])
+        d.xdo("mousemove", str(east[0]), str(east[1]))
+        d.wait(lambda s: s["mouse_point"] is not None and abs(s["mouse_point"][2] - 15) < 0.5, "the mouse on the top")
+        d.xdo("click", "1")
+        d.xdo("mousemove", str(above[0]), str(above[1]), "keydown", "ctrl", "click", "1", "keyup", "ctrl")
+        s = d.press_button("SculptFace", lambda s: s["docs"][s["active"]]["solids"], "the SculptedSolid")
+        made = solid(s)
+        assert made["mirror_mm"] is not None and made["mirror_mm"] <= 1e-9, made
+        d.press_button("Session", lambda s: s["docs"][s["active"]]["sculpts"][0]["session"], "the session")
+        d.drag([east] + [(east[0], east[1] - 10 * k) for k in range(1, 11)], seconds=0.8)
+        d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
+        d.click_button("Session")
+        s = d.wait(lambda s: not s["docs"][s["active"]]["sculpts"][0]["session"], "the session to stop")
+        pulled = solid(s)
+        assert pulled["valid"] and pulled["solids"] == 1 and pulled["closed"] and not pulled["error"], pulled
+        assert abs(pulled["volume"] - part["volume"]) > 1.0, "the stroke changed the part"
+        assert pulled["mirror_mm"] <= 1e-9, pulled["mirror_mm"]
+        d.click_button("Zebra")
+        d.wait(lambda s: any(o["display"] == "zebra" for o in s["overlays"]), "the zebra stripes")
+        d.shot("solid_mirrored_zebra")
+    finally:
+        d.close()

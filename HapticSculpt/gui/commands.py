@@ -47,17 +47,20 @@ class NewPatch:
 
 def _face_selection() -> tuple[Any, list[str], Any] | None:
     """(object, its selected faces, a selected plane or None) when the selection is faces of one
-    object, optionally with one plane (a mirror plane for a symmetric sculpt); else None."""
+    object, optionally with one plane (a mirror plane for a symmetric sculpt: picked by its face,
+    its edge or in the tree); a plane's own face alone is sculpted as a patch. Else None."""
     from ..app.face_symmetry import is_plane
     sel = Gui.Selection.getSelectionEx()
-    with_faces = [s for s in sel if any(n.startswith("Face") for n in s.SubElementNames)]
-    if len(with_faces) != 1:
+    faces = [s for s in sel if any(n.startswith("Face") for n in s.SubElementNames) and not is_plane(s.Object)]
+    planes = [s for s in sel if is_plane(s.Object)]
+    if not faces and len(planes) == 1 and len(sel) == 1:
+        faces, planes = planes, []
+    if len(faces) != 1 or len(planes) > 1 or len(faces) + len(planes) != len(sel):
         return None
-    others = [s.Object for s in sel if s is not with_faces[0]]
-    if len(others) > 1 or (others and not is_plane(others[0])):
+    names = [n for n in faces[0].SubElementNames if n.startswith("Face")]
+    if not names:
         return None
-    faces = [n for n in with_faces[0].SubElementNames if n.startswith("Face")]
-    return with_faces[0].Object, faces, others[0] if others else None
+    return faces[0].Object, names, planes[0].Object if planes else None
 
 
 class SculptFace:

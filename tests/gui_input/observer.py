@@ -45,9 +45,29 @@ def _solids(doc):
                     "closed": all(sh.isClosed() for sh in shape.Shells), "volume": shape.Volume,
                     "faces": len(shape.Faces), "wires": sorted(len(f.Wires) for f in shape.Faces),
                     "seams": json.loads(o.SeamReport or "[]"), "error": o.RebuildError,
-                    "sculpt_faces": list(o.SculptFaces),
+                    "sculpt_faces": list(o.SculptFaces), "mirror_mm": _mirror_distance(o),
                     "base_visible": bool(o.Base.ViewObject.Visibility) if o.Base is not None else None})
     return out
+
+
+def _mirror_distance(o):
+    """How far a symmetric SculptedSolid's sculpted face is from its own mirror image (None if it
+    has no mirror plane), on a 21 x 21 grid."""
+    sym = json.loads(getattr(o, "Symmetry", "") or "null")
+    if not sym or not o.Sculpts:
+        return None
+    from HapticSculpt.app.sculpted_solid import sculpted_surface
+    s = sculpted_surface(o.Sculpts[0])
+    p0, n = FreeCAD.Vector(*sym["point"]), FreeCAD.Vector(*sym["normal"])
+    u0, u1, v0, v1 = s.bounds()
+    worst = 0.0
+    for i in range(21):
+        for j in range(21):
+            u, v = u0 + (u1 - u0) * i / 20, v0 + (v1 - v0) * j / 20
+            p = s.value(u, v)
+            q = s.value(u0 + u1 - u, v) if sym["direction"] == 0 else s.value(u, v0 + v1 - v)
+            worst = max(worst, (p - n * (2 * (p - p0).dot(n)) - q).Length)
+    return worst
 
 
 def _on_screen(o):
