@@ -185,6 +185,22 @@ def run_scene(seed: int, steps: int = STEPS) -> SceneResult:
             held = sorted(int(i) for i in held_rng.choice(n_poles, int(held_rng.integers(1, n_poles + 1)), replace=False))
             s.hold_poles(held)
         held_at = np.array(s.poles).reshape(-1, 3)[held].copy()
+        # Linked poles (a G1 seam: a row kept between its neighbours) or mirror symmetry (x = 0) in
+        # a quarter each of the scenes with nothing held, from a stream of their own.
+        extra_rng = np.random.default_rng([seed, 2])
+        nv = controls[1]
+        links: list = []
+        mirrored = False
+        if not held and extra_rng.random() < 0.25 and controls[0] >= 3:
+            row, a = int(extra_rng.integers(1, controls[0] - 1)), float(extra_rng.uniform(0.05, 0.95))
+            links = [(row * nv + j, [((row - 1) * nv + j, a), ((row + 1) * nv + j, 1.0 - a)]) for j in range(nv)]
+            s.hold_poles([], links)
+        elif not held and extra_rng.random() < 0.33:
+            try:
+                s.set_symmetry(0, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0])
+                mirrored = True
+            except ValueError:
+                pass  # (a shape that is not symmetric: refused, as it must be)
         energy0 = _energy(s)
         work_in = 0.0
         last_work = s.work_done
@@ -214,6 +230,16 @@ def run_scene(seed: int, steps: int = STEPS) -> SceneResult:
                 return res
             if held and not np.array_equal(np.array(s.poles).reshape(-1, 3)[held], held_at):
                 res.failure = f"a held pole moved in step {k}"
+                return res
+            p = np.array(s.poles)
+            flat = p.reshape(-1, 3)
+            # (to rounding: the core's sums are fused multiply-adds)
+            if links and any(np.abs(flat[pole] - w0 * flat[m0] - w1 * flat[m1]).max() > 1e-13 * max(1.0, np.abs(flat).max())
+                             for pole, ((m0, w0), (m1, w1)) in links):
+                res.failure = f"a linked pole left its masters in step {k}"
+                return res
+            if mirrored and not np.array_equal(p[::-1] * [-1.0, 1.0, 1.0], p):
+                res.failure = f"the mirror symmetry broke in step {k}"
                 return res
             work = s.work_done
             work_in += max(0.0, work - last_work)

@@ -449,7 +449,7 @@ def hold_boundary(obj: Any, boundary: Any = "G0") -> list[int]:
     _sculpt(obj)
     controls = tuple(obj.Proxy.live.snapshot().surface.controls)
     held = boundary_poles(controls, boundary)  # validated before the document changes
-    obj.Proxy.live.edit(lambda s: s.hold_poles(held), "Hold edges")
+    obj.Proxy.live.edit(lambda s: s.hold_poles(held, s.linked_poles), "Hold edges")  # (links kept)
     return held
 
 

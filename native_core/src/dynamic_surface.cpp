@@ -391,6 +391,9 @@ bool DynamicSurface::guardsEnergy(double dt, bool verlet) const {
     if (!guard_.settings.enabled) return false;
     // Verlet is stable here but not a descent method: the guard stays as for every explicit scheme.
     if (verlet) return true;
+    // The symmetry's projection is not energy-neutral where something is not symmetric (a penalty
+    // constraint on one side, a painted map): the guard takes out what it would put in.
+    if (!mirror_.empty()) return true;
     // Point, tangent and normal constraints project onto convex sets, so they keep the guarantee.
     if (solver_.kind != IntegratorKind::LocalGlobal || springs_.law.kind != LawKind::Linear || constraints_.anyNonConvex())
         return true;
