@@ -429,6 +429,23 @@ class TestSymmetricSculpt(SolidChecks):
         self.assertLessEqual(mirror_distance(sculpted_surface(obj.Sculpts[0]), sym["point"], sym["normal"],
                                              sym["direction"]), 1e-9)
 
+    def test_mirrored_in_an_origin_plane(self):
+        """The document's own planes: an App::Part's origin YZ plane (x = 0), a box centred on it."""
+        box = self.doc.addObject("Part::Box", "Box")
+        box.Length, box.Width, box.Height = 40, 30, 10
+        box.Placement = FreeCAD.Placement(FreeCAD.Vector(-20, 0, 0), FreeCAD.Rotation())
+        container = self.doc.addObject("App::Part", "Container")
+        self.doc.recompute()
+        yz = next(f for f in container.Origin.OriginFeatures if f.Role == "YZ_Plane")
+        top = face_named(box.Shape, lambda f: abs(f.CenterOfMass.z - 10) < 1e-9)
+        obj = hs.sculpt_solid(self.doc, box, [top], symmetry=yz)
+        sym = json.loads(obj.Symmetry)
+        self.assertLess(np.abs(np.abs(sym["normal"]) - [1, 0, 0]).max(), 1e-12)
+        pull(obj, (10, 12, 10), (0, 0, 5))
+        self.check_sculpted(obj, box, top)
+        self.assertLessEqual(mirror_distance(sculpted_surface(obj.Sculpts[0]), sym["point"], sym["normal"],
+                                             sym["direction"]), 1e-9)
+
     def test_what_is_not_symmetric_is_refused(self):
         box = self.part(Part.makeBox(40, 30, 10), "Box")
         top = face_named(box.Shape, lambda f: abs(f.CenterOfMass.z - 10) < 1e-9)
