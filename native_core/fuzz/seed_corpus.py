@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Seed corpora for the HID fuzz harnesses from hid-recorder fixtures: the recordings themselves
+"""Seed corpora for the fuzz harnesses: from hid-recorder fixtures, the recordings themselves
 (fuzz_hid_recording), their report descriptors (fuzz_report_descriptor) and their input reports,
-each prefixed with its length as the harness reads them (fuzz_spacemouse_report).
+each prefixed with its length as the harness reads them (fuzz_spacemouse_report); the Falcon's
+status stream (fuzz_falcon_frames, from ../falcon next to the HID fixtures).
 
     seed_corpus.py FIXTURE_DIR CORPUS_DIR
 """
@@ -18,8 +19,10 @@ def hex_bytes(fields: list[str]) -> bytes:
 
 def main(fixtures: str, corpus: str) -> None:
     out = pathlib.Path(corpus)
-    for name in ("fuzz_hid_recording", "fuzz_report_descriptor", "fuzz_spacemouse_report"):
+    for name in ("fuzz_hid_recording", "fuzz_report_descriptor", "fuzz_spacemouse_report", "fuzz_falcon_frames"):
         (out / name).mkdir(parents=True, exist_ok=True)
+    for path in sorted(pathlib.Path(fixtures).parent.joinpath("falcon").glob("*.bin")):
+        shutil.copy(path, out / "fuzz_falcon_frames" / path.name)
     for path in sorted(pathlib.Path(fixtures).glob("*.hid")):
         shutil.copy(path, out / "fuzz_hid_recording" / path.name)
         reports = b""
