@@ -102,7 +102,7 @@ void bindRuntime(py::module_& m) {
         .def(py::init([](std::shared_ptr<DynamicSurface> surface, std::shared_ptr<Device> device, double hapticRate,
                          double simDt, double graphicsRate, double maxForce, double maxStiffness, double staleLimit,
                          double fadeTime, double maxLag, double logSeconds, bool stopWhenFinished, bool realtime,
-                         double idleRate) {
+                         double idleRate, double spin, int simNice) {
                  RuntimeSettings s;
                  s.hapticRate = hapticRate;
                  s.simDt = simDt;
@@ -116,12 +116,14 @@ void bindRuntime(py::module_& m) {
                  s.stopWhenFinished = stopWhenFinished;
                  s.realtime = realtime;
                  s.idleRate = idleRate;
+                 s.spin = spin;
+                 s.simNice = simNice;
                  return std::make_shared<HapticRuntime>(std::move(surface), std::move(device), s);
              }), py::arg("surface"), py::arg("device"), py::arg("haptic_rate") = 1000.0, py::arg("sim_dt") = 5e-4,
              py::arg("graphics_rate") = 60.0, py::arg("max_force") = 0.0, py::arg("max_stiffness") = 0.0,
              py::arg("stale_limit") = 0.02, py::arg("fade_time") = 0.05, py::arg("max_lag") = 0.005,
              py::arg("log_seconds") = 0.0, py::arg("stop_when_finished") = false, py::arg("realtime") = false,
-             py::arg("idle_rate") = 100.0)
+             py::arg("idle_rate") = 100.0, py::arg("spin") = 0.0, py::arg("sim_nice") = 0)
         .def("start", &HapticRuntime::start)
         .def("stop", &HapticRuntime::stop, py::call_guard<py::gil_scoped_release>(),
              "Zero the force, join both threads (GIL released while waiting).")
@@ -136,6 +138,8 @@ void bindRuntime(py::module_& m) {
             d["haptic_period_p50_ms"] = s.periodP50 * 1e3;
             d["haptic_period_p99_ms"] = s.periodP99 * 1e3;
             d["haptic_period_max_ms"] = s.periodMax * 1e3;
+            d["latency_p50_ms"] = s.latencyP50 * 1e3;
+            d["latency_p99_ms"] = s.latencyP99 * 1e3;
             d["haptic_ticks"] = s.hapticTicks;
             d["sim_steps"] = s.simSteps;
             d["refused_steps"] = s.refusedSteps;

@@ -4,6 +4,10 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <sys/prctl.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -22,6 +26,20 @@ void atomicMax(std::atomic<double>& a, double v) {
     }
 }
 
+// The q-quantile of a histogram of n + 1 bins of the given width (the last one open-ended).
+double binPercentile(const std::atomic<std::uint32_t>* bins, int n, double width, double q) {
+    std::uint64_t total = 0;
+    for (int i = 0; i <= n; ++i) total += bins[i].load(std::memory_order_relaxed);
+    if (total == 0) return 0.0;
+    const auto want = static_cast<std::uint64_t>(std::ceil(q * static_cast<double>(total)));
+    std::uint64_t seen = 0;
+    for (int i = 0; i <= n; ++i) {
+        seen += bins[i].load(std::memory_order_relaxed);
+        if (seen >= want) return (i + 0.5) * width;
+    }
+    return n * width;
+}
+
 bool finiteSample(const DeviceSample& s) {
     return s.position.allFinite() && s.orientation.coeffs().allFinite() && s.orientation.norm() > 0;
 }
@@ -29,7 +47,7 @@ bool finiteSample(const DeviceSample& s) {
 
 HapticRuntime::HapticRuntime(std::shared_ptr<DynamicSurface> surface, std::shared_ptr<Device> device, RuntimeSettings settings)
     : surface_(std::move(surface)), device_(std::move(device)), settings_(settings),
-      periodBins_(new std::atomic<std::uint32_t>[kBins + 1]) {
+      periodBins_(new std::atomic<std::uint32_t>[kBins + 1]), latencyBins_(new std::atomic<std::uint32_t>[kBins + 1]) {
     if (!surface_) throw std::invalid_argument("surface: required");
     if (!device_) throw std::invalid_argument("device: required");
     liveSurface_.store(surface_.get(), std::memory_order_relaxed);
@@ -47,7 +65,12 @@ HapticRuntime::HapticRuntime(std::shared_ptr<DynamicSurface> surface, std::share
     positive(settings_.maxLag, "max_lag");
     for (double v : {settings_.graphicsRate, settings_.maxForce, settings_.maxStiffness, settings_.logSeconds, settings_.idleRate})
         if (!(v >= 0) || !std::isfinite(v)) throw std::invalid_argument("settings: rates, limits and log length must be finite and >= 0");
-    for (int i = 0; i <= kBins; ++i) periodBins_[i].store(0, std::memory_order_relaxed);
+    if (!(settings_.spin >= 0 && settings_.spin <= 0.001)) throw std::invalid_argument("spin: must be in [0, 0.001] s");
+    if (settings_.simNice < 0 || settings_.simNice > 19) throw std::invalid_argument("sim_nice: must be in 0..19");
+    for (int i = 0; i <= kBins; ++i) {
+        periodBins_[i].store(0, std::memory_order_relaxed);
+        latencyBins_[i].store(0, std::memory_order_relaxed);
+    }
     caps_ = device_->caps();
     if (settings_.maxForce == 0) settings_.maxForce = caps_.maxForce > 0 ? caps_.maxForce : INFINITY;
     if (settings_.maxStiffness == 0) settings_.maxStiffness = caps_.maxStiffness > 0 ? caps_.maxStiffness : INFINITY;
@@ -238,6 +261,9 @@ void HapticRuntime::hapticLoop() {
         sp.sched_priority = std::max(1, sched_get_priority_max(SCHED_FIFO) - 1);
         realtimeOk_.store(pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0, std::memory_order_relaxed);
     }
+    // Wake-ups to the microsecond: a thread's timer slack (50 us by default) delays every one.
+    prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+    const auto spin = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(settings_.spin));
     const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / settings_.hapticRate));
     const auto idlePeriod = settings_.idleRate > 0
         ? std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / settings_.idleRate)) : period;
@@ -252,7 +278,13 @@ void HapticRuntime::hapticLoop() {
             // Idle (surface at rest, nothing grabbed): poll the device at idleRate only; a grab is
             // seen within 1/idleRate and the next tick is back at full rate.
             next += idle ? idlePeriod : period;
-            std::this_thread::sleep_until(next);
+            if (spin.count() > 0 && !idle) {
+                std::this_thread::sleep_until(next - spin);
+                while (Clock::now() < next) {
+                }
+            } else {
+                std::this_thread::sleep_until(next);
+            }
             const auto tick = Clock::now();
             if (!first && !idle && !wasIdle) {
                 const double p = std::chrono::duration<double>(tick - last).count();
@@ -276,6 +308,8 @@ void HapticRuntime::hapticLoop() {
             const Vec3 estimated = finiteSample(sample) ? estimateForce(e, sample.position, sample.orientation, t) : Vec3::Zero();
             const Vec3 rendered = e.sequence ? limitForce(e, estimated, t, limits_) : Vec3::Zero();
             device_->setForce(rendered);
+            const double latency = std::chrono::duration<double>(Clock::now() - tick).count();
+            latencyBins_[std::min(kBins, static_cast<int>(latency / kBinWidth))].fetch_add(1, std::memory_order_relaxed);
             for (int i = 0; i < 3; ++i) force_[i].store(rendered[i], std::memory_order_relaxed);
             estimateAge_.store(t - e.time, std::memory_order_relaxed);
             if (tickCount_ < ticks_.size()) ticks_[tickCount_++] = {t, sample, estimated, rendered};
@@ -302,6 +336,7 @@ void HapticRuntime::hapticLoop() {
 }
 
 void HapticRuntime::simLoop() {
+    if (settings_.simNice > 0) setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), settings_.simNice);
     const double dt = settings_.simDt;
     const double graphicsEvery = settings_.graphicsRate > 0 ? 1.0 / settings_.graphicsRate : INFINITY;
     double simTime = 0, nextGraphics = 0;
@@ -434,20 +469,10 @@ RuntimeStatus HapticRuntime::status() const {
         s.hapticHz = static_cast<double>(s.hapticTicks) / s.elapsed;
         s.simHz = static_cast<double>(s.simSteps) / s.elapsed;
     }
-    std::uint64_t total = 0;
-    for (int i = 0; i <= kBins; ++i) total += periodBins_[i].load(std::memory_order_relaxed);
-    auto percentile = [&](double q) {
-        if (total == 0) return 0.0;
-        const auto want = static_cast<std::uint64_t>(std::ceil(q * static_cast<double>(total)));
-        std::uint64_t seen = 0;
-        for (int i = 0; i <= kBins; ++i) {
-            seen += periodBins_[i].load(std::memory_order_relaxed);
-            if (seen >= want) return (i + 0.5) * kBinWidth;
-        }
-        return kBins * kBinWidth;
-    };
-    s.periodP50 = percentile(0.5);
-    s.periodP99 = percentile(0.99);
+    s.periodP50 = binPercentile(periodBins_.get(), kBins, kBinWidth, 0.5);
+    s.periodP99 = binPercentile(periodBins_.get(), kBins, kBinWidth, 0.99);
+    s.latencyP50 = binPercentile(latencyBins_.get(), kBins, kBinWidth, 0.5);
+    s.latencyP99 = binPercentile(latencyBins_.get(), kBins, kBinWidth, 0.99);
     s.periodMax = periodMax_.load(std::memory_order_relaxed);
     s.force = Vec3(force_[0].load(std::memory_order_relaxed), force_[1].load(std::memory_order_relaxed),
                    force_[2].load(std::memory_order_relaxed));

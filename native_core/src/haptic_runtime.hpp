@@ -31,6 +31,12 @@ struct RuntimeSettings {
     double logSeconds = 0;      ///< > 0: keep every haptic tick and simulation snapshot for analysis
     bool stopWhenFinished = false;  ///< stop when a finite (replay) device has played out
     bool realtime = false;      ///< try SCHED_FIFO for the haptic thread (needs privileges)
+    /// s before each haptic tick the thread stops sleeping and spins on the clock: a sleeping
+    /// thread wakes up to a scheduler's latency late, a spinning one on time (0: sleep only).
+    double spin = 0;
+    /// Niceness added to the simulation thread (0..19, no privileges needed): the haptic thread
+    /// then wins the core from it at once when both are ready.
+    int simNice = 0;
     double idleRate = 100;      ///< Hz: device polling while the surface rests and nothing is grabbed (0: never idle)
 };
 
@@ -39,6 +45,7 @@ struct RuntimeStatus {
     double elapsed = 0;             ///< s since start
     double hapticHz = 0, simHz = 0;
     double periodP50 = 0, periodP99 = 0, periodMax = 0;  ///< haptic period (s)
+    double latencyP50 = 0, latencyP99 = 0;  ///< s from reading the device to writing its force
     std::uint64_t hapticTicks = 0, simSteps = 0, refusedSteps = 0, strokes = 0;
     double droppedSimTime = 0;      ///< s of simulated time dropped to keep up with real time
     Vec3 force = Vec3::Zero();      ///< last rendered force
@@ -222,7 +229,7 @@ private:
     // statistics (relaxed atomics: read by status() while the loops run)
     static constexpr int kBins = 4000;      // 2.5 us bins up to 10 ms
     static constexpr double kBinWidth = 2.5e-6;
-    std::unique_ptr<std::atomic<std::uint32_t>[]> periodBins_;
+    std::unique_ptr<std::atomic<std::uint32_t>[]> periodBins_, latencyBins_;
     std::atomic<double> periodMax_{0}, estimateAge_{0}, droppedSimTime_{0};
     std::atomic<std::uint64_t> hapticTicks_{0}, simSteps_{0}, refused_{0}, strokeCount_{0};
     std::atomic<double> force_[3] = {0.0, 0.0, 0.0};

@@ -491,3 +491,26 @@ TEST(HapticRuntime, RefusesBadSettings) {
     EXPECT_THROW(HapticRuntime(s, dev, bad), std::invalid_argument);
     EXPECT_THROW(HapticRuntime(s, nullptr, RuntimeSettings{}), std::invalid_argument);
 }
+
+TEST(HapticRuntime, LatencyIsMeasuredAndTheTimingSettingsAreChecked) {
+    auto s = patch();
+    RuntimeSettings settings;
+    settings.stopWhenFinished = true;
+    settings.spin = 2e-4;   // spins the last 0.2 ms before each tick
+    settings.simNice = 5;   // the simulation thread yields to the haptic one
+    HapticRuntime rt(s, lift(0.3, 10.0), settings);
+    rt.start();
+    EXPECT_TRUE(waitFor([&] { return !rt.running(); }));
+    rt.stop();
+    const RuntimeStatus st = rt.status();
+    EXPECT_EQ(st.error, "");
+    EXPECT_GT(st.latencyP50, 0.0);
+    EXPECT_GE(st.latencyP99, st.latencyP50);
+    EXPECT_LT(st.latencyP50, 0.001);  // reading a replay and writing nowhere takes microseconds
+    for (auto bad : {std::pair{-1e-6, 0}, std::pair{0.002, 0}, std::pair{0.0, -1}, std::pair{0.0, 20}}) {
+        RuntimeSettings b;
+        b.spin = bad.first;
+        b.simNice = bad.second;
+        EXPECT_THROW(HapticRuntime(patch(), lift(0.1, 1.0), b), std::invalid_argument);
+    }
+}
