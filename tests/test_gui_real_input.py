@@ -62,12 +62,18 @@ class Desktop:
         self.env = dict(os.environ, DISPLAY=self.display, QTWEBENGINE_DISABLE_SANDBOX="1", FREECAD_USER_HOME=home,
                         HS_OBSERVER_OUT=self.state_file)
         self.log = open(os.path.join(tmp, "freecad.log"), "a")
+        if os.path.exists(self.state_file):  # (a restart: the last FreeCAD's state is not this one's)
+            os.remove(self.state_file)
         files = [open_file] if open_file else []
         self.freecad = subprocess.Popen(["freecad", os.path.join(ROOT, "tests", "gui_input", "observer.py"), *files],
                                         env=self.env, stdout=self.log, stderr=subprocess.STDOUT)
-        self.version = self.wait(lambda s: s.get("workbench") == "HapticSculptWorkbench",
-                                 "FreeCAD starting on the workbench", 120)["version"]
-        self.focus()
+        try:
+            self.version = self.wait(lambda s: s.get("workbench") == "HapticSculptWorkbench",
+                                     "FreeCAD starting on the workbench", 120)["version"]
+            self.focus()
+        except BaseException:
+            self.close()  # (a FreeCAD left running would load every test after this one)
+            raise
 
     def wait_window(self, title: str, timeout: float = 20.0) -> None:
         """Waits until a window whose title contains ``title`` is shown (a dialog FreeCAD opened) and
