@@ -366,6 +366,29 @@ class TestSeveralFaces(SolidChecks):
         moved = displaced_by_face(obj, loft, [front, right])
         self.assertTrue(all(abs(v) > 1.0 for v in moved.values()), moved)
 
+    def test_two_faces_follow_a_changed_base(self):
+        """A parametric box and fillet: the box made 1.5x longer, the two faces' sculpt follows (what
+        was displaced grows with the faces), the seam stays tangent."""
+        box = self.doc.addObject("Part::Box", "Box")
+        box.Length, box.Width, box.Height = 40, 30, 10
+        self.doc.recompute()
+        edge = next(k for k, e in enumerate(box.Shape.Edges)
+                    if abs(e.CenterOfMass.z - 10) < 1e-9 and abs(e.CenterOfMass.y) < 1e-9)
+        fillet = self.doc.addObject("Part::Fillet", "Fillet")
+        fillet.Base, fillet.Edges = box, [(edge + 1, 4.0, 4.0)]
+        self.doc.recompute()
+        top = face_named(fillet.Shape, lambda f: isinstance(f.Surface, Part.Plane) and abs(f.CenterOfMass.z - 10) < 1e-9)
+        round_ = face_named(fillet.Shape, lambda f: isinstance(f.Surface, Part.Cylinder))
+        obj = hs.sculpt_solid(self.doc, fillet, [top, round_])
+        pull(obj, (20, 4.5, 10), (0, -3, 4))
+        before = self.check_sculpted(obj, fillet, [top, round_])
+        box.Length = 60
+        self.doc.recompute()
+        self.assertEqual(obj.RebuildError, "")
+        self.assertAlmostEqual(obj.Shape.BoundBox.XLength, 60, delta=1e-6)
+        after = self.check_sculpted(obj, fillet, [top, round_])
+        self.assertAlmostEqual(after / before, 1.5, delta=0.03)
+
     def test_faces_that_cannot_be_joined_are_refused(self):
         part, top, fillet = self.filleted_box()
         bottom = face_named(part.Shape, lambda f: abs(f.CenterOfMass.z) < 1e-9)
