@@ -91,9 +91,19 @@ class Desktop:
         raise AssertionError(f"timed out waiting for the window {title!r} to have the keyboard")
 
     def focus(self) -> None:
-        """Keyboard focus to FreeCAD's main window (what clicking its title bar does on a desktop)."""
-        window = self.xdo("search", "--name", "FreeCAD").split()[-1]
-        self.xdo("windowfocus", "--sync", window)
+        """Keyboard focus to FreeCAD's main window (what clicking its title bar does on a desktop),
+        once it has its title (the workbench can be up before: seen on a loaded machine)."""
+        end = time.monotonic() + 30.0
+        while True:
+            found = subprocess.run(["xdotool", "search", "--name", "FreeCAD"], env=self.env, capture_output=True,
+                                   text=True).stdout.split()
+            if found or time.monotonic() > end:
+                break
+            time.sleep(0.05)
+        if not found:
+            self.shot("timeout")
+            raise AssertionError("timed out waiting for FreeCAD's main window")
+        self.xdo("windowfocus", "--sync", found[-1])
 
     def close(self) -> None:
         for p in (self.freecad, self.xvfb):
