@@ -95,9 +95,11 @@ def rope_build() -> core.DynamicSurface:
     return s
 
 
-def rope_play(s: core.DynamicSurface, dt: float) -> list[np.ndarray]:
+def rope_play(s: core.DynamicSurface, dt: float, at: tuple[int, int] = (12, 12)) -> list[np.ndarray]:
+    """Grabs 2 mm above mesh point ``at``, rises 15 mm over 0.15 s (the cursor moved every 1 ms of
+    simulated time), lets go and swings free until 0.3 s; the mesh at the release and at the end."""
     per_ms = round(MS / dt)
-    top = np.array(s.mesh[12, 12]) + [0, 0, 2.0]
+    top = np.array(s.mesh[at]) + [0, 0, 2.0]
     snaps = []
     for k in range(300):
         grab = k < 150
@@ -158,17 +160,7 @@ def two_faces_build() -> core.DynamicSurface:
 
 
 def two_faces_play(s: core.DynamicSurface, dt: float) -> list[np.ndarray]:
-    per_ms = round(MS / dt)
-    top = np.array(s.mesh[9, 12]) + [0, 0, 2.0]  # beside the seam (mesh column 11.5)
-    snaps = []
-    for k in range(300):
-        grab = k < 150
-        s.set_cursor(list(top + [0, 0, 15.0 * min(k, 150) / 150]), grab=grab)
-        s.step(dt, per_ms)
-        if k == 149:
-            snaps.append(np.array(s.mesh))
-    snaps.append(np.array(s.mesh))
-    return snaps
+    return rope_play(s, dt, at=(9, 12))  # beside the seam (mesh column 11.5)
 
 
 # name: (build, play, simulated seconds, (shortest, longest) time step)

@@ -106,6 +106,14 @@ class SolidChecks(DocumentTestCase):
         self.doc.recompute()
         return obj
 
+    def reopened(self, obj, file_name):
+        """``obj`` as the document saved to ``file_name``, closed and opened again, has it."""
+        path, name = os.path.join(self.tmp, file_name), obj.Name
+        self.doc.saveAs(path)
+        FreeCAD.closeDocument(self.doc.Name)
+        self.doc = FreeCAD.openDocument(path)
+        return self.doc.getObject(name)
+
     def volumes(self, obj, base):
         """OCP's view of the base, the sculpted solid and its STEP file (see OCP_SOLIDS)."""
         paths = {"base": os.path.join(self.tmp, "base.brep"), "solid": os.path.join(self.tmp, "solid.brep"),
@@ -338,12 +346,7 @@ class TestSeveralFaces(SolidChecks):
         self.doc.undo()
         self.doc.redo()
         self.assertEqual(obj.Shape.Volume, volume)
-        path = os.path.join(self.tmp, "two_faces.FCStd")
-        self.doc.saveAs(path)
-        name = obj.Name
-        FreeCAD.closeDocument(self.doc.Name)
-        self.doc = FreeCAD.openDocument(path)
-        again = self.doc.getObject(name)
+        again = self.reopened(obj, "two_faces.FCStd")
         self.assertEqual(again.Shape.Volume, volume)
         pull(again, mass_point_near(again, 30, 6), (0, 0, -2))
         self.check_sculpted(again, self.doc.getObject("Part"), [top, fillet], min_volume=0.0)
@@ -425,12 +428,7 @@ class TestSymmetricSculpt(SolidChecks):
         self.doc.undo()
         self.doc.redo()
         self.assertEqual(obj.Shape.Volume, volume)
-        path = os.path.join(self.tmp, "symmetric.FCStd")
-        self.doc.saveAs(path)
-        name = obj.Name
-        FreeCAD.closeDocument(self.doc.Name)
-        self.doc = FreeCAD.openDocument(path)
-        again = self.doc.getObject(name)
+        again = self.reopened(obj, "symmetric.FCStd")
         self.assertEqual(again.Sculpts[0].Proxy.live.snapshot().symmetry[0], sym["direction"])
         pull(again, mass_point_near(again, 8, 20), (0, 0, -3))
         surface = sculpted_surface(again.Sculpts[0])
@@ -514,14 +512,10 @@ class TestSculptedSolidDocument(SolidChecks):
         from HapticSculpt.app.sculpted_solid import preview
         box, obj = self.make()
         pull(obj, (20, 15, 10), (0, 0, 6))
-        volume, name = obj.Shape.Volume, obj.Name
+        volume = obj.Shape.Volume
         obj.Shape = preview(obj, read_state(obj.Sculpts[0]))  # what a GUI session's frame shows
         self.assertEqual(len(obj.Shape.Solids), 0)
-        path = os.path.join(self.tmp, "during.FCStd")
-        self.doc.saveAs(path)
-        FreeCAD.closeDocument(self.doc.Name)
-        self.doc = FreeCAD.openDocument(path)
-        again = self.doc.getObject(name)
+        again = self.reopened(obj, "during.FCStd")
         self.assertEqual(len(again.Shape.Solids), 1)
         self.assertAlmostEqual(again.Shape.Volume, volume, delta=1e-9 * volume)
 
@@ -546,12 +540,8 @@ class TestSculptedSolidDocument(SolidChecks):
     def test_save_and_reopen(self):
         box, obj = self.make()
         pull(obj, (20, 15, 10), (0, 0, 6))
-        volume, report, name = obj.Shape.Volume, obj.SeamReport, obj.Name
-        path = os.path.join(self.tmp, "solid.FCStd")
-        self.doc.saveAs(path)
-        FreeCAD.closeDocument(self.doc.Name)
-        self.doc = FreeCAD.openDocument(path)
-        again = self.doc.getObject(name)
+        volume, report = obj.Shape.Volume, obj.SeamReport
+        again = self.reopened(obj, "solid.FCStd")
         self.assertEqual(again.Shape.Volume, volume)
         self.assertEqual(again.SeamReport, report)
         again.touch()

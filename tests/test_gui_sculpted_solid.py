@@ -34,6 +34,31 @@ def solid(s: dict) -> dict:
     return s["docs"][s["active"]]["solids"][0]
 
 
+def view_part(d: Desktop, name: str) -> dict:
+    """Waits for the opened file's object ``name``, turns the view isometric and fits it (FreeCAD's
+    0 and V, F) until the part is all in view, and maps the view's pixels to the screen's."""
+    s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["screen"].get(name), "the file to open")
+    d.xdo("mousemove", "640", "500", "click", "1")  # (the view has the keys and the mouse)
+    d.xdo("key", "0")  # isometric
+    d.xdo("key", "--delay", "150", "v", "f")  # fit all
+    size = s["views"][0]["size"]
+    s = d.wait(lambda s: all(0 < p[0] < size[0] and 0 < p[1] < size[1]
+                             for p in s["docs"][s["active"]]["screen"][name]), "the part in view")
+    d.calibrate()
+    return s
+
+
+def stroke_in_session(d: Desktop, start: tuple[int, int], rise: int, steps: int, seconds: float) -> dict:
+    """Starts a session, drags from ``start`` up the screen ``rise`` pixels a step, stops the
+    session (one click: stopping commits and rebuilds the solid, a second would start again);
+    the state once it has stopped."""
+    d.press_button("Session", lambda s: s["docs"][s["active"]]["sculpts"][0]["session"], "the session")
+    d.drag([start] + [(start[0], start[1] - rise * k) for k in range(1, steps + 1)], seconds=seconds)
+    d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
+    d.click_button("Session")
+    return d.wait(lambda s: not s["docs"][s["active"]]["sculpts"][0]["session"], "the session to stop")
+
+
 @pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
 def test_a_face_of_a_part_sculpted_in_place(tmp_path):
     os.makedirs(SHOTS, exist_ok=True)
@@ -41,14 +66,7 @@ def test_a_face_of_a_part_sculpted_in_place(tmp_path):
     part = run_freecad_gui(f"PATH = {path!r}\n" + HOUSING, str(tmp_path))
     d = Desktop(str(tmp_path), "CAD", open_file=path)
     try:
-        s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["screen"].get("Housing"), "the file to open")
-        d.xdo("mousemove", "640", "500", "click", "1")  # (the view has the keys and the mouse)
-        d.xdo("key", "0")  # isometric
-        d.xdo("key", "--delay", "150", "v", "f")  # fit all (FreeCAD's V, F)
-        size = s["views"][0]["size"]
-        s = d.wait(lambda s: all(0 < p[0] < size[0] and 0 < p[1] < size[1]
-                                 for p in s["docs"][s["active"]]["screen"]["Housing"]), "the part in view")
-        d.calibrate()
+        s = view_part(d, "Housing")
         # the top face between the fillet and the hole: the bounding box's west point (x = 15 mm)
         west = d.to_screen(s["docs"][s["active"]]["screen"]["Housing"][2])
         d.xdo("mousemove", str(west[0]), str(west[1]))
@@ -60,11 +78,7 @@ def test_a_face_of_a_part_sculpted_in_place(tmp_path):
         assert abs(made["volume"] - part["volume"]) < 1e-3 * part["volume"]
         assert made["faces"] == part["faces"] and made["base_visible"] is False
         assert max(r["g0_mm"] for r in made["seams"]) <= 1e-7
-        d.press_button("Session", lambda s: s["docs"][s["active"]]["sculpts"][0]["session"], "the session")
-        d.drag([west] + [(west[0], west[1] - 8 * k) for k in range(1, 13)], seconds=0.8)
-        d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
-        d.click_button("Session")  # once: stopping commits and rebuilds the solid, a second click would start again
-        s = d.wait(lambda s: not s["docs"][s["active"]]["sculpts"][0]["session"], "the session to stop")
+        s = stroke_in_session(d, west, 8, 12, 0.8)
         picture = d.shot("solid_pulled")
         assert abs(solid(s)["volume"] - made["volume"]) > 1.0, "the stroke changed the part"
         pulled = solid(s)
@@ -122,14 +136,7 @@ def test_a_top_and_its_fillet_picked_together_and_sculpted_as_one(tmp_path):
     part = run_freecad_gui(f"PATH = {path!r}\n" + BLOCK, str(tmp_path))
     d = Desktop(str(tmp_path), "CAD", open_file=path)
     try:
-        s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["screen"].get("Block"), "the file to open")
-        d.xdo("mousemove", "640", "500", "click", "1")
-        d.xdo("key", "0")  # isometric
-        d.xdo("key", "--delay", "150", "v", "f")  # fit all
-        size = s["views"][0]["size"]
-        s = d.wait(lambda s: all(0 < p[0] < size[0] and 0 < p[1] < size[1]
-                                 for p in s["docs"][s["active"]]["screen"]["Block"]), "the part in view")
-        d.calibrate()
+        s = view_part(d, "Block")
         centre, south = (d.to_screen(p) for p in (s["docs"][s["active"]]["screen"]["Block"][k] for k in (0, 4)))
         # from the top's south point (y = 10 mm) on towards the fillet (y < 6), a few pixels a step
         # as a hand moves: the last point on the top and the first on the fillet
@@ -156,12 +163,8 @@ def test_a_top_and_its_fillet_picked_together_and_sculpted_as_one(tmp_path):
         assert abs(made["volume"] - part["volume"]) < 1e-6 * part["volume"]
         seam = [r for r in made["seams"] if r["g1_deg"] is not None]
         assert seam, "the seam between the top and the fillet is held G1"
-        d.press_button("Session", lambda s: s["docs"][s["active"]]["sculpts"][0]["session"], "the session")
         # a stroke across the seam: grabbed on the top beside it, pulled up
-        d.drag([on_top] + [(on_top[0], on_top[1] - 10 * k) for k in range(1, 13)], seconds=0.9)
-        d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
-        d.click_button("Session")
-        s = d.wait(lambda s: not s["docs"][s["active"]]["sculpts"][0]["session"], "the session to stop")
+        s = stroke_in_session(d, on_top, 10, 12, 0.9)
         pulled = solid(s)
         assert pulled["valid"] and pulled["solids"] == 1 and pulled["closed"] and not pulled["error"], pulled
         assert abs(pulled["volume"] - made["volume"]) > 1.0, "the stroke changed the part"
@@ -204,14 +207,7 @@ def test_a_top_picked_with_a_plane_is_sculpted_mirrored(tmp_path):
     part = run_freecad_gui(f"PATH = {path!r}\n" + MIRRORED, str(tmp_path))
     d = Desktop(str(tmp_path), "CAD", open_file=path)
     try:
-        s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["screen"].get("Mirror"), "the file to open")
-        d.xdo("mousemove", "640", "500", "click", "1")
-        d.xdo("key", "0")  # isometric
-        d.xdo("key", "--delay", "150", "v", "f")  # fit all
-        size = s["views"][0]["size"]
-        s = d.wait(lambda s: all(0 < p[0] < size[0] and 0 < p[1] < size[1]
-                                 for p in s["docs"][s["active"]]["screen"]["Block"]), "the part in view")
-        d.calibrate()
+        s = view_part(d, "Block")
         screen = s["docs"][s["active"]]["screen"]
         east = d.to_screen(screen["Block"][1])  # (45, 20, 15): on the top, on the camera's side of the plane
         # (30, 20, 20) on the plane above the block: halfway between its top edge's middle and the block's top
@@ -224,11 +220,7 @@ def test_a_top_picked_with_a_plane_is_sculpted_mirrored(tmp_path):
         s = d.press_button("SculptFace", lambda s: s["docs"][s["active"]]["solids"], "the SculptedSolid")
         made = solid(s)
         assert made["mirror_mm"] is not None and made["mirror_mm"] <= 1e-9, made
-        d.press_button("Session", lambda s: s["docs"][s["active"]]["sculpts"][0]["session"], "the session")
-        d.drag([east] + [(east[0], east[1] - 10 * k) for k in range(1, 11)], seconds=0.8)
-        d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
-        d.click_button("Session")
-        s = d.wait(lambda s: not s["docs"][s["active"]]["sculpts"][0]["session"], "the session to stop")
+        s = stroke_in_session(d, east, 10, 10, 0.8)
         pulled = solid(s)
         assert pulled["valid"] and pulled["solids"] == 1 and pulled["closed"] and not pulled["error"], pulled
         assert abs(pulled["volume"] - part["volume"]) > 1.0, "the stroke changed the part"

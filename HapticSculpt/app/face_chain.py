@@ -177,9 +177,6 @@ class FaceChain:
                                          tuple(p["own"]), tuple(p["span"])) for p in d["placements"]),
                          tuple(d["v_range"]), tuple(Seam(s["edge"], float(s["u"]), tuple(s["faces"])) for s in d["seams"]))
 
-    def placement(self, face: str) -> Placement:
-        return next(p for p in self.placements if p.face == face)
-
     def seam_edges(self) -> set[str]:
         return {s.edge for s in self.seams}
 
@@ -228,11 +225,12 @@ def single(shape: Any, face: str) -> FaceChain:
 
 
 # --- finding the chain ------------------------------------------------------------------------------
-def _order(shape: Any, faces: Sequence[str]) -> tuple[list[str], dict[frozenset[str], str]]:
+def _order(edges_of: dict[str, list[face_in_solid.FaceEdge]],
+           faces: Sequence[str]) -> tuple[list[str], dict[frozenset[str], str]]:
     """The faces in chain order and the edge each neighbouring pair shares; ValueError otherwise."""
     shared: dict[frozenset[str], str] = {}
     for f in faces:
-        for e in face_in_solid.face_edges(shape, f):
+        for e in edges_of[f]:
             for n in e.neighbours:
                 if n in faces and n != f:
                     key = frozenset((f, n))
@@ -256,9 +254,8 @@ def _order(shape: Any, faces: Sequence[str]) -> tuple[list[str], dict[frozenset[
     return order, shared
 
 
-def _side_of(shape: Any, face: str, edge: str) -> str:
+def _side_of(edges: list[face_in_solid.FaceEdge], face: str, edge: str) -> str:
     """The side of the face's parameter range the edge covers whole ("u0", "u1", "v0" or "v1")."""
-    edges = face_in_solid.face_edges(shape, face)
     e = next(x for x in edges if x.name == edge)
     if e.side is None:
         raise ValueError(f"faces: {edge} is not a side of {face}'s parameter range; the faces cannot be joined "
@@ -283,7 +280,8 @@ def chain_of(shape: Any, faces: Sequence[str]) -> FaceChain:
     """The faces of ``shape`` placed in one parameter space (ValueError saying why they cannot be)."""
     if len(faces) == 1:
         return single(shape, faces[0])
-    order, shared = _order(shape, faces)
+    edges_of = {f: face_in_solid.face_edges(shape, f) for f in faces}  # (found once: each costs a conversion)
+    order, shared = _order(edges_of, faces)
     nfaces = {f: face_in_solid.nurbs_face(shape.getElement(f)) for f in order}
     size = max(float(np.linalg.norm(np.ptp(np.array([tuple(v.Point) for v in shape.getElement(f).Vertexes]), axis=0)))
                for f in order) or 1.0
@@ -297,9 +295,9 @@ def chain_of(shape: Any, faces: Sequence[str]) -> FaceChain:
         # the edge with the previous face goes to u0, the one with the next to u1
         want = {}
         if prev:
-            want[_side_of(shape, f, prev)] = "u0"
+            want[_side_of(edges_of[f], f, prev)] = "u0"
         if nxt:
-            want[_side_of(shape, f, nxt)] = "u1"
+            want[_side_of(edges_of[f], f, nxt)] = "u1"
         sides = list(want)
         if len(sides) == 2 and sides[0][0] != sides[1][0]:
             raise ValueError(f"faces: {f} meets its neighbours on two adjacent sides ({prev}, {nxt}), not opposite "

@@ -52,12 +52,12 @@ def _boundary_kinds(boundary: Any, edges: list[face_in_solid.FaceEdge], faces: S
     return kinds
 
 
-def _seam_edges(shape: Any, chain: face_chain.FaceChain) -> list[face_in_solid.FaceEdge]:
+def _seam_edges(chain: face_chain.FaceChain) -> list[face_in_solid.FaceEdge]:
     """The seams between the chain's faces as edges (for the boundary's names and checks)."""
     return [face_in_solid.FaceEdge(s.edge, None, np.zeros((0, 2)), s.faces) for s in chain.seams]
 
 
-def made_of(sculpt: Any) -> Any:
+def _made_of(sculpt: Any) -> Any:
     """A sculpt's current net as a SourceSurface (to find the poles that hold it)."""
     from .source_surface import SourceSurface
     return SourceSurface(sculpt.Proxy.live.snapshot().surface, "exact", 0.0, "")
@@ -125,7 +125,7 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
         controls, mesh = (controls[0] * len(faces), controls[1]), (mesh[0] * len(faces), mesh[1])
     edges = chain.edges(shape)
     seams = chain.seam_edges()
-    kinds = _boundary_kinds(boundary, edges + _seam_edges(shape, chain), faces)
+    kinds = _boundary_kinds(boundary, edges + _seam_edges(chain), faces)
     mirror = None
     if symmetry is not None:
         point, normal = face_symmetry.plane_of(symmetry, doc)
@@ -167,11 +167,12 @@ def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
     edges = chain.edges(shape)
     if isinstance(boundary, dict):
         boundary = {**boundary_of(obj), **boundary}
-    kinds = _boundary_kinds(boundary, edges + _seam_edges(shape, chain), faces)
-    if isinstance(boundary, str):  # (a seam is as tangent as its faces let it be)
-        kinds = seam_kinds(made_of(sculpt_of(obj)), chain, kinds, set())
+    kinds = _boundary_kinds(boundary, edges + _seam_edges(chain), faces)
     sculpt = sculpt_of(obj)
-    held, links = _holds(made_of(sculpt), chain, edges, kinds, mirror_of(obj), ", ".join(faces))
+    made = _made_of(sculpt)
+    if isinstance(boundary, str):  # (a seam is as tangent as its faces let it be)
+        kinds = seam_kinds(made, chain, kinds, set())
+    held, links = _holds(made, chain, edges, kinds, mirror_of(obj), ", ".join(faces))
     live = sculpt.Proxy.live
     if live.session is not None:
         raise RuntimeError(f"{obj.Label}: stop the sculpting session before changing how its edges are held")

@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "dynamic_surface.hpp"
+#include "pulled_steps.hpp"
 
 using namespace hs;
 
-long allocationCount();  // test_core.cpp
 
 namespace {
 
@@ -122,18 +122,7 @@ TEST_P(HeldPolesTest, SteppingWithHeldPolesDoesNotAllocate) {
     DynamicSurface s(BSplineSurface::plane(kN, kN, 3, 3, 100, 100), 30, 30);
     configure(s, setup);
     s.holdPoles(rings(1));
-    Cursor c;
-    c.grab = true;
-    s.setCursor(c);
-    s.step(setup.dt);
-    s.step(setup.dt);
-    const long before = allocationCount();
-    for (int k = 0; k < 50; ++k) {
-        c.position.z() += 0.05;
-        s.setCursor(c);
-        s.step(setup.dt);
-    }
-    EXPECT_EQ(allocationCount() - before, 0) << setup.name;
+    EXPECT_EQ(allocationsWhilePulling(s, setup.dt), 0) << setup.name;
 }
 
 INSTANTIATE_TEST_SUITE_P(Integrators, HeldPolesTest,
@@ -303,18 +292,7 @@ TEST_P(HeldPolesTest, SteppingWithLinkedPolesDoesNotAllocate) {
     DynamicSurface& s = *made;
     configure(s, setup);
     s.holdPoles(outerRing(), seamLinks());
-    Cursor c;
-    c.grab = true;
-    s.setCursor(c);
-    s.step(setup.dt);
-    s.step(setup.dt);
-    const long before = allocationCount();
-    for (int k = 0; k < 50; ++k) {
-        c.position.z() += 0.05;
-        s.setCursor(c);
-        s.step(setup.dt);
-    }
-    EXPECT_EQ(allocationCount() - before, 0) << setup.name;
+    EXPECT_EQ(allocationsWhilePulling(s, setup.dt), 0) << setup.name;
 }
 
 TEST(HeldPoles, BadLinksAreRefusedByName) {

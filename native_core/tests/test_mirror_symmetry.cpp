@@ -7,10 +7,10 @@
 #include <vector>
 
 #include "dynamic_surface.hpp"
+#include "pulled_steps.hpp"
 
 using namespace hs;
 
-long allocationCount();  // test_core.cpp
 
 namespace {
 
@@ -82,19 +82,7 @@ TEST_P(MirrorSymmetryTest, SteppingWithSymmetryDoesNotAllocate) {
     const Scheme setup = GetParam();
     auto made = symmetricPlane(setup);
     DynamicSurface& s = *made;
-    Cursor c;
-    c.position = Vec3(20, 0, 0);
-    c.grab = true;
-    s.setCursor(c);
-    s.step(setup.dt);
-    s.step(setup.dt);
-    const long before = allocationCount();
-    for (int k = 0; k < 50; ++k) {
-        c.position.z() += 0.05;
-        s.setCursor(c);
-        s.step(setup.dt);
-    }
-    EXPECT_EQ(allocationCount() - before, 0) << setup.name;
+    EXPECT_EQ(allocationsWhilePulling(s, setup.dt, Vec3(20, 0, 0)), 0) << setup.name;
 }
 
 INSTANTIATE_TEST_SUITE_P(Integrators, MirrorSymmetryTest,
