@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "device_limits.hpp"
+
 namespace hs {
 
 namespace {
@@ -17,12 +19,12 @@ falcon::Vec3d toDevice(const Vec3& v) { return falcon::Vec3d(v.x(), v.z(), -v.y(
 }  // namespace
 
 void FalconSettings::validate() const {
-    if (!origin.allFinite()) throw std::invalid_argument("origin: must be finite");
-    requirePositive(scale, "scale");
+    mapping.validate();
     requirePositive(countsPerNewtonMetre, "counts_per_newton_metre");
     requirePositive(maxForce, "max_force");
     requireInRange(homingTimeout, "homing_timeout", 0.01, 600.0);
     requireInRange(readTimeout, "read_timeout", 0.0, 0.1);
+    requireInRange(rateHz, "rate", 100.0, 10000.0);
 }
 
 FalconDevice::FalconDevice(std::shared_ptr<falcon::Transport> transport, FalconSettings settings)
@@ -35,8 +37,9 @@ DeviceCaps FalconDevice::caps() const {
     DeviceCaps c;
     c.dof = 3;
     c.forceOutput = true;
-    c.rateHz = 1000;  // the firmware answers each frame; the FTDI latency timer (1 ms) sets the pace
-    c.maxForce = settings_.maxForce;
+    c.rateHz = settings_.rateHz;
+    c.maxForce = settings_.mapping.sessionForce(settings_.maxForce);
+    c.maxStiffness = settings_.mapping.sessionStiffness(passiveStiffnessFor(limitsFor("Novint Falcon"), settings_.rateHz));
     return c;
 }
 
@@ -104,7 +107,7 @@ bool FalconDevice::sample(double, DeviceSample& out) {
         if (lost_) return false;
         missed_.fetch_add(1, std::memory_order_relaxed);
     }
-    out.position = settings_.origin + settings_.scale * 1000.0 * toDocument(tip_ - falcon::Vec3d(0, 0, kCentreZ));
+    out.position = settings_.mapping.position(1000.0 * toDocument(tip_ - falcon::Vec3d(0, 0, kCentreZ)));
     out.orientation = Eigen::Quaterniond::Identity();
     out.buttons = buttons_;
     out.valid = positioned_;
@@ -112,7 +115,7 @@ bool FalconDevice::sample(double, DeviceSample& out) {
 }
 
 void FalconDevice::setForce(const Vec3& force) {
-    Vec3 f = force.allFinite() ? force : Vec3::Zero();
+    Vec3 f = force.allFinite() ? settings_.mapping.newtons(force) : Vec3::Zero();
     if (f.norm() > settings_.maxForce) f *= settings_.maxForce / f.norm();
     falcon::Vec3d torques;
     if (!positioned_ || !falcon::motorTorques(tip_, toDevice(f), torques)) torques.setZero();

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "device.hpp"
+#include "device_mapping.hpp"
 #include "falcon_frames.hpp"
 #include "falcon_kinematics.hpp"
 #include "falcon_transport.hpp"
@@ -15,15 +16,17 @@
 namespace hs {
 
 struct FalconSettings {
-    /// Where the middle of the Falcon's workspace (0, 0, 0.11 m in its frame) sits in the document
-    /// (mm), and mm of document per mm of grip travel. The grip's right, up and towards the user
-    /// are the document's x, z and -y (a front view).
-    Vec3 origin = Vec3::Zero();
-    double scale = 1.0;
+    /// Where the middle of the Falcon's workspace (0, 0, 0.11 m in its frame) sits in the
+    /// document, the travel scale and the session's force unit. The grip's right, up and towards
+    /// the user are the document's x, z and -y (a front view).
+    DeviceMapping mapping;
     /// Motor command per N m of torque: libnifalcon's conversion (its Stamper kinematics).
     double countsPerNewtonMetre = 1e4;
-    /// The largest force rendered (N): the Falcon's rating in CHAI3D.
+    /// The largest force rendered (N): the Falcon's rating (device_limits.hpp).
     double maxForce = 8.0;
+    /// The servo rate the passivity bound is taken at (Hz): the firmware answers each frame and
+    /// the FTDI latency timer (1 ms) sets the pace.
+    double rateHz = 1000;
     double homingTimeout = 10.0;  ///< s: after it, start() throws saying what to do
     double readTimeout = 0.002;   ///< s a tick waits for its status frame before it keeps the last one
     void validate() const;

@@ -82,7 +82,7 @@ TEST(FalconDevice, ASpringRenderedInAClosedLoopHoldsTheGrip) {
     double settled = 0, energyLate = 0;
     for (int k = 0; k < 3000; ++k) {
         ASSERT_TRUE(dev.sample(k * 1e-3, s));
-        const Vec3 f = -0.4 * s.position;  // N/mm: 400 N/m towards the middle
+        const Vec3 f = -400.0 * s.position;  // mN/mm (the session's units) = 400 N/m towards the middle
         dev.setForce(f);
         if (k > 2500) {
             settled = std::max(settled, std::abs(s.position.z() - 20.0 * 300 / 700));

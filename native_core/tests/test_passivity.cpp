@@ -5,6 +5,7 @@
 
 #include <stdexcept>
 
+#include "device_limits.hpp"
 #include "passivity.hpp"
 
 using namespace hs;
@@ -31,4 +32,26 @@ TEST(Passivity, AtTheBoundTheWallTakesEnergyOutAtTwiceItPutsItIn) {
 TEST(Passivity, BadArgumentsAreRefused) {
     EXPECT_THROW(sampledWallEnergyRatio(0.0, 1.0, 10.0, 0.0, 1e-3, 1.0), std::invalid_argument);
     EXPECT_THROW(sampledWallEnergyRatio(1.0, 1.0, 10.0, 0.0, 1e-3, 0.0), std::invalid_argument);
+}
+
+TEST(Passivity, EachDeviceInTheTableAtItsRenderedStiffness) {
+    // What each device gets (device_limits.hpp): at its bound, and with virtual damping taking a
+    // share, the wall takes energy out; at twice the bound it puts energy in.
+    for (const DeviceLimits& row : deviceLimitsTable())
+        for (double rate : row.servoRates) {
+            const double T = 1.0 / rate, k = passiveStiffnessFor(row, rate);
+            EXPECT_LT(sampledWallEnergyRatio(row.mass, row.damping, k, 0.0, T, 2.0), 1.0) << row.model << " " << rate;
+            const double b = 0.5 * row.damping, kd = passiveStiffnessFor(row, rate, b);
+            EXPECT_NEAR(kd, 0.5 * k, 1e-9 * k);
+            EXPECT_LT(sampledWallEnergyRatio(row.mass, row.damping, kd, b, T, 2.0), 1.0) << row.model << " " << rate;
+            EXPECT_GT(sampledWallEnergyRatio(row.mass, row.damping, 2.0 * k, 0.0, T, 2.0), 1e3) << row.model << " " << rate;
+        }
+}
+
+TEST(Passivity, UnknownDevicesGetTheSoftestRow) {
+    EXPECT_EQ(limitsFor("Touch X").model, "Touch X");
+    EXPECT_EQ(limitsFor("touch").model, "Touch");
+    EXPECT_EQ(limitsFor("omega.3 left").model, "omega.3");
+    EXPECT_EQ(limitsFor("something new").model, "Touch");  // the smallest damping
+    EXPECT_THROW(passiveStiffnessFor(limitsFor("Touch"), 0.0), std::invalid_argument);
 }

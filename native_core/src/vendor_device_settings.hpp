@@ -1,0 +1,27 @@
+// Settings shared by the devices behind a vendor's library (OpenHaptics, Force Dimension DHD).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "device_mapping.hpp"
+
+namespace hs {
+
+struct VendorDeviceSettings {
+    DeviceMapping mapping;
+    /// Library names or paths tried in order (empty: the vendor's usual names).
+    std::vector<std::string> library;
+    /// The haptic loop's rate (Hz) the passivity bound is taken at: the servo rate for OpenHaptics
+    /// (its scheduler), the session's haptic rate for DHD (it is polled).
+    double rateHz = 1000;
+    double maxForce = 0;        ///< N; 0: the device's rating (device_limits.hpp)
+    double staleAfter = 0.1;    ///< s without a servo frame before the device counts as lost
+    void validate() const {
+        mapping.validate();
+        requireInRange(rateHz, "rate", 100.0, 10000.0);
+        requirePositive(maxForce, "max_force", true);
+        requireInRange(staleAfter, "stale_after", 0.005, 10.0);
+    }
+};
+
+}  // namespace hs
