@@ -49,7 +49,7 @@ build-tsan: deps
 	cmake --build $(BUILD)/tsan -j $(JOBS)
 
 test-tsan: build-tsan
-	TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 ctest --test-dir $(BUILD)/tsan --output-on-failure -R "Runtime|TripleBuffer|HapticEstimate|FalconDevice"
+	TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 ctest --test-dir $(BUILD)/tsan --output-on-failure -R "Runtime|TripleBuffer|HapticEstimate|FalconDevice|FalconUsb|VendorDevices"
 
 test-cpp: build
 	ctest --test-dir $(BUILD)/release --output-on-failure -j $(JOBS)

@@ -56,6 +56,7 @@ void DhdDevice::start() {
     if (id_ < 0) throw std::runtime_error(lastError("cannot open the device (in use by another program, or no permission?)"));
     const char* name = api_.getSystemName(static_cast<char>(id_));
     model_ = name ? name : "";
+    forceLimit_ = settings_.maxForce > 0 ? settings_.maxForce : limitsFor(model_).ratedForce;
     if (api_.enableForce(1, static_cast<char>(id_)) < 0) {
         const std::string why = lastError("cannot enable force");
         shutdown();
@@ -106,8 +107,7 @@ bool DhdDevice::sample(double, DeviceSample& out) {
 void DhdDevice::setForce(const Vec3& force) {
     if (lost_ || id_ < 0) return;
     Vec3 f = force.allFinite() ? settings_.mapping.newtons(force) : Vec3::Zero();
-    const double limit = settings_.maxForce > 0 ? settings_.maxForce : limitsFor(model_).ratedForce;
-    if (f.norm() > limit) f *= limit / f.norm();
+    if (f.norm() > forceLimit_) f *= forceLimit_ / f.norm();
     const Vec3 d = toDevice(f);
     if (api_.setForce(d.x(), d.y(), d.z(), static_cast<char>(id_)) < 0) lost_ = true;
 }

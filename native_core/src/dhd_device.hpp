@@ -49,6 +49,7 @@ private:
     Api api_{};
     int id_ = -1;
     std::string model_;
+    double forceLimit_ = 0;  // N, set by start(): the clamp per tick
     bool lost_ = false, valid_ = false;
     Vec3 position_ = Vec3::Zero();  // mm, device frame
     std::atomic<std::uint64_t> malformed_{0};

@@ -71,9 +71,16 @@ HapticRuntime::HapticRuntime(std::shared_ptr<DynamicSurface> surface, std::share
         periodBins_[i].store(0, std::memory_order_relaxed);
         latencyBins_[i].store(0, std::memory_order_relaxed);
     }
+    requestedLimits_ = {settings_.maxForce, settings_.maxStiffness};
+    applyDeviceLimits();
+}
+
+// Limits left at 0 come from the device; read again once it has started, when a device that
+// learns its model on opening (a vendor's library) knows its own.
+void HapticRuntime::applyDeviceLimits() {
     caps_ = device_->caps();
-    if (settings_.maxForce == 0) settings_.maxForce = caps_.maxForce > 0 ? caps_.maxForce : INFINITY;
-    if (settings_.maxStiffness == 0) settings_.maxStiffness = caps_.maxStiffness > 0 ? caps_.maxStiffness : INFINITY;
+    settings_.maxForce = requestedLimits_[0] > 0 ? requestedLimits_[0] : caps_.maxForce > 0 ? caps_.maxForce : INFINITY;
+    settings_.maxStiffness = requestedLimits_[1] > 0 ? requestedLimits_[1] : caps_.maxStiffness > 0 ? caps_.maxStiffness : INFINITY;
     limits_ = {settings_.maxForce, settings_.maxStiffness, settings_.staleLimit, settings_.fadeTime};
 }
 
@@ -236,6 +243,7 @@ void HapticRuntime::start() {
     } catch (const std::exception&) {
     }
     device_->start();
+    applyDeviceLimits();
     t0_ = Clock::now();
     started_ = true;
     sim_ = std::thread([this] { simLoop(); });

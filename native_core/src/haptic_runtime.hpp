@@ -176,6 +176,10 @@ public:
     /// around the tick's time (the surface as the simulation computed it then).
     std::vector<double> forceErrors(double floor = 0.05) const;
 
+    /// The settings in force: limits left at 0 filled in from the device (after start(), from the
+    /// device as it found itself on opening).
+    const RuntimeSettings& settings() const { return settings_; }
+
 private:
     void hapticLoop();
     void simLoop();
@@ -193,6 +197,8 @@ private:
     RuntimeSettings settings_;
     DeviceCaps caps_;
     ForceLimits limits_;
+    std::array<double, 2> requestedLimits_{};  // max force and stiffness as given (0: the device's)
+    void applyDeviceLimits();
     std::chrono::steady_clock::time_point t0_;
     std::thread haptic_, sim_;
     bool started_ = false, joined_ = false;

@@ -63,8 +63,8 @@ DeviceCaps OpenHapticsDevice::caps() const {
     c.forceOutput = true;
     c.rateHz = settings_.rateHz;
     const DeviceLimits& row = limitsFor(model_);
-    const double rated = settings_.maxForce > 0 ? settings_.maxForce : maxForce_ > 0 ? std::min(maxForce_, row.ratedForce) : row.ratedForce;
-    c.maxForce = settings_.mapping.sessionForce(rated);
+    // (before start(): the setting, else the table's rating)
+    c.maxForce = settings_.mapping.sessionForce(forceLimit_ > 0 ? forceLimit_ : settings_.maxForce > 0 ? settings_.maxForce : row.ratedForce);
     double k = passiveStiffnessFor(row, settings_.rateHz);
     if (nominalStiffness_ > 0) k = std::min(k, nominalStiffness_);  // the vendor's own figure, if lower
     c.maxStiffness = settings_.mapping.sessionStiffness(k);
@@ -88,6 +88,8 @@ void OpenHapticsDevice::start() {
     v = 0;
     api_.getDoublev(kNominalMaxStiffness, &v);  // N/mm
     nominalStiffness_ = v > 0 && std::isfinite(v) ? 1000 * v : 0;
+    const double rated = limitsFor(model_).ratedForce;
+    forceLimit_ = settings_.maxForce > 0 ? settings_.maxForce : maxForce_ > 0 ? std::min(maxForce_, rated) : rated;
     api_.enable(kForceOutput);
     callback_ = api_.scheduleAsynchronous(&OpenHapticsDevice::servoCallback, this, kMaxSchedulerPriority);
     scheduled_ = true;
@@ -182,8 +184,7 @@ bool OpenHapticsDevice::sample(double, DeviceSample& out) {
 
 void OpenHapticsDevice::setForce(const Vec3& force) {
     Vec3 f = force.allFinite() ? settings_.mapping.newtons(force) : Vec3::Zero();
-    const double limit = settings_.maxForce > 0 ? settings_.maxForce : maxForce_ > 0 ? maxForce_ : limitsFor(model_).ratedForce;
-    if (f.norm() > limit) f *= limit / f.norm();
+    if (f.norm() > forceLimit_) f *= forceLimit_ / f.norm();
     const Vec3 d = toDevice(f);
     for (int i = 0; i < 3; ++i) force_[i].store(d[i], std::memory_order_relaxed);
 }

@@ -81,6 +81,7 @@ private:
     unsigned long callback_ = 0;
     std::string model_;
     double maxForce_ = 0, nominalStiffness_ = 0;
+    double forceLimit_ = 0;  // N, set by start(): the clamp per tick
     TripleBuffer<Frame> frameBuffer_{Frame{}};
     std::atomic<double> force_[3] = {0.0, 0.0, 0.0};
     std::atomic<bool> lost_{false};

@@ -108,10 +108,11 @@ void holdsASpring(D& dev, double tolerance) {
     EXPECT_NEAR(s.position.z(), 20.0 * 300 / 700, tolerance);
 }
 
-RuntimeStatus strokeInSession(const std::shared_ptr<Device>& dev, StrokeSnapshot& stroke) {
+RuntimeStatus strokeInSession(const std::shared_ptr<Device>& dev, StrokeSnapshot& stroke, RuntimeSettings& used) {
     auto surface = std::make_shared<DynamicSurface>(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 24, 24);
     HapticRuntime rt(surface, dev, RuntimeSettings{});
     rt.start();
+    used = rt.settings();
     const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(30);
     while (rt.running() && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(std::chrono::milliseconds(2));
     rt.stop();
@@ -277,7 +278,9 @@ TEST(VendorDevices, OpenHapticsRopeStrokeInAThreadedSessionThenUnplugged) {
     fake.call<void (*)(long)>("unplug_after")(1400);
     auto dev = std::make_shared<OpenHapticsDevice>(settingsFor(kHd));
     StrokeSnapshot stroke;
-    const RuntimeStatus st = strokeInSession(dev, stroke);
+    RuntimeSettings used;
+    const RuntimeStatus st = strokeInSession(dev, stroke, used);
+    EXPECT_NEAR(used.maxForce, 3300, 1e-9);  // mN: the Touch's, as it reported itself on opening
     EXPECT_EQ(st.error, "device lost");
     EXPECT_EQ(st.force.norm(), 0.0);
     EXPECT_EQ(st.strokes, 1u);
@@ -294,7 +297,11 @@ TEST(VendorDevices, DhdRopeStrokeInAThreadedSessionThenUnplugged) {
     fake.call<void (*)(long)>("unplug_after")(1400);
     auto dev = std::make_shared<DhdDevice>(settingsFor(kDhd));
     StrokeSnapshot stroke;
-    const RuntimeStatus st = strokeInSession(dev, stroke);
+    RuntimeSettings used;
+    const RuntimeStatus st = strokeInSession(dev, stroke, used);
+    // the omega.3's limits, known once it was opened (before: the softest row's)
+    EXPECT_NEAR(used.maxStiffness, 5000, 1e-9);
+    EXPECT_NEAR(used.maxForce, 12000, 1e-9);
     EXPECT_EQ(st.error, "device lost");
     EXPECT_EQ(st.force.norm(), 0.0);
     EXPECT_EQ(st.strokes, 1u);
