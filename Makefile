@@ -5,7 +5,7 @@ BUILD       := build
 JOBS        ?= 2
 APT_PACKAGES := build-essential cmake ninja-build pkg-config libeigen3-dev pybind11-dev libgtest-dev \
                 python3-dev python3-numpy python3-scipy python3-pytest python3-hypothesis python3-matplotlib \
-                python3-venv freecad-python3 freecad libhidapi-dev xvfb xauth xdotool imagemagick debootstrap
+                python3-venv freecad-python3 freecad libhidapi-dev libusb-1.0-0 xvfb xauth xdotool imagemagick debootstrap
 SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
@@ -72,7 +72,8 @@ $(FC_HOME)/Mod/HapticSculpt:
 # Everything but the GUI tests, against the in-tree build (the GUI tests run from the installed
 # addon in test-addon, or from here in test-gui).
 test-python: build ocp-venv
-	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) -m pytest -q tests \
+	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python HS_FAKE_VENDOR=$(CURDIR)/$(BUILD)/release/fake_vendor \
+	  $(PY) -m pytest -q tests \
 	  --ignore-glob='tests/test_gui_*' $(PYTEST_ARGS)
 
 test-gui: build ocp-venv

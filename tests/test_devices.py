@@ -29,11 +29,15 @@ def run_runtime(surface, device, seconds):
 def test_udev_rules_cover_every_model_with_uaccess_only():
     text = open(devices.UDEV_RULES).read()
     rules = [ln for ln in text.splitlines() if ln and not ln.startswith("#")]
-    ids = {(int(v, 16), int(p, 16)) for v, p in
-           (re.search(r'idVendor}=="([0-9a-f]{4})", ATTRS{idProduct}=="([0-9a-f]{4})"', r).groups() for r in rules)}
-    assert ids == {(v, p) for v, p, _ in _core.spacemouse_models()}
+
+    def ids(prefix):
+        return {(int(v, 16), int(p, 16)) for v, p in
+                (re.search(r'idVendor}=="([0-9a-f]{4})", ATTRS{idProduct}=="([0-9a-f]{4})"', r).groups()
+                 for r in rules if r.startswith(prefix))}
+    assert ids('KERNEL=="hidraw*"') == {(v, p) for v, p, _ in _core.spacemouse_models()}
+    assert ids('SUBSYSTEM=="usb"') == {(0x0403, 0xcb48)}  # the Falcon, and no other USB device
     for r in rules:
-        assert r.startswith('KERNEL=="hidraw*"') and r.endswith('TAG+="uaccess"'), r
+        assert r.startswith(('KERNEL=="hidraw*"', 'SUBSYSTEM=="usb"')) and r.endswith('TAG+="uaccess"'), r
         assert "MODE" not in r and "GROUP" not in r and "#" not in r
 
 

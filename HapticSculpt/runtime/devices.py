@@ -1,8 +1,12 @@
-"""Devices a session can drive: what is attached (hidapi/hidraw), SpaceMouse, HID PID force
-feedback and replays (the mouse is the GUI's: HapticSculpt.gui.mouse_device). All loops run in
-C++; these are thin, validated constructors."""
+"""Devices a session can drive: what is attached (:func:`list`), the 3-DOF force devices (Novint
+Falcon, 3D Systems Touch/Phantom through OpenHaptics, Force Dimension through DHD), the SpaceMouse,
+HID PID force feedback and replays (the mouse is the GUI's: HapticSculpt.gui.mouse_device). All
+loops run in C++; these are thin, validated constructors. Forces are in the session's units: mN
+with the workbench's mm, kg and s (``force_scale`` = N per session force unit)."""
 from __future__ import annotations
 
+import builtins
+import glob
 import os
 from typing import Any, Sequence
 
@@ -23,7 +27,7 @@ def native_device(device: Any) -> Any:
     raise TypeError(f"device: expected a ReplayDevice or a HapticSculpt device, got {type(device).__name__}")
 
 
-def list_devices() -> list[dict[str, Any]]:
+def list_devices() -> builtins.list[dict[str, Any]]:
     """Attached HID interfaces, each with ``kind``: "spacemouse" for a known SpaceMouse, else "hid"."""
     out = []
     for d in _core.hid_devices():
@@ -48,7 +52,7 @@ def spacemouse(path: str | None = None, recording: str | None = None, mode: str 
         raise ValueError(f"recording: no such file {recording!r}")
     return _core.SpaceMouseDevice(path=path, recording=recording, paced=paced, mode=mode,
                                   translation_scale=translation_scale, rotation_scale=rotation_scale,
-                                  dead_zone=dead_zone, origin=list(map(float, origin)))
+                                  dead_zone=dead_zone, origin=_point(origin))
 
 
 def force_feedback(input_device: Any, output: Any, full_scale_force: float, max_force: float,
@@ -58,3 +62,152 @@ def force_feedback(input_device: Any, output: Any, full_scale_force: float, max_
     ``full_scale_force`` maps to the device's largest magnitude."""
     driver = _core.PidForceDriver(output, full_scale_force=full_scale_force)
     return _core.ForceFeedbackDevice(native_device(input_device), driver, max_force, max_stiffness)
+
+
+#: Where the Falcon's firmware file is looked for when none is given (see the README).
+FALCON_FIRMWARE_ENV = "HAPTICSCULPT_FALCON_FIRMWARE"
+#: USB vendor ids of the devices that need a vendor's library (usb.ids): 3D Systems, Force Dimension.
+_VENDOR_USB_IDS = {"openhaptics": "2988", "dhd": "1451"}
+
+
+def _point(origin: Sequence[float]) -> builtins.list[float]:
+    values = [float(v) for v in origin]
+    if len(values) != 3:
+        raise ValueError(f"origin: expected 3 numbers, got {len(values)}")
+    return values
+
+
+def _library(library: str | Sequence[str] | None) -> builtins.list[str] | None:
+    if library is None:
+        return None
+    return [library] if isinstance(library, str) else [str(x) for x in library]
+
+
+def _usb_vendors() -> set[str]:
+    """USB vendor ids attached (sysfs; no library or permission needed)."""
+    found = set()
+    for path in glob.glob("/sys/bus/usb/devices/*/idVendor"):
+        try:
+            with open(path) as f:
+                found.add(f.read().strip().lower())
+        except OSError:
+            pass
+    return found
+
+
+def falcon_firmware(firmware: str | None = None) -> str:
+    """The Falcon firmware file to use: ``firmware``, else $HAPTICSCULPT_FALCON_FIRMWARE, else ""."""
+    path = firmware if firmware is not None else os.environ.get(FALCON_FIRMWARE_ENV, "")
+    if path and not os.path.isfile(path):
+        raise ValueError(f"firmware: no such file {path!r}")
+    return path
+
+
+def falcon(index: int = 0, firmware: str | None = None, origin: Sequence[float] = (0.0, 0.0, 0.0),
+           scale: float = 1.0, force_scale: float = 1e-3, max_force: float = 0.0, rate: float = 1000.0,
+           library: str | Sequence[str] | None = None) -> Any:
+    """The ``index``-th Novint Falcon on USB. Its firmware (Novint's, loaded after each power-up) comes
+    from ``firmware`` or $HAPTICSCULPT_FALCON_FIRMWARE when it is not running yet. ``origin``: where
+    the middle of its workspace sits in the document (mm); ``scale``: document mm per mm of travel.
+    Call ``start()`` (or start a session) to home it."""
+    if int(index) < 0:
+        raise ValueError("index: must be >= 0")
+    return _core.FalconDevice(index=int(index), firmware=falcon_firmware(firmware), library=_library(library),
+                              origin=_point(origin), scale=scale, force_scale=force_scale, max_force=max_force,
+                              rate=rate)
+
+
+def openhaptics(origin: Sequence[float] = (0.0, 0.0, 0.0), scale: float = 1.0, force_scale: float = 1e-3,
+                max_force: float = 0.0, rate: float = 1000.0, library: str | Sequence[str] | None = None) -> Any:
+    """3D Systems Touch / Phantom (its default device) through OpenHaptics, loaded at run time."""
+    return _core.OpenHapticsDevice(library=_library(library), origin=_point(origin), scale=scale,
+                                   force_scale=force_scale, max_force=max_force, rate=rate)
+
+
+def dhd(origin: Sequence[float] = (0.0, 0.0, 0.0), scale: float = 1.0, force_scale: float = 1e-3,
+        max_force: float = 0.0, rate: float = 1000.0, library: str | Sequence[str] | None = None) -> Any:
+    """The first Force Dimension device through the DHD SDK, loaded at run time."""
+    return _core.DhdDevice(library=_library(library), origin=_point(origin), scale=scale, force_scale=force_scale,
+                           max_force=max_force, rate=rate)
+
+
+def list(firmware: str | None = None, libraries: dict[str, Any] | None = None) -> builtins.list[dict[str, Any]]:
+    """What is attached, force devices first, each a dict with ``kind`` ("falcon", "openhaptics",
+    "dhd", "spacemouse", "hid"), ``name``, ``force`` (renders force), ``usable`` and, when it is not,
+    ``why`` (no permission, the Falcon's firmware file missing, the vendor's library missing).
+    ``libraries`` maps a kind to the library to load instead of the system's (tests)."""
+    libraries = libraries or {}
+    out: builtins.list[dict[str, Any]] = []
+    try:
+        falcons = _core.usb_falcons(library=_library(libraries.get("falcon")))
+    except RuntimeError as e:  # no libusb: Falcons can only be seen through sysfs
+        falcons = []
+        if any(_sysfs_has("0403", "cb48")):
+            out.append({"kind": "falcon", "name": "Novint Falcon", "force": True, "usable": False, "why": str(e)})
+    for k, f in enumerate(falcons):
+        why = f["why"]
+        if not why and not f["firmware_running"]:
+            try:
+                given = falcon_firmware(firmware)
+            except ValueError as e:
+                why = str(e)
+            else:
+                if not given:
+                    why = (f"its firmware is not loaded (it must be, after each power-up): set ${FALCON_FIRMWARE_ENV} "
+                           "to Novint's firmware file (see the README)")
+        out.append({"kind": "falcon", "name": f"Novint Falcon (USB {f['bus']}:{f['address']})", "index": k,
+                    "force": True, "usable": not why, "why": why})
+    vendors = _usb_vendors()
+    for kind, probe, name in (("openhaptics", _core.openhaptics_probe, "3D Systems Touch/Phantom (OpenHaptics)"),
+                              ("dhd", _core.dhd_probe, "Force Dimension (DHD)")):
+        p = probe(library=_library(libraries.get(kind)))
+        if p["loaded"]:
+            if p["attached"] > 0:
+                out.append({"kind": kind, "name": p["model"] or name, "force": True, "usable": True, "why": ""})
+            elif _VENDOR_USB_IDS[kind] in vendors:
+                out.append({"kind": kind, "name": name, "force": True, "usable": False, "why": p["why"]})
+        elif _VENDOR_USB_IDS[kind] in vendors:  # its device is there, its library is not
+            out.append({"kind": kind, "name": name, "force": True, "usable": False,
+                        "why": f"the vendor's library is not installed: {p['why']}"})
+    for d in list_devices():
+        access = os.access(d["path"], os.R_OK | os.W_OK)
+        out.append({"kind": d["kind"], "name": d["spacemouse"] or d["name"], "path": d["path"], "force": False,
+                    "usable": access,
+                    "why": "" if access else "no permission to open it: install the udev rules (sudo make install-udev)"})
+    return out
+
+
+def _sysfs_has(vendor: str, product: str) -> builtins.list[bool]:
+    hits = []
+    for path in glob.glob("/sys/bus/usb/devices/*/idVendor"):
+        try:
+            with open(path) as f, open(os.path.join(os.path.dirname(path), "idProduct")) as g:
+                hits.append(f.read().strip() == vendor and g.read().strip() == product)
+        except OSError:
+            pass
+    return hits
+
+
+def pick(firmware: str | None = None, libraries: dict[str, Any] | None = None, **mapping: Any) -> Any | None:
+    """The device a session should use: the first usable force device (Falcon, Touch/Phantom, Force
+    Dimension), else the first usable SpaceMouse, else None (the caller takes the mouse).
+    ``mapping``: origin, scale, force_scale, max_force, rate for a force device."""
+    libraries = libraries or {}
+    for d in list(firmware, libraries):
+        if not d["usable"]:
+            continue
+        if d["kind"] == "falcon":
+            return falcon(d["index"], firmware, library=libraries.get("falcon"), **mapping)
+        if d["kind"] == "openhaptics":
+            return openhaptics(library=libraries.get("openhaptics"), **mapping)
+        if d["kind"] == "dhd":
+            return dhd(library=libraries.get("dhd"), **mapping)
+        if d["kind"] == "spacemouse":
+            return spacemouse(d["path"])
+    return None
+
+
+def limits() -> builtins.list[dict[str, Any]]:
+    """The force devices' limits table (README "Force devices"): rated force (N), damping (N s/m),
+    servo rates (Hz) and the passive stiffness bound at each (N/m), with their source."""
+    return _core.device_limits()

@@ -10,4 +10,5 @@ void bindTools(pybind11::module_& m);           ///< bind_tools.cpp: Tool and th
 void bindDynamicSurface(pybind11::module_& m);  ///< bind_dynamic_surface.cpp: DynamicSurface, StepReport
 void bindRuntime(pybind11::module_& m);         ///< bind_runtime.cpp: Device, replays, HapticRuntime
 void bindDevices(pybind11::module_& m);         ///< bind_devices.cpp: HID, SpaceMouse, force feedback
+void bindForceDevices(pybind11::module_& m);    ///< bind_force_devices.cpp: Falcon, OpenHaptics, DHD
 }  // namespace hs

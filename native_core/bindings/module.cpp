@@ -14,4 +14,5 @@ PYBIND11_MODULE(HS_MODULE_NAME, m) {
     hs::bindDynamicSurface(m);
     hs::bindRuntime(m);
     hs::bindDevices(m);  // SpaceMouse, HID PID: subclasses of Device
+    hs::bindForceDevices(m);
 }

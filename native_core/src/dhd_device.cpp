@@ -1,5 +1,6 @@
 #include "dhd_device.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "device_limits.hpp"
@@ -29,6 +30,22 @@ DhdDevice::DhdDevice(VendorDeviceSettings settings)
     api_.getButtonMask = l.function<decltype(api_.getButtonMask)>("dhdGetButtonMask");
     api_.getSystemName = l.function<decltype(api_.getSystemName)>("dhdGetSystemName");
     api_.errorGetLastStr = l.function<decltype(api_.errorGetLastStr)>("dhdErrorGetLastStr");
+}
+
+VendorProbe DhdDevice::probe(const std::vector<std::string>& library) {
+    VendorProbe p;
+    VendorDeviceSettings settings;
+    settings.library = library;
+    try {
+        DhdDevice dev(settings);
+        p.loaded = true;
+        p.library = dev.library_.name();
+        p.attached = std::max(0, dev.api_.getDeviceCount());
+        if (p.attached == 0) p.why = dev.lastError("no device attached");
+    } catch (const std::runtime_error& e) {
+        p.why = e.what();
+    }
+    return p;
 }
 
 DhdDevice::~DhdDevice() { shutdown(); }

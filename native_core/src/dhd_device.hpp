@@ -25,6 +25,8 @@ public:
     bool sample(double t, DeviceSample& out) override;
     void setForce(const Vec3& force) override;
     std::string model() const { return model_; }
+    /// Loads the library and counts the devices (none is opened).
+    static VendorProbe probe(const std::vector<std::string>& library = {});
     /// Samples whose position was not finite (kept the last one).
     std::uint64_t malformed() const { return malformed_.load(std::memory_order_relaxed); }
 

@@ -48,6 +48,29 @@ OpenHapticsDevice::OpenHapticsDevice(VendorDeviceSettings settings)
     api_.getString = l.function<decltype(api_.getString)>("hdGetString");
 }
 
+VendorProbe OpenHapticsDevice::probe(const std::vector<std::string>& library) {
+    VendorProbe p;
+    VendorDeviceSettings settings;
+    settings.library = library;
+    try {
+        OpenHapticsDevice dev(settings);
+        p.loaded = true;
+        p.library = dev.library_.name();
+        dev.handle_ = dev.api_.initDevice(nullptr);
+        if (dev.handle_ == kInvalidHandle || dev.api_.getError().errorCode != kSuccess) {
+            p.why = dev.lastError("no device (is it plugged in, and set up with Touch Setup?)");
+            return p;
+        }
+        dev.open_ = true;  // (closed by its destructor)
+        const char* model = dev.api_.getString(kDeviceModelType);
+        p.model = model ? model : "";
+        p.attached = 1;
+    } catch (const std::runtime_error& e) {
+        p.why = e.what();
+    }
+    return p;
+}
+
 OpenHapticsDevice::~OpenHapticsDevice() { shutdown(); }
 
 std::string OpenHapticsDevice::lastError(const char* what) const {

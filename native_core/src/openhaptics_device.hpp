@@ -27,6 +27,8 @@ public:
     void stop() override;
     bool sample(double t, DeviceSample& out) override;
     void setForce(const Vec3& force) override;
+    /// Loads the library, opens the default device and closes it again.
+    static VendorProbe probe(const std::vector<std::string>& library = {});
     /// The device's model as the library names it ("" before start).
     std::string model() const { return model_; }
     std::uint64_t frames() const { return frames_.load(std::memory_order_relaxed); }

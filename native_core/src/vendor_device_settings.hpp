@@ -24,4 +24,13 @@ struct VendorDeviceSettings {
     }
 };
 
+/// What devices.list() learns about a vendor's devices without keeping one open.
+struct VendorProbe {
+    bool loaded = false;     ///< the vendor's library loaded
+    std::string library;     ///< which one
+    int attached = 0;        ///< devices found (OpenHaptics: 0 or 1, its default device)
+    std::string model;       ///< the first one's model, where the library names it
+    std::string why;         ///< why none is usable ("" when one is)
+};
+
 }  // namespace hs

@@ -196,7 +196,7 @@ int libusb_bulk_transfer(void*, unsigned char endpoint, unsigned char* data, int
         data[at++] = 0x31;
         data[at++] = 0x60;
         const std::size_t n = std::min({s.out.size() - taken, std::size_t{62}, static_cast<std::size_t>(length - at)});
-        std::memcpy(data + at, s.out.data() + taken, n);
+        if (n) std::memcpy(data + at, s.out.data() + taken, n);
         at += static_cast<int>(n);
         taken += n;
     } while (taken < s.out.size());
