@@ -373,26 +373,39 @@ class Controller:
         run_echoed(f"HapticSculpt.set_tool({ref(obj)}, {tool!r}{falloff})")
 
     def start_session(self, device: Any = None) -> Any:
-        """Starts sculpting the active sculpt with `device`, else the first attached device, else the mouse."""
-        from ..runtime.devices import list_devices, spacemouse
+        """Starts sculpting the active sculpt with `device`, else the first attached force device, else
+        a SpaceMouse, else the mouse (devices.pick)."""
+        from ..runtime import devices
         from ..runtime.session import Session
         from .mouse_device import MouseDevice
         obj = self.active_sculpt()
         if obj is None:
             raise RuntimeError("select the sculpt to sculpt (or create a patch first)")
         if device is None:
-            found = [d for d in list_devices() if d.get("spacemouse")]
-            if found:
-                device = spacemouse(found[0]["path"])
-            else:
-                device = MouseDevice()
-                device.attach_all([i.view for i in self.inputs] or [self.view()])
+            device = self._attached_device(obj, devices)
+        if device is None:
+            device = MouseDevice()
+            device.attach_all([i.view for i in self.inputs] or [self.view()])
         self.mouse = device if isinstance(device, MouseDevice) else None
         session = Session()
         session.set_airbrush(self.painting, factor=AIRBRUSH_FACTOR)  # before the first tick can grab
         self.session = session.start(obj, device, tool=obj.Proxy.live.snapshot().tool.name)
         self.refresh(obj)
         return self.session
+
+    @staticmethod
+    def _attached_device(obj: Any, devices: Any) -> Any | None:
+        """A force device centred on the sculpt, its ~100 mm workspace scaled to the sculpt's size,
+        else a SpaceMouse; None when there is neither, or the one there fails to open (said in the
+        report view: the mouse takes over)."""
+        box = obj.Shape.BoundBox
+        centre = (box.Center.x, box.Center.y, box.Center.z)
+        try:
+            return devices.pick(origin=centre, scale=max(1.0, box.DiagonalLength / 100.0))
+        except (RuntimeError, ValueError) as e:
+            import FreeCAD
+            FreeCAD.Console.PrintWarning(f"HapticSculpt: {e}; sculpting with the mouse\n")
+            return None
 
     def stop_session(self) -> None:
         if self.session is not None:

@@ -77,7 +77,15 @@ def _point(origin: Sequence[float]) -> builtins.list[float]:
     return values
 
 
-def _library(library: str | Sequence[str] | None) -> builtins.list[str] | None:
+#: Environment variables naming a library to load instead of the system's, per kind (a vendor's SDK
+#: installed off the loader's path, e.g. /opt/OpenHaptics/Developer/lib/libHD.so).
+LIBRARY_ENV = {"falcon": "HAPTICSCULPT_LIBUSB", "openhaptics": "HAPTICSCULPT_OPENHAPTICS_LIB",
+               "dhd": "HAPTICSCULPT_DHD_LIB"}
+
+
+def _library(library: str | Sequence[str] | None, kind: str) -> builtins.list[str] | None:
+    if library is None:
+        library = os.environ.get(LIBRARY_ENV[kind]) or None
     if library is None:
         return None
     return [library] if isinstance(library, str) else [str(x) for x in library]
@@ -112,7 +120,7 @@ def falcon(index: int = 0, firmware: str | None = None, origin: Sequence[float] 
     Call ``start()`` (or start a session) to home it."""
     if int(index) < 0:
         raise ValueError("index: must be >= 0")
-    return _core.FalconDevice(index=int(index), firmware=falcon_firmware(firmware), library=_library(library),
+    return _core.FalconDevice(index=int(index), firmware=falcon_firmware(firmware), library=_library(library, "falcon"),
                               origin=_point(origin), scale=scale, force_scale=force_scale, max_force=max_force,
                               rate=rate)
 
@@ -120,15 +128,15 @@ def falcon(index: int = 0, firmware: str | None = None, origin: Sequence[float] 
 def openhaptics(origin: Sequence[float] = (0.0, 0.0, 0.0), scale: float = 1.0, force_scale: float = 1e-3,
                 max_force: float = 0.0, rate: float = 1000.0, library: str | Sequence[str] | None = None) -> Any:
     """3D Systems Touch / Phantom (its default device) through OpenHaptics, loaded at run time."""
-    return _core.OpenHapticsDevice(library=_library(library), origin=_point(origin), scale=scale,
+    return _core.OpenHapticsDevice(library=_library(library, "openhaptics"), origin=_point(origin), scale=scale,
                                    force_scale=force_scale, max_force=max_force, rate=rate)
 
 
 def dhd(origin: Sequence[float] = (0.0, 0.0, 0.0), scale: float = 1.0, force_scale: float = 1e-3,
         max_force: float = 0.0, rate: float = 1000.0, library: str | Sequence[str] | None = None) -> Any:
     """The first Force Dimension device through the DHD SDK, loaded at run time."""
-    return _core.DhdDevice(library=_library(library), origin=_point(origin), scale=scale, force_scale=force_scale,
-                           max_force=max_force, rate=rate)
+    return _core.DhdDevice(library=_library(library, "dhd"), origin=_point(origin), scale=scale,
+                           force_scale=force_scale, max_force=max_force, rate=rate)
 
 
 def list(firmware: str | None = None, libraries: dict[str, Any] | None = None) -> builtins.list[dict[str, Any]]:
@@ -139,7 +147,7 @@ def list(firmware: str | None = None, libraries: dict[str, Any] | None = None) -
     libraries = libraries or {}
     out: builtins.list[dict[str, Any]] = []
     try:
-        falcons = _core.usb_falcons(library=_library(libraries.get("falcon")))
+        falcons = _core.usb_falcons(library=_library(libraries.get("falcon"), "falcon"))
     except RuntimeError as e:  # no libusb: Falcons can only be seen through sysfs
         falcons = []
         if any(_sysfs_has("0403", "cb48")):
@@ -160,7 +168,7 @@ def list(firmware: str | None = None, libraries: dict[str, Any] | None = None) -
     vendors = _usb_vendors()
     for kind, probe, name in (("openhaptics", _core.openhaptics_probe, "3D Systems Touch/Phantom (OpenHaptics)"),
                               ("dhd", _core.dhd_probe, "Force Dimension (DHD)")):
-        p = probe(library=_library(libraries.get(kind)))
+        p = probe(library=_library(libraries.get(kind), kind))
         if p["loaded"]:
             if p["attached"] > 0:
                 out.append({"kind": kind, "name": p["model"] or name, "force": True, "usable": True, "why": ""})
@@ -173,7 +181,8 @@ def list(firmware: str | None = None, libraries: dict[str, Any] | None = None) -
         access = os.access(d["path"], os.R_OK | os.W_OK)
         out.append({"kind": d["kind"], "name": d["spacemouse"] or d["name"], "path": d["path"], "force": False,
                     "usable": access,
-                    "why": "" if access else "no permission to open it: install the udev rules (sudo make install-udev)"})
+                    "why": "" if access else "no permission to open it: install the udev rules (sudo make install-udev)"
+                    })
     return out
 
 
@@ -203,7 +212,7 @@ def pick(firmware: str | None = None, libraries: dict[str, Any] | None = None, *
         if d["kind"] == "dhd":
             return dhd(library=libraries.get("dhd"), **mapping)
         if d["kind"] == "spacemouse":
-            return spacemouse(d["path"])
+            return spacemouse(d["path"], origin=mapping.get("origin", (0.0, 0.0, 0.0)))
     return None
 
 
