@@ -13,6 +13,9 @@ PHONY_LONG := stress fuzz bench-peers
 .PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-gui-repeat test-cpp test-asan test-python \
         test-gui test-freecad test-addon wheel ocp-venv demo bench install install-udev uninstall clean test-other-debian \
         test-gui-repeat-other-debian
+# The fake vendor libraries (libusb with an emulated Falcon, OpenHaptics, DHD) the device tests
+# load instead of the system's: built with the C++ tests.
+export HS_FAKE_VENDOR := $(CURDIR)/$(BUILD)/release/fake_vendor
 # A private FreeCAD user folder whose Mod/HapticSculpt links this checkout (tests, demo render).
 FC_HOME     := $(BUILD)/freecad-home
 # cadquery (with its own OCCT, OCP) in its own virtual environment: its numpy must not shadow Debian's.
@@ -72,8 +75,7 @@ $(FC_HOME)/Mod/HapticSculpt:
 # Everything but the GUI tests, against the in-tree build (the GUI tests run from the installed
 # addon in test-addon, or from here in test-gui).
 test-python: build ocp-venv
-	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python HS_FAKE_VENDOR=$(CURDIR)/$(BUILD)/release/fake_vendor \
-	  $(PY) -m pytest -q tests \
+	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) -m pytest -q tests \
 	  --ignore-glob='tests/test_gui_*' $(PYTEST_ARGS)
 
 test-gui: build ocp-venv
@@ -96,7 +98,7 @@ wheel: deps $(WHEEL_VENV)/.installed
 # The Addon Manager's install without a compiler: a copy of the repository without build output in
 # a private FreeCAD home's Mod folder, the wheel in its AdditionalPythonPackages; then, from there,
 # the FreeCAD-layer tests through FreeCAD's runner and the GUI tests (tests/addon_install.py).
-test-addon: wheel ocp-venv
+test-addon: build wheel ocp-venv
 	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) tests/addon_install.py \
 	  --wheel $$(ls $(BUILD)/wheel/dist/*.whl) --pip-python $(WHEEL_VENV)/bin/python --out $(BUILD)/addon-install
 
@@ -132,7 +134,7 @@ test-gui-repeat: build ocp-venv
 	  ctest --test-dir $(BUILD)/release --output-on-failure -R "HapticRuntime" | tail -1; \
 	  HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) -m pytest -q -p no:cacheprovider \
 	    tests/test_gui_real_input.py tests/test_gui_overlay.py tests/test_gui_workbench.py tests/test_gui_undo.py \
-	    tests/test_gui_sculpted_solid.py \
+	    tests/test_gui_sculpted_solid.py tests/test_gui_force_device.py \
 	    tests/test_freecad_session.py -rfE | tail -n 15; \
 	done
 

@@ -171,8 +171,9 @@ class _SculptCommand:
 class Session(_SculptCommand):
     icon_name = "Session"
     menu = "Start/stop sculpting"
-    tip = ("Start sculpting the selected sculpt (or the only one) with the attached SpaceMouse (the mouse when "
-           "none is attached: the left button grabs); run again to stop")
+    tip = ("Start sculpting the selected sculpt (or the only one) with the first attached force device (Falcon, "
+           "Touch/Phantom, Force Dimension), else a SpaceMouse, else the mouse (its left button grabs); run again to "
+           "stop")
 
     def IsActive(self) -> bool:
         return _ctl().session is not None or _has_sculpt()

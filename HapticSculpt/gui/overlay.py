@@ -201,8 +201,9 @@ class Overlay:
     def _status(self, s: core.DynamicSurface) -> str:
         """The tool, the material and what goes on, for the HUD's status line."""
         parts = [f"tool: {s.tool.name}", "clay" if s.plasticity[0] else "elastic"]
-        if self._session() is not None:
-            parts.append("sculpting")
+        session = self._session()
+        if session is not None:
+            parts.append(f"sculpting with the {session.device_name or 'mouse'}")
         if self.display == "zebra":
             turn = (f"strips at {self.stripe_angle:g} deg" if self.stripe_mode == "reflection"
                     else "to ({:.2g}, {:.2g}, {:.2g})".format(*self.stripe_direction))

@@ -109,6 +109,11 @@ class Session:
             self._start_timer()
         return self
 
+    @property
+    def device_name(self) -> str:
+        """The name of the device this session runs with ("" when it is not running)."""
+        return self._device.name if self._device is not None and self._runtime is not None else ""
+
     def stop(self, commit: bool = True) -> dict[str, Any]:
         """Zeroes the force, joins the threads, commits the remaining strokes (unless ``commit`` is
         False, e.g. when the document is going away) and returns the final status."""

@@ -31,6 +31,8 @@ def _sculpts(doc):
                     "stiffness_map": [min(o.StiffnessMap), max(o.StiffnessMap), len(o.StiffnessMap)],
                     "stiffness_values": list(o.StiffnessMap),
                     "session": o.Proxy.live.session is not None if getattr(o.Proxy, "live", None) else False,
+                    "device": o.Proxy.live.session.device_name
+                    if getattr(o.Proxy, "live", None) and o.Proxy.live.session else "",
                     "selected": o in Gui.Selection.getSelection(), "screen": _on_screen(o), "digest": digest(o)})
     return out
 

@@ -6,6 +6,8 @@
 // the expected one and the running mode is set. fake_usb_* calls steer it.
 #include <algorithm>
 #include <array>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <mutex>
 #include <vector>
@@ -71,8 +73,23 @@ struct libusb_device_descriptor {
     std::uint8_t iManufacturer, iProduct, iSerialNumber, bNumConfigurations;
 };
 
+void fake_usb_reset(int firmwareRunning);
+void fake_usb_script(const double* rows, int n);
+
+// A process that cannot call fake_usb_* (FreeCAD in the GUI tests) names a script file instead:
+// HS_FAKE_FALCON_SCRIPT, rows of "t x y z buttons"; the Falcon then runs its firmware.
 int libusb_init(void** ctx) {
     *ctx = &handleTag;
+    if (const char* path = std::getenv("HS_FAKE_FALCON_SCRIPT")) {
+        std::vector<double> rows;
+        if (std::FILE* f = std::fopen(path, "r")) {
+            double v;
+            while (std::fscanf(f, "%lf", &v) == 1) rows.push_back(v);
+            std::fclose(f);
+        }
+        fake_usb_reset(1);
+        fake_usb_script(rows.data(), static_cast<int>(rows.size() / 5));
+    }
     return 0;
 }
 void libusb_exit(void*) {}

@@ -1,0 +1,53 @@
+"""A force device in FreeCAD's GUI, as a designer with a Novint Falcon meets it: a new patch, the
+Session button clicked with real X events, and the session takes the Falcon (the first attached
+force device) instead of the mouse: it homes, the grip's stroke pulls the surface (one undo step,
+shown at once), Undo puts it back while the session runs on. The Falcon is the emulated one behind the fake libusb built with
+the C++ tests, loaded through the workbench's own run-time loading (HAPTICSCULPT_LIBUSB); the hand
+on its grip follows a script (HS_FAKE_FALCON_SCRIPT). Screenshot: build/screenshots/falcon_stroke.png."""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+from test_gui_real_input import NEEDS, SHOTS, Desktop, sculpt, undo
+
+FAKES = os.environ.get("HS_FAKE_VENDOR", os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                                      "build", "release", "fake_vendor"))
+
+# The hand on the grip (the Falcon's frame, m: y up, the workspace's middle at z = 0.11): at rest
+# in the middle for 3 s, then 20 mm up over 0.6 s with the grab button held, let go at 4 s.
+HAND = [(0.0, 0.0, 0.0, 0.11, 0), (3.0, 0.0, 0.0, 0.11, 1), (3.6, 0.0, 0.02, 0.11, 1), (4.0, 0.0, 0.02, 0.11, 0),
+        (60.0, 0.0, 0.02, 0.11, 0)]
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_the_session_takes_the_falcon_and_its_stroke_is_one_undo_step(tmp_path, monkeypatch):
+    library = os.path.join(FAKES, "libusb-fake.so")
+    assert os.path.isfile(library), f"the fake libusb is built by make build: {library}"
+    script = tmp_path / "hand.txt"
+    script.write_text("\n".join(" ".join(str(v) for v in row) for row in HAND))
+    monkeypatch.setenv("HAPTICSCULPT_LIBUSB", library)
+    monkeypatch.setenv("HS_FAKE_FALCON_SCRIPT", str(script))
+    os.makedirs(SHOTS, exist_ok=True)
+    d = Desktop(str(tmp_path), "Gesture")
+    try:
+        d.xdo("key", "ctrl+n")
+        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
+        d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        before = undo(d.state())[0]
+        s = d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
+        assert sculpt(s)["device"] == "falcon", "the session did not take the attached Falcon"
+        s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the Falcon's stroke as an undo step", 40)
+        lifted = np.array(sculpt(s)["poles"]).reshape(-1, 3)[:, 2].max()
+        assert lifted > 5.0, f"the grip's stroke did not pull the surface ({lifted} mm)"
+        d.wait(lambda s: np.array(sculpt(s)["shape_poles"])[:, 2].max() > 0.7 * lifted, "the stroke to show")
+        d.shot("falcon_stroke")
+        # ctrl+z while the Falcon still sculpts: the flat patch shows at once, the session runs on
+        d.xdo("key", "ctrl+z")
+        s = d.wait(lambda s: undo(s)[0] == before and np.abs(np.array(sculpt(s)["shape_poles"])[:, 2]).max() < 1e-3,
+                   "Undo to show the flat patch")
+        assert sculpt(s)["session"] and sculpt(s)["device"] == "falcon"
+        d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
+    finally:
+        d.close()
