@@ -5,7 +5,7 @@ BUILD       := build
 JOBS        ?= 2
 APT_PACKAGES := build-essential cmake ninja-build pkg-config libeigen3-dev pybind11-dev libgtest-dev \
                 python3-dev python3-numpy python3-scipy python3-pytest python3-hypothesis python3-matplotlib \
-                python3-venv freecad-python3 freecad libhidapi-dev libusb-1.0-0 xvfb xauth xdotool imagemagick debootstrap
+                python3-venv freecad-python3 freecad libhidapi-dev libusb-1.0-0 libwebsockets-dev libsimdjson-dev xvfb xauth xdotool imagemagick debootstrap
 SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
