@@ -142,7 +142,7 @@ test-gui-repeat: build ocp-venv
 # fixtures' descriptors and reports. A crash or sanitizer report fails the target and leaves the
 # input in $(BUILD)/fuzz/crashes.
 FUZZ_SECONDS ?= 60
-FUZZ_HARNESSES := fuzz_report_descriptor fuzz_spacemouse_report fuzz_hid_recording fuzz_falcon_frames
+FUZZ_HARNESSES := fuzz_report_descriptor fuzz_spacemouse_report fuzz_hid_recording fuzz_falcon_frames fuzz_haply_messages
 fuzz: deps
 	@dpkg-query -W -f='$${Status}' clang libclang-rt-14-dev 2>/dev/null | grep -c "ok installed" | grep -q 2 || \
 	  (DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends clang libclang-rt-14-dev)

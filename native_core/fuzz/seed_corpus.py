@@ -2,7 +2,8 @@
 """Seed corpora for the fuzz harnesses: from hid-recorder fixtures, the recordings themselves
 (fuzz_hid_recording), their report descriptors (fuzz_report_descriptor) and their input reports,
 each prefixed with its length as the harness reads them (fuzz_spacemouse_report); the Falcon's
-status stream (fuzz_falcon_frames, from ../falcon next to the HID fixtures).
+status stream (fuzz_falcon_frames, from ../falcon next to the HID fixtures); the Haply service's
+messages (fuzz_haply_messages, from ../haply).
 
     seed_corpus.py FIXTURE_DIR CORPUS_DIR
 """
@@ -19,8 +20,11 @@ def hex_bytes(fields: list[str]) -> bytes:
 
 def main(fixtures: str, corpus: str) -> None:
     out = pathlib.Path(corpus)
-    for name in ("fuzz_hid_recording", "fuzz_report_descriptor", "fuzz_spacemouse_report", "fuzz_falcon_frames"):
+    for name in ("fuzz_hid_recording", "fuzz_report_descriptor", "fuzz_spacemouse_report", "fuzz_falcon_frames",
+                 "fuzz_haply_messages"):
         (out / name).mkdir(parents=True, exist_ok=True)
+    for path in sorted(pathlib.Path(fixtures).parent.joinpath("haply").glob("*.json")):
+        shutil.copy(path, out / "fuzz_haply_messages" / path.name)
     for path in sorted(pathlib.Path(fixtures).parent.joinpath("falcon").glob("*.bin")):
         shutil.copy(path, out / "fuzz_falcon_frames" / path.name)
     for path in sorted(pathlib.Path(fixtures).glob("*.hid")):

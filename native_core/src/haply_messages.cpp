@@ -22,28 +22,43 @@ Reader::Reader() : parser_(std::make_unique<Parser>()), buffer_(new char[kMaxMes
 Reader::~Reader() = default;
 
 namespace {
-bool readVec(od::object parent, const char* key, Vec3& out) {
+// simdjson's on-demand document must not be touched again after a hard error (a field that is
+// merely absent is not one): every read below hands its error up.
+bool hard(simdjson::error_code e) { return e && e != simdjson::NO_SUCH_FIELD; }
+
+simdjson::error_code readVec(od::object parent, const char* key, Vec3& out) {
     od::object v;
-    if (parent[key].get_object().get(v)) return false;
-    double x, y, z;
-    if (v["x"].get_double().get(x) || v["y"].get_double().get(y) || v["z"].get_double().get(z)) return false;
+    double x = 0, y = 0, z = 0;
+    simdjson::error_code e = parent[key].get_object().get(v);
+    if (!e) e = v["x"].get_double().get(x);
+    if (!e) e = v["y"].get_double().get(y);
+    if (!e) e = v["z"].get_double().get(z);
+    if (e) return e;
     out = Vec3(x, y, z);
-    return out.allFinite();
+    return out.allFinite() ? simdjson::SUCCESS : simdjson::INCORRECT_TYPE;
 }
 
 // A Verse Grip's button ("button": bool) or a wireless one's ("buttons": {"a": bool, ...}).
-std::uint32_t gripButtons(od::object state) {
+simdjson::error_code gripButtons(od::object state, std::uint32_t& bits) {
     bool pressed = false;
-    if (!state["button"].get_bool().get(pressed)) return pressed ? 1u : 0u;
+    simdjson::error_code e = state["button"].get_bool().get(pressed);
+    if (!e) {
+        bits = pressed ? 1u : 0u;
+        return e;
+    }
+    if (hard(e)) return e;
     od::object buttons;
-    if (state["buttons"].get_object().get(buttons)) return 0;
-    std::uint32_t bits = 0, bit = 1;
-    for (auto field : buttons) {
+    if ((e = state["buttons"].get_object().get(buttons))) return e;
+    bits = 0;
+    std::uint32_t bit = 1;
+    for (auto item : buttons) {
+        od::field f;
         bool b = false;
-        if (!field.value().get_bool().get(b) && b) bits |= bit;
+        if ((e = std::move(item).get(f)) || (e = f.value().get_bool().get(b))) return e;
+        if (b) bits |= bit;
         bit <<= 1;
     }
-    return bits;
+    return simdjson::SUCCESS;
 }
 }  // namespace
 
@@ -70,11 +85,18 @@ bool Reader::inventory(std::size_t n, std::vector<Inverse3Info>& out, std::strin
         Inverse3Info info;
         info.deviceId = std::string(id);
         od::object status;
-        if (!device["status"].get_object().get(status)) {
+        simdjson::error_code e = device["status"].get_object().get(status);
+        for (auto [key, flag] : {std::pair<const char*, bool*>{"ready", &info.ready}, {"in_use", &info.inUse},
+                                 {"calibrated", &info.calibrated}}) {
+            if (e) break;
             bool v = false;
-            if (!status["ready"].get_bool().get(v)) info.ready = v;
-            if (!status["in_use"].get_bool().get(v)) info.inUse = v;
-            if (!status["calibrated"].get_bool().get(v)) info.calibrated = v;
+            e = status[key].get_bool().get(v);
+            if (!e) *flag = v;
+            else if (!hard(e)) e = simdjson::SUCCESS;
+        }
+        if (hard(e)) {
+            why = "a malformed status";
+            return false;
         }
         out.push_back(std::move(info));
     }
@@ -91,23 +113,29 @@ bool Reader::state(std::size_t n, const char* deviceId, State& state) {
     State next = state;
     next.found = false;
     for (auto item : devices) {
-        od::object device, s;
+        od::object device, st;
         std::string_view id;
         if (item.get_object().get(device) || device["device_id"].get_string().get(id)) return false;
         if (id != deviceId) continue;
-        if (device["state"].get_object().get(s) || !readVec(s, "cursor_position", next.position)) return false;
+        if (device["state"].get_object().get(st) || readVec(st, "cursor_position", next.position)) return false;
         Vec3 v;
-        if (readVec(s, "cursor_velocity", v)) next.velocity = v;
+        const simdjson::error_code e = readVec(st, "cursor_velocity", v);
+        if (!e) next.velocity = v;
+        else if (hard(e)) return false;
         next.found = true;
         break;
     }
     if (!next.found) return false;
     for (const char* grips : {"verse_grip", "wireless_verse_grip"}) {
         od::array list;
-        if (doc[grips].get_array().get(list)) continue;
+        simdjson::error_code e = doc[grips].get_array().get(list);
+        if (e == simdjson::NO_SUCH_FIELD) continue;
+        if (e) return false;
         for (auto item : list) {  // the first grip's buttons
-            od::object grip, s;
-            if (!item.get_object().get(grip) && !grip["state"].get_object().get(s)) next.buttons = gripButtons(s);
+            od::object grip, st;
+            if ((e = item.get_object().get(grip)) || (e = grip["state"].get_object().get(st)) ||
+                (e = gripButtons(st, next.buttons)))
+                if (hard(e)) return false;
             break;
         }
         break;

@@ -6,6 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <thread>
 
@@ -164,4 +168,35 @@ TEST(HaplyDevice, ARopeStrokeInAThreadedSessionThenTheLinkDrops) {
     EXPECT_GT(stroke.poles.col(2).maxCoeff(), kSanitized ? 0.05 : 0.5);  // the surface was pulled up
     std::lock_guard<std::mutex> g(service.lock);
     EXPECT_GT(service.mechanism.largestForce, 0.05);  // and pulled the grip back
+}
+
+TEST(HaplyMessages, ReadsTheDocumentedShapes) {
+    auto load = [](const char* name, haply::Reader& r) {
+        std::ifstream in(std::string(HS_FIXTURES) + "/../haply/" + name);
+        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        EXPECT_FALSE(text.empty()) << name;
+        std::memcpy(r.buffer(), text.data(), text.size());
+        return text.size();
+    };
+    haply::Reader reader;
+    std::vector<haply::Inverse3Info> devices;
+    std::string why;
+    ASSERT_TRUE(reader.inventory(load("inventory.json", reader), devices, why)) << why;
+    ASSERT_EQ(devices.size(), 1u);
+    EXPECT_EQ(devices[0].deviceId, "049D");
+    EXPECT_TRUE(devices[0].ready && devices[0].calibrated && !devices[0].inUse);
+    haply::State s;
+    ASSERT_TRUE(reader.state(load("state.json", reader), "049D", s));
+    EXPECT_TRUE(s.found);
+    EXPECT_DOUBLE_EQ(s.position.z(), 0.161);
+    EXPECT_DOUBLE_EQ(s.velocity.x(), 0.01);
+    EXPECT_EQ(s.buttons, 1u);  // a wireless grip's "a"
+    EXPECT_FALSE(reader.state(load("state.json", reader), "04BA", s));  // not that device
+    const std::size_t n = load("inventory.json", reader) - 40;  // cut short
+    EXPECT_FALSE(reader.state(n, "049D", s));
+    char out[512];
+    const std::size_t k = haply::writeForceCommand(out, sizeof out, "049D", Vec3(0.5, NAN, 1), false);
+    EXPECT_EQ(std::string(out, k),
+              "{\"inverse3\":[{\"device_id\":\"049D\",\"commands\":{\"set_cursor_force\":{\"vector\":{\"x\":0.000000,\"y\":0.000000,\"z\":0.000000}}}}]}");
+    EXPECT_EQ(haply::writeForceCommand(out, 20, "049D", Vec3::Zero(), true), 0u);  // does not fit
 }
