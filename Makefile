@@ -5,7 +5,7 @@ BUILD       := build
 JOBS        ?= 2
 APT_PACKAGES := build-essential cmake ninja-build pkg-config libeigen3-dev pybind11-dev libgtest-dev \
                 python3-dev python3-numpy python3-scipy python3-pytest python3-hypothesis python3-matplotlib \
-                python3-venv freecad-python3 freecad libhidapi-dev libusb-1.0-0 libwebsockets-dev libsimdjson-dev xvfb xauth xdotool imagemagick debootstrap
+                python3-venv freecad-python3 freecad libhidapi-dev libusb-1.0-0 libwebsockets-dev libsimdjson-dev python3-websockets xvfb xauth xdotool imagemagick debootstrap
 SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
@@ -52,7 +52,7 @@ build-tsan: deps
 	cmake --build $(BUILD)/tsan -j $(JOBS)
 
 test-tsan: build-tsan
-	TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 ctest --test-dir $(BUILD)/tsan --output-on-failure -R "Runtime|TripleBuffer|HapticEstimate|FalconDevice|FalconUsb|VendorDevices"
+	TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 ctest --test-dir $(BUILD)/tsan --output-on-failure -R "Runtime|TripleBuffer|HapticEstimate|FalconDevice|FalconUsb|VendorDevices|HaplyDevice"
 
 test-cpp: build
 	ctest --test-dir $(BUILD)/release --output-on-failure -j $(JOBS)

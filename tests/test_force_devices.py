@@ -1,6 +1,6 @@
 """The 3-DOF force devices from Python, through the same run-time loading a real installation
 uses, with the fake libusb (an FTDI bridge and an emulated Falcon), OpenHaptics and DHD libraries
-built with the C++ tests: devices.list() naming what is attached and why something is not usable,
+built with the C++ tests, and a mock Haply Inverse Service on loopback (haply_service_mock.py): devices.list() naming what is attached and why something is not usable,
 devices.pick() preferring a force device, a threaded session with each, the limits table, and
 validation at the boundary."""
 from __future__ import annotations
@@ -15,6 +15,7 @@ import pytest
 from HapticSculpt import core
 from HapticSculpt.core import native as _core
 from HapticSculpt.runtime import devices
+from haply_service_mock import MockInverseService
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FAKES = os.environ.get("HS_FAKE_VENDOR", os.path.join(ROOT, "build", "release", "fake_vendor"))
@@ -93,10 +94,38 @@ def test_pick_prefers_a_force_device(fakes):
     assert isinstance(devices.pick(libraries=LIBS), _core.DhdDevice)
 
 
-@pytest.mark.parametrize("kind", ["falcon", "openhaptics", "dhd"])
+def test_the_haply_service_is_listed_and_picked_first(fakes):
+    with MockInverseService(devices=("049D", "04BA")) as service:
+        libraries = dict(LIBS, haply=service.address)
+        found = devices.list(libraries=libraries)
+        assert [(d["kind"], d["usable"]) for d in found[:3]] == [("haply", True), ("haply", True), ("falcon", True)]
+        assert found[1]["device_id"] == "04BA"
+        dev = devices.pick(libraries=libraries)
+        assert isinstance(dev, _core.HaplyDevice)
+        dev.start()
+        assert dev.device_id == "049D" and dev.sample(0.0)["valid"]
+        dev.stop()
+        assert service.first_command["session"]["configure"]["basis"] == {"permutation": "XYZ"}
+    with MockInverseService(in_use=True) as service:
+        haply = devices.list(libraries=dict(LIBS, haply=service.address))[0]
+        assert haply["kind"] == "haply" and not haply["usable"] and "in use" in haply["why"]
+    # no service: nothing listed for it, and a clear error when asked for
+    assert all(d["kind"] != "haply" for d in devices.list(libraries=dict(LIBS, haply=f"127.0.0.1:{service.port}")))
+    with pytest.raises(RuntimeError, match="Inverse Service"):
+        devices.haply(service=f"127.0.0.1:{service.port}").start()
+    with pytest.raises(ValueError, match="host:port"):
+        devices.haply(service="localhost")
+
+
+@pytest.mark.parametrize("kind", ["haply", "falcon", "openhaptics", "dhd"])
 def test_a_threaded_session_with_each_device_pulls_the_surface(fakes, kind):
     usb, hd, dhd = fakes
     ramp = [(t, min(1.0, t / 0.6) * 0.02, 1.0 if t < 0.8 else 0.0) for t in (0.0, 0.6, 0.8, 5.0)]
+    if kind == "haply":  # Haply: z up; the grip where it is at the start maps to the origin
+        with MockInverseService([(t, 0.0, 0.0, up, b) for t, up, b in ramp]) as service:
+            run_stroke(devices.haply(service=service.address))
+            assert service.largest_force > 0.01  # N: the grip was pulled back
+        return
     if kind == "falcon":  # the Falcon's frame: y up, the workspace's middle at z = 0.11 m
         script(usb, "fake_usb_", [(t, 0.0, up, 0.11, b) for t, up, b in ramp])
         dev = devices.falcon(library=LIBS["falcon"])
@@ -106,6 +135,11 @@ def test_a_threaded_session_with_each_device_pulls_the_surface(fakes, kind):
     else:  # DHD: z up
         script(dhd, "fake_dhd_", [(t, 0.0, 0.0, up, b) for t, up, b in ramp])
         dev = devices.dhd(library=LIBS["dhd"])
+    run_stroke(dev)
+
+
+def run_stroke(dev) -> None:
+    """A threaded session on a flat patch until its first stroke ends: the surface was lifted."""
     surface = core.patch((8, 8), (3, 3), (24, 24), (100.0, 100.0))
     rt = _core.HapticRuntime(surface, dev)
     rt.start()

@@ -1,5 +1,6 @@
-"""Devices a session can drive: what is attached (:func:`list`), the 3-DOF force devices (Novint
-Falcon, 3D Systems Touch/Phantom through OpenHaptics, Force Dimension through DHD), the SpaceMouse,
+"""Devices a session can drive: what is attached (:func:`list`), the 3-DOF force devices (Haply
+Inverse3 through its Inverse Service, Novint Falcon, 3D Systems Touch/Phantom through OpenHaptics,
+Force Dimension through DHD), the SpaceMouse,
 HID PID force feedback and replays (the mouse is the GUI's: HapticSculpt.gui.mouse_device). All
 loops run in C++; these are thin, validated constructors. Forces are in the session's units: mN
 with the workbench's mm, kg and s (``force_scale`` = N per session force unit)."""
@@ -70,6 +71,18 @@ FALCON_FIRMWARE_ENV = "HAPTICSCULPT_FALCON_FIRMWARE"
 _VENDOR_USB_IDS = {"openhaptics": "2988", "dhd": "1451"}
 
 
+#: Where the Haply Inverse Service listens ("host:port"), if not on this machine's port 10001.
+HAPLY_SERVICE_ENV = "HAPTICSCULPT_HAPLY_SERVICE"
+
+
+def _haply_address(service: str | None) -> tuple[str, int]:
+    text = service if service is not None else os.environ.get(HAPLY_SERVICE_ENV, "127.0.0.1:10001")
+    host, _, port = text.rpartition(":")
+    if not host or not port.isdigit():
+        raise ValueError(f"service: expected 'host:port', got {text!r}")
+    return host, int(port)
+
+
 def _point(origin: Sequence[float]) -> builtins.list[float]:
     values = [float(v) for v in origin]
     if len(values) != 3:
@@ -111,6 +124,16 @@ def falcon_firmware(firmware: str | None = None) -> str:
     return path
 
 
+def haply(device_id: str = "", service: str | None = None, origin: Sequence[float] = (0.0, 0.0, 0.0),
+          scale: float = 1.0, force_scale: float = 1e-3, max_force: float = 0.0, rate: float = 1000.0) -> Any:
+    """A Haply Inverse3 through the Inverse Service (``service`` "host:port", else
+    $HAPTICSCULPT_HAPLY_SERVICE, else this machine's port 10001); ``device_id`` "" takes the first
+    one it lists. Where the grip is at ``start()`` maps to ``origin``."""
+    host, port = _haply_address(service)
+    return _core.HaplyDevice(host=host, port=port, device_id=str(device_id), origin=_point(origin), scale=scale,
+                             force_scale=force_scale, max_force=max_force, rate=rate)
+
+
 def falcon(index: int = 0, firmware: str | None = None, origin: Sequence[float] = (0.0, 0.0, 0.0),
            scale: float = 1.0, force_scale: float = 1e-3, max_force: float = 0.0, rate: float = 1000.0,
            library: str | Sequence[str] | None = None) -> Any:
@@ -140,12 +163,23 @@ def dhd(origin: Sequence[float] = (0.0, 0.0, 0.0), scale: float = 1.0, force_sca
 
 
 def list(firmware: str | None = None, libraries: dict[str, Any] | None = None) -> builtins.list[dict[str, Any]]:
-    """What is attached, force devices first, each a dict with ``kind`` ("falcon", "openhaptics",
-    "dhd", "spacemouse", "hid"), ``name``, ``force`` (renders force), ``usable`` and, when it is not,
-    ``why`` (no permission, the Falcon's firmware file missing, the vendor's library missing).
-    ``libraries`` maps a kind to the library to load instead of the system's (tests)."""
+    """What is attached, force devices first, each a dict with ``kind`` ("haply", "falcon",
+    "openhaptics", "dhd", "spacemouse", "hid"), ``name``, ``force`` (renders force), ``usable`` and, when it is not,
+    ``why`` (no permission, the Falcon's firmware file missing, the vendor's library missing, in
+    use). ``libraries`` maps a kind to the library to load instead of the system's, and "haply" to
+    the Inverse Service's "host:port"."""
     libraries = libraries or {}
     out: builtins.list[dict[str, Any]] = []
+    host, port = _haply_address(libraries.get("haply"))
+    try:  # (a service that is not running refuses at once)
+        inverse3s = _core.haply_devices(host=host, port=port, timeout=1.0)
+    except RuntimeError:
+        inverse3s = []
+    for d in inverse3s:
+        why = ("in use by another program" if d["in_use"] else
+               "" if d["ready"] else "not ready (powered? see the Haply Hub)")
+        out.append({"kind": "haply", "name": f"Haply Inverse3 {d['device_id']}", "device_id": d["device_id"],
+                    "force": True, "usable": not why, "why": why})
     try:
         falcons = _core.usb_falcons(library=_library(libraries.get("falcon"), "falcon"))
     except RuntimeError as e:  # no libusb: Falcons can only be seen through sysfs
@@ -198,13 +232,16 @@ def _sysfs_has(vendor: str, product: str) -> builtins.list[bool]:
 
 
 def pick(firmware: str | None = None, libraries: dict[str, Any] | None = None, **mapping: Any) -> Any | None:
-    """The device a session should use: the first usable force device (Falcon, Touch/Phantom, Force
-    Dimension), else the first usable SpaceMouse, else None (the caller takes the mouse).
+    """The device a session should use: the first usable force device (Inverse3, Falcon,
+    Touch/Phantom, Force Dimension), else the first usable SpaceMouse, else None (the caller takes
+    the mouse).
     ``mapping``: origin, scale, force_scale, max_force, rate for a force device."""
     libraries = libraries or {}
     for d in list(firmware, libraries):
         if not d["usable"]:
             continue
+        if d["kind"] == "haply":
+            return haply(d["device_id"], libraries.get("haply"), **mapping)
         if d["kind"] == "falcon":
             return falcon(d["index"], firmware, library=libraries.get("falcon"), **mapping)
         if d["kind"] == "openhaptics":

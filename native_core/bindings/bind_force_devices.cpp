@@ -1,4 +1,4 @@
-// The 3-DOF force devices: the Novint Falcon over USB, 3D Systems' Touch/Phantom (OpenHaptics) and
+// The 3-DOF force devices: Haply's Inverse3 through its service, the Novint Falcon over USB, 3D Systems' Touch/Phantom (OpenHaptics) and
 // Force Dimension's (DHD) through their vendors' libraries, what is attached, and the table of
 // device limits. Opening and homing wait: they release the GIL.
 #include <pybind11/eigen.h>
@@ -11,6 +11,7 @@
 #include "dhd_device.hpp"
 #include "falcon_device.hpp"
 #include "falcon_usb.hpp"
+#include "haply_device.hpp"
 #include "openhaptics_device.hpp"
 
 namespace py = pybind11;
@@ -110,6 +111,46 @@ void bindForceDevices(py::module_& m) {
         }
         return out;
     }, "The force devices' limits (N, N s/m, kg, Hz, N/m at each rate) and where they come from.");
+
+    m.def("haply_devices", [](const std::string& host, int port, double timeout) {
+        std::vector<haply::Inverse3Info> found;
+        {
+            py::gil_scoped_release release;
+            found = HaplyDevice::discover(host, port, timeout);
+        }
+        py::list out;
+        for (const auto& d : found) {
+            py::dict e;
+            e["device_id"] = d.deviceId;
+            e["ready"] = d.ready;
+            e["in_use"] = d.inUse;
+            e["calibrated"] = d.calibrated;
+            out.append(e);
+        }
+        return out;
+    }, py::arg("host") = "127.0.0.1", py::arg("port") = 10001, py::arg("timeout") = 1.0,
+       "The Inverse3s Haply's Inverse Service lists; RuntimeError when it cannot be reached.");
+
+    py::class_<HaplyDevice, Device, std::shared_ptr<HaplyDevice>>(m, "HaplyDevice",
+        "A Haply Inverse3 through the Inverse Service (WebSocket JSON); the grip's position at start() maps to origin.")
+        .def(py::init([](const std::string& host, int port, const std::string& deviceId, const Vec3& origin, double scale,
+                         double forceScale, double maxForce, double rate) {
+                 HaplySettings s;
+                 s.mapping = mappingOf(origin, scale, forceScale);
+                 s.host = host;
+                 s.port = port;
+                 s.deviceId = deviceId;
+                 s.maxForce = maxForce;
+                 s.rateHz = rate;
+                 s.validate();
+                 return std::make_shared<HaplyDevice>(s);
+             }), py::arg("host") = "127.0.0.1", py::arg("port") = 10001, py::arg("device_id") = "", HS_MAPPING_ARGS)
+        .def("start", &HaplyDevice::start, py::call_guard<py::gil_scoped_release>())
+        .def("stop", &HaplyDevice::stop, py::call_guard<py::gil_scoped_release>())
+        .def("set_force", [](HaplyDevice& d, const Vec3& f) { d.setForce(f); }, py::arg("force"))
+        .def_property_readonly("device_id", &HaplyDevice::deviceId)
+        .def_property_readonly("updates", &HaplyDevice::updates)
+        .def_property_readonly("malformed", &HaplyDevice::malformed);
 
     py::class_<FalconDevice, Device, std::shared_ptr<FalconDevice>>(m, "FalconDevice",
         "A Novint Falcon on USB (libusb loaded at run time); its firmware is loaded from `firmware` if it is not running.")

@@ -124,7 +124,9 @@ void bindRuntime(py::module_& m) {
              py::arg("stale_limit") = 0.02, py::arg("fade_time") = 0.05, py::arg("max_lag") = 0.005,
              py::arg("log_seconds") = 0.0, py::arg("stop_when_finished") = false, py::arg("realtime") = false,
              py::arg("idle_rate") = 100.0, py::arg("spin") = 0.0, py::arg("sim_nice") = 0)
-        .def("start", &HapticRuntime::start)
+        .def("start", &HapticRuntime::start, py::call_guard<py::gil_scoped_release>(),
+             "Start the device and both threads (GIL released: a device may take a while, e.g. a Falcon homing "
+             "or a service answering from a Python thread).")
         .def("stop", &HapticRuntime::stop, py::call_guard<py::gil_scoped_release>(),
              "Zero the force, join both threads (GIL released while waiting).")
         .def_property_readonly("running", &HapticRuntime::running)
