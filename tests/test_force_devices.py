@@ -11,11 +11,11 @@ import time
 
 import numpy as np
 import pytest
+from haply_service_mock import MockInverseService
 
 from HapticSculpt import core
 from HapticSculpt.core import native as _core
 from HapticSculpt.runtime import devices
-from haply_service_mock import MockInverseService
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FAKES = os.environ.get("HS_FAKE_VENDOR", os.path.join(ROOT, "build", "release", "fake_vendor"))
