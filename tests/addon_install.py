@@ -72,7 +72,7 @@ def main(argv: list[str]) -> int:
     run("GUI tests (from the installed addon)",
         [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-rfE", *args.pytest_args.split(),
          "tests/test_gui_workbench.py", "tests/test_gui_undo.py", "tests/test_gui_overlay.py",
-         "tests/test_gui_real_input.py", "tests/test_gui_sculpted_solid.py"],
+         "tests/test_gui_real_input.py", "tests/test_gui_sculpted_solid.py", "tests/test_gui_force_device.py"],
         env=env, cwd=addon)
     return 0
 
