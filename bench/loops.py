@@ -11,8 +11,9 @@ Prints a table and writes bench/results/loops.json: for the 12x12/40x40 scene wi
 top level (haptic_hz, haptic_period_p50/p99/max_ms, sim_hz, force_error_rel = 99th percentile of
 the estimated force's error against the force from the exact surface, relative to the force,
 cpu_percent of one core, latency_p50/p99_ms = from reading the device to writing its force) and
-every run under "scenes", each with its "load"; plus bench/results/loops.png (period histogram,
-force error).
+every run under "scenes", each with its "load" and "realtime_priority" (sessions ask for SCHED_FIFO
+on the haptic thread, granted to root or within an rtprio limit; --no-realtime runs without); plus
+bench/results/loops.png (period histogram, force error).
 """
 from __future__ import annotations
 
@@ -121,6 +122,7 @@ def run_scene(controls, mesh, sim_dt, seconds, rate, load="none", **settings):
         "haptic_period_p50_ms": status["haptic_period_p50_ms"],
         "haptic_period_p99_ms": status["haptic_period_p99_ms"],
         "haptic_period_max_ms": status["haptic_period_max_ms"],
+        "realtime_priority": status["realtime_priority"],
         "latency_p50_ms": status["latency_p50_ms"],
         "latency_p99_ms": status["latency_p99_ms"],
         "sim_hz": status["sim_hz"],
@@ -167,20 +169,23 @@ def main() -> None:
     ap.add_argument("--loads", default="none,cpu_hog", help="which loads to run, of none and cpu_hog")
     ap.add_argument("--spin", type=float, default=None, help="the runtime's spin (s) instead of its default")
     ap.add_argument("--sim-nice", type=int, default=None, help="the runtime's sim_nice instead of its default")
+    ap.add_argument("--no-realtime", action="store_true",
+                    help="do not ask for real-time priority for the haptic thread (sessions ask by default)")
     args = ap.parse_args()
     os.makedirs(os.path.join(ROOT, "bench", "results"), exist_ok=True)
     results, data = [], []
     for controls, mesh, sim_dt in SCENES:
         for load in args.loads.split(","):
             settings = {k: v for k, v in (("spin", args.spin), ("sim_nice", args.sim_nice)) if v is not None}
+            settings["realtime"] = not args.no_realtime
             r, periods, errors = run_scene(controls, mesh, sim_dt, args.seconds, args.rate, load, **settings)
             results.append(r)
             data.append((periods, errors))
-    print(f"{'scene':<14}{'load':>8}{'haptic Hz':>10}{'p50 ms':>8}{'p99 ms':>8}{'max ms':>8}{'sim Hz':>9}"
+    print(f"{'scene':<14}{'load':>8}{'rt':>3}{'haptic Hz':>10}{'p50 ms':>8}{'p99 ms':>8}{'max ms':>8}{'sim Hz':>9}"
           f"{'dropped s':>10}{'err p99':>9}{'lat p50':>9}{'lat p99':>9}{'cpu %':>7}")
     for r in results:
         err = f"{r['force_error_rel']:>9.2e}" if r["force_error_rel"] is not None else f"{'-':>9}"
-        print(f"{r['scene']:<14}{r['load']:>8}{r['haptic_hz']:>10.1f}{r['haptic_period_p50_ms']:>8.3f}"
+        print(f"{r['scene']:<14}{r['load']:>8}{'y' if r['realtime_priority'] else 'n':>3}{r['haptic_hz']:>10.1f}{r['haptic_period_p50_ms']:>8.3f}"
               f"{r['haptic_period_p99_ms']:>8.3f}{r['haptic_period_max_ms']:>8.2f}{r['sim_hz']:>9.0f}"
               f"{r['dropped_sim_time']:>10.2f}{err}{r['latency_p50_ms']:>9.4f}{r['latency_p99_ms']:>9.4f}"
               f"{r['cpu_percent']:>7.1f}")

@@ -76,9 +76,12 @@ class Session:
     def start(self, obj: Any, device: Any, tool: str = "rope", haptic_rate: float = 1000.0,
               sim_dt: float = 5e-4, max_force: float = 0.0, max_stiffness: float = 0.0,
               stale_limit: float = 0.02, record_seconds: float = 0.0, stop_when_finished: bool = False,
-              realtime: bool = False) -> "Session":
+              realtime: bool = True) -> "Session":
         """Starts the loops. ``max_force``/``max_stiffness`` of 0 take the device's limits;
-        ``record_seconds`` > 0 logs every haptic tick (for :meth:`recording` and benchmarks)."""
+        ``record_seconds`` > 0 logs every haptic tick (for :meth:`recording` and benchmarks).
+        ``realtime`` asks for real-time priority (SCHED_FIFO) for the haptic thread, which holds its
+        1 ms period while other programs load the machine; Linux grants it to root or within an
+        rtprio limit (README), else the thread runs as before (``status()["realtime_priority"]``)."""
         if self._runtime is not None:
             raise RuntimeError("session: already started; stop it first")
         if not is_sculpt(obj):

@@ -265,9 +265,16 @@ void HapticRuntime::stop() {
 
 void HapticRuntime::hapticLoop() {
     if (settings_.realtime) {
+        // Below the top priority, and within the user's rtprio limit where one is set (a line in
+        // /etc/security/limits.d grants it without root): asking for more than the limit fails.
+        int priority = sched_get_priority_max(SCHED_FIFO) - 1;
+        rlimit limit{};
+        if (geteuid() != 0 && getrlimit(RLIMIT_RTPRIO, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+            priority = std::min(priority, static_cast<int>(limit.rlim_cur));
         sched_param sp{};
-        sp.sched_priority = std::max(1, sched_get_priority_max(SCHED_FIFO) - 1);
-        realtimeOk_.store(pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0, std::memory_order_relaxed);
+        sp.sched_priority = priority;
+        realtimeOk_.store(priority >= 1 && pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0,
+                          std::memory_order_relaxed);
     }
     // Wake-ups to the microsecond: a thread's timer slack (50 us by default) delays every one.
     prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
