@@ -128,6 +128,7 @@ def run_scene(controls, mesh, sim_dt, seconds, rate, load="none", **settings):
         "sim_hz": status["sim_hz"],
         "sim_dt": sim_dt,
         "dropped_sim_time": status["dropped_sim_time"],
+        "doubled_steps": status["doubled_steps"],
         "force_error_rel": float(np.percentile(errors, 99)) if errors.size else None,
         "force_error_rel_median": float(np.median(errors)) if errors.size else None,
         "force_rms": float(np.sqrt(np.mean(np.sum(ticks["rendered_force"] ** 2, axis=1)))),
@@ -169,6 +170,9 @@ def main() -> None:
     ap.add_argument("--loads", default="none,cpu_hog", help="which loads to run, of none and cpu_hog")
     ap.add_argument("--spin", type=float, default=None, help="the runtime's spin (s) instead of its default")
     ap.add_argument("--sim-nice", type=int, default=None, help="the runtime's sim_nice instead of its default")
+    ap.add_argument("--max-lag", type=float, default=None, help="the runtime's max_lag (s) instead of its default")
+    ap.add_argument("--no-catch-up", action="store_true",
+                    help="a simulation behind real time drops the backlog instead of taking double steps")
     ap.add_argument("--no-realtime", action="store_true",
                     help="do not ask for real-time priority for the haptic thread (sessions ask by default)")
     args = ap.parse_args()
@@ -176,18 +180,20 @@ def main() -> None:
     results, data = [], []
     for controls, mesh, sim_dt in SCENES:
         for load in args.loads.split(","):
-            settings = {k: v for k, v in (("spin", args.spin), ("sim_nice", args.sim_nice)) if v is not None}
+            settings = {k: v for k, v in (("spin", args.spin), ("sim_nice", args.sim_nice), ("max_lag", args.max_lag))
+                        if v is not None}
             settings["realtime"] = not args.no_realtime
+            settings["catch_up"] = not args.no_catch_up
             r, periods, errors = run_scene(controls, mesh, sim_dt, args.seconds, args.rate, load, **settings)
             results.append(r)
             data.append((periods, errors))
     print(f"{'scene':<14}{'load':>8}{'rt':>3}{'haptic Hz':>10}{'p50 ms':>8}{'p99 ms':>8}{'max ms':>8}{'sim Hz':>9}"
-          f"{'dropped s':>10}{'err p99':>9}{'lat p50':>9}{'lat p99':>9}{'cpu %':>7}")
+          f"{'dropped s':>10}{'2dt':>7}{'err p99':>9}{'lat p50':>9}{'lat p99':>9}{'cpu %':>7}")
     for r in results:
         err = f"{r['force_error_rel']:>9.2e}" if r["force_error_rel"] is not None else f"{'-':>9}"
         print(f"{r['scene']:<14}{r['load']:>8}{'y' if r['realtime_priority'] else 'n':>3}{r['haptic_hz']:>10.1f}{r['haptic_period_p50_ms']:>8.3f}"
               f"{r['haptic_period_p99_ms']:>8.3f}{r['haptic_period_max_ms']:>8.2f}{r['sim_hz']:>9.0f}"
-              f"{r['dropped_sim_time']:>10.2f}{err}{r['latency_p50_ms']:>9.4f}{r['latency_p99_ms']:>9.4f}"
+              f"{r['dropped_sim_time']:>10.2f}{r['doubled_steps']:>7}{err}{r['latency_p50_ms']:>9.4f}{r['latency_p99_ms']:>9.4f}"
               f"{r['cpu_percent']:>7.1f}")
     main_scene = dict(results[0])
     main_scene["scenes"] = results

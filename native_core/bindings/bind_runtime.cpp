@@ -102,7 +102,7 @@ void bindRuntime(py::module_& m) {
         .def(py::init([](std::shared_ptr<DynamicSurface> surface, std::shared_ptr<Device> device, double hapticRate,
                          double simDt, double graphicsRate, double maxForce, double maxStiffness, double staleLimit,
                          double fadeTime, double maxLag, double logSeconds, bool stopWhenFinished, bool realtime,
-                         double idleRate, double spin, int simNice) {
+                         double idleRate, double spin, int simNice, bool catchUp) {
                  RuntimeSettings s;
                  s.hapticRate = hapticRate;
                  s.simDt = simDt;
@@ -118,12 +118,13 @@ void bindRuntime(py::module_& m) {
                  s.idleRate = idleRate;
                  s.spin = spin;
                  s.simNice = simNice;
+                 s.catchUp = catchUp;
                  return std::make_shared<HapticRuntime>(std::move(surface), std::move(device), s);
              }), py::arg("surface"), py::arg("device"), py::arg("haptic_rate") = 1000.0, py::arg("sim_dt") = 5e-4,
              py::arg("graphics_rate") = 60.0, py::arg("max_force") = 0.0, py::arg("max_stiffness") = 0.0,
-             py::arg("stale_limit") = 0.02, py::arg("fade_time") = 0.05, py::arg("max_lag") = 0.005,
+             py::arg("stale_limit") = 0.02, py::arg("fade_time") = 0.05, py::arg("max_lag") = 0.01,
              py::arg("log_seconds") = 0.0, py::arg("stop_when_finished") = false, py::arg("realtime") = false,
-             py::arg("idle_rate") = 100.0, py::arg("spin") = 0.0, py::arg("sim_nice") = 0)
+             py::arg("idle_rate") = 100.0, py::arg("spin") = 0.0, py::arg("sim_nice") = 0, py::arg("catch_up") = true)
         .def("start", &HapticRuntime::start, py::call_guard<py::gil_scoped_release>(),
              "Start the device and both threads (GIL released: a device may take a while, e.g. a Falcon homing "
              "or a service answering from a Python thread).")
@@ -147,6 +148,7 @@ void bindRuntime(py::module_& m) {
             d["refused_steps"] = s.refusedSteps;
             d["strokes"] = s.strokes;
             d["dropped_sim_time"] = s.droppedSimTime;
+            d["doubled_steps"] = s.doubledSteps;
             d["force"] = Vec3(s.force);
             d["estimate_age_ms"] = s.estimateAge * 1e3;
             d["realtime_priority"] = s.realtimePriority;

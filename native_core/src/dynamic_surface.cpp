@@ -205,31 +205,43 @@ void DynamicSurface::ensureMassFactor() {
 
 void DynamicSurface::ensureSystem(double dt, bool factor) {
     const std::uint64_t key[4] = {mass_.version(), damping_.version(), stiffness_.version(), structureKey()};
-    bool same = dt == systemDt_ && (systemFactored_ || !factor);
-    for (int i = 0; i < 4; ++i) same = same && key[i] == systemKey_[i];
-    if (same) return;
-    // S = A^T (M + dt D + dt^2 L) A with L the Laplacian of springs and penalty terms.
+    auto current = [&](const SystemSlot& slot) {
+        bool same = dt == slot.dt && (slot.factored || !factor);
+        for (int i = 0; i < 4; ++i) same = same && key[i] == slot.key[i];
+        return same;
+    };
+    for (std::size_t k = 0; k < systems_.size(); ++k)
+        if (current(systems_[k])) {
+            system_ = k;
+            systems_[k].used = ++systemUses_;
+            return;
+        }
+    // Rebuild the slot used least recently. S = A^T (M + dt D + dt^2 L) A with L the Laplacian of
+    // springs and penalty terms.
+    system_ = systems_[0].used <= systems_[1].used ? 0 : 1;
+    SystemSlot& slot = systems_[system_];
+    slot.used = ++systemUses_;
     Eigen::SparseMatrix<double> D(d_.rows(), d_.rows());
     D = (m_ + dt * gamma_).asDiagonal();
     const Eigen::SparseMatrix<double> Sm = D + (dt * dt) * laplacian();
     const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
     Eigen::SparseMatrix<double> sys = A.transpose() * Sm * A;
     held_.restrict(sys, true);
-    cg_.invDiag = sys.diagonal().cwiseInverse();  // Jacobi preconditioner
+    slot.invDiag = sys.diagonal().cwiseInverse();  // Jacobi preconditioner
     if (factor) {
         ensureMassFactor();  // throws first if the mesh does not see every control point
         try {
-            systemSolver_.factor(sys, "system matrix A^T (M + dt D + dt^2 L) A");
+            slot.solver.factor(sys, "system matrix A^T (M + dt D + dt^2 L) A");
         } catch (const std::runtime_error&) {
             // The mass matrix factors, so only dt^2 L (singular: free translations) can swamp it.
-            systemDt_ = -1;
+            slot.dt = -1;
             throw std::invalid_argument("dt: too long for this mass and stiffness (dt^2 x stiffness / mass swamps the "
                                         "mass matrix and the system is numerically singular); use a shorter step");
         }
     }
-    systemFactored_ = factor;
-    systemDt_ = dt;
-    for (int i = 0; i < 4; ++i) systemKey_[i] = key[i];
+    slot.factored = factor;
+    slot.dt = dt;
+    for (int i = 0; i < 4; ++i) slot.key[i] = key[i];
 }
 
 Eigen::SparseMatrix<double> DynamicSurface::laplacian() const {

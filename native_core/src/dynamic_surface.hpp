@@ -293,13 +293,23 @@ private:
     std::unique_ptr<Tool> tool_;
     Cursor cursor_;
     // Factorisations and the versions of what they were built from.
-    PrefactoredSolver massSolver_, systemSolver_;
+    PrefactoredSolver massSolver_;
     Eigen::SparseMatrix<double> massMatrix_;  // A^T M A, as last factored by ensureMassFactor()
     std::uint64_t massVersion_ = ~0ull, materialKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
-    std::uint64_t systemKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
     std::uint64_t wakeKey_[4] = {0, 0, 0, 0};
-    double systemDt_ = -1;
-    bool systemFactored_ = false;
+    // The system matrix for the two step lengths used last (a session steps at its dt, and at
+    // twice it while catching up with real time), each with its factors and Jacobi diagonal.
+    struct SystemSlot {
+        PrefactoredSolver solver;
+        Eigen::VectorXd invDiag;
+        std::uint64_t key[4] = {~0ull, ~0ull, ~0ull, ~0ull};
+        double dt = -1;
+        bool factored = false;
+        std::uint64_t used = 0;
+    };
+    std::array<SystemSlot, 2> systems_;
+    std::size_t system_ = 0;  // the slot in use
+    std::uint64_t systemUses_ = 0;
     // Measures of the material and the initial shape; the clock.
     double minMass_ = 0, maxStiffness_ = 0, maxDampingRate_ = 0, size_ = 1, spacingU_ = 1, spacingV_ = 1;
     double time_ = 0, work_ = 0;

@@ -115,13 +115,24 @@ void HapticRuntime::setAirbrush(const AirbrushSettings& a) {
     airbrushChanged_.store(true, std::memory_order_release);
 }
 
+// Both step lengths the simulation takes: twice its step first (for catching up with real time;
+// a surface for which that step is too long is stepped at dt and drops its backlog instead), then
+// its step, so the step in use is the one left current.
+void HapticRuntime::prepareSteps(DynamicSurface& surface) const {
+    try {
+        surface.prepare(2 * settings_.simDt);
+    } catch (const std::invalid_argument&) {
+    }
+    surface.prepare(settings_.simDt);
+}
+
 std::uint64_t HapticRuntime::postEdit(SurfaceEdit edit) {
     if (edit.id == 0) throw std::invalid_argument("edit: id must be > 0");
     if (edit.next) {
         if (edit.next.get() == liveSurface_.load(std::memory_order_acquire) || edit.next->g() != sampling_[0] ||
             edit.next->h() != sampling_[1] || edit.next->poles().rows() != sampling_[2])
             throw std::invalid_argument("edit: the edited surface must be a new surface with the live one's sampling and control net");
-        edit.next->prepare(settings_.simDt);  // factor here, not in the simulation thread
+        prepareSteps(*edit.next);  // factor here, not in the simulation thread
     }
     std::lock_guard<std::mutex> lock(editMutex_);
     editsPending_.push_back(std::move(edit));
@@ -239,7 +250,7 @@ void HapticRuntime::start() {
     // which the first steps would otherwise fall behind the device by. A configuration the core
     // refuses is left for the first step to report, as it always was.
     try {
-        surface_->prepare(settings_.simDt);
+        prepareSteps(*surface_);
     } catch (const std::exception&) {
     }
     device_->start();
@@ -361,6 +372,7 @@ void HapticRuntime::simLoop() {
     HapticEstimate previous, current;
     Reaction reaction;
     std::uint64_t sequence = 0;
+    bool doubleSteps = settings_.catchUp;
     try {
         while (!stopRequested_.load(std::memory_order_acquire)) {
             // Keep pace with real time: step when the interval it represents has passed.
@@ -369,8 +381,14 @@ void HapticRuntime::simLoop() {
                 std::this_thread::sleep_until(t0_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(simTime + dt)));
                 continue;
             }
-            if (wall - simTime > settings_.maxLag) {  // too slow for real time: drop the backlog
-                const double drop = wall - simTime - dt;
+            // Behind real time by more than a step: degrade on purpose, one step of twice the
+            // length (half the steps per simulated second, each as costly), and simulated time
+            // keeps pace with the device instead of running in slow motion. Only past maxLag (a
+            // stall) is the backlog dropped.
+            const bool doubled = doubleSteps && wall - simTime > 2 * dt;
+            const double h = doubled ? 2 * dt : dt;
+            if (wall - simTime > settings_.maxLag) {
+                const double drop = wall - simTime - h;
                 droppedSimTime_.store(droppedSimTime_.load(std::memory_order_relaxed) + drop, std::memory_order_relaxed);
                 simTime += drop;
             }
@@ -403,9 +421,18 @@ void HapticRuntime::simLoop() {
                 c.grab = button && !painting;  // the airbrush takes the button: the tool lets go
                 surface_->setCursor(c);
             }
-            const StepReport r = surface_->step(dt);
-            simTime += dt;
+            StepReport r;
+            try {
+                r = surface_->step(h);
+            } catch (const std::invalid_argument&) {
+                if (!doubled) throw;
+                doubleSteps = false;  // too long a step for this surface: drop backlogs instead
+                r = surface_->step(dt);
+            }
+            const double taken = doubled && doubleSteps ? h : dt;
+            simTime += taken;
             simSteps_.fetch_add(1, std::memory_order_relaxed);
+            if (taken > dt) doubledSteps_.fetch_add(1, std::memory_order_relaxed);
             if (r.refused) refused_.fetch_add(1, std::memory_order_relaxed);
             if (!r.slept) reaction = r.reaction;
             // Publish the tool's local model, velocities by finite differences over this step.
@@ -415,8 +442,8 @@ void HapticRuntime::simLoop() {
             const bool sameGrab = previous.kind == current.kind && previous.points == current.points &&
                                   current.kind != EstimateKind::None && previous.sequence + 1 == current.sequence &&
                                   current.toolTime > previous.toolTime;
-            for (int k = 0; k < current.points; ++k) current.v[k] = sameGrab ? Vec3((current.x[k] - previous.x[k]) / dt) : Vec3::Zero();
-            current.offsetRate = sameGrab ? Vec3((current.offsetSum - previous.offsetSum) / dt) : Vec3::Zero();
+            for (int k = 0; k < current.points; ++k) current.v[k] = sameGrab ? Vec3((current.x[k] - previous.x[k]) / taken) : Vec3::Zero();
+            current.offsetRate = sameGrab ? Vec3((current.offsetSum - previous.offsetSum) / taken) : Vec3::Zero();
             estimate_.write(current);
             if (snapshotCount_ < snapshots_.size()) snapshots_[snapshotCount_++] = current;
             previous = current;
@@ -472,6 +499,7 @@ RuntimeStatus HapticRuntime::status() const {
     s.refusedSteps = refused_.load(std::memory_order_relaxed);
     s.strokes = strokeCount_.load(std::memory_order_relaxed);
     s.droppedSimTime = droppedSimTime_.load(std::memory_order_relaxed);
+    s.doubledSteps = doubledSteps_.load(std::memory_order_relaxed);
     shown_.update();
     const ShownCursor& shown = shown_.front();
     s.cursor = shown.cursor.position;

@@ -26,8 +26,11 @@ struct RuntimeSettings {
     double maxStiffness = 0;    ///< limit on the rendered force-displacement slope; 0: the device's
     double staleLimit = 0.02;   ///< s: a simulation snapshot older than this starts fading the force
     double fadeTime = 0.05;     ///< s: from full force to zero once stale
-    double maxLag = 0.005;      ///< s: a simulation further behind real time drops the difference (it
+    double maxLag = 0.01;       ///< s: a simulation further behind real time drops the difference (it
                                 ///< runs in slow motion rather than let the estimate extrapolate far)
+    /// A simulation more than a step behind real time takes steps of twice simDt until it has
+    /// caught up (prepared and factored beforehand), so it keeps pace rather than drop time.
+    bool catchUp = true;
     double logSeconds = 0;      ///< > 0: keep every haptic tick and simulation snapshot for analysis
     bool stopWhenFinished = false;  ///< stop when a finite (replay) device has played out
     bool realtime = false;      ///< try SCHED_FIFO for the haptic thread (needs privileges)
@@ -48,6 +51,7 @@ struct RuntimeStatus {
     double latencyP50 = 0, latencyP99 = 0;  ///< s from reading the device to writing its force
     std::uint64_t hapticTicks = 0, simSteps = 0, refusedSteps = 0, strokes = 0;
     double droppedSimTime = 0;      ///< s of simulated time dropped to keep up with real time
+    std::uint64_t doubledSteps = 0; ///< steps of twice simDt taken to catch up with real time
     Vec3 force = Vec3::Zero();      ///< last rendered force
     double estimateAge = 0;         ///< s: age of the snapshot the last tick used
     bool realtimePriority = false;
@@ -199,6 +203,7 @@ private:
     ForceLimits limits_;
     std::array<double, 2> requestedLimits_{};  // max force and stiffness as given (0: the device's)
     void applyDeviceLimits();
+    void prepareSteps(DynamicSurface& surface) const;
     std::chrono::steady_clock::time_point t0_;
     std::thread haptic_, sim_;
     bool started_ = false, joined_ = false;
@@ -237,6 +242,7 @@ private:
     static constexpr double kBinWidth = 2.5e-6;
     std::unique_ptr<std::atomic<std::uint32_t>[]> periodBins_, latencyBins_;
     std::atomic<double> periodMax_{0}, estimateAge_{0}, droppedSimTime_{0};
+    std::atomic<std::uint64_t> doubledSteps_{0};
     std::atomic<std::uint64_t> hapticTicks_{0}, simSteps_{0}, refused_{0}, strokeCount_{0};
     std::atomic<double> force_[3] = {0.0, 0.0, 0.0};
     std::atomic<double> stoppedAt_{0};

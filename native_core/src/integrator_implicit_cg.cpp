@@ -26,7 +26,7 @@ StepReport DynamicSurface::stepImplicitCG(double dt) {
     x_.setZero();
     double rnorm = bnorm;
     if (bnorm > 0) {
-        cg_.z = cg_.invDiag.asDiagonal() * cg_.r;
+        cg_.z = systems_[system_].invDiag.asDiagonal() * cg_.r;
         cg_.p = cg_.z;
         double rz = cg_.r.cwiseProduct(cg_.z).sum();
         for (int it = 0; it < solver_.cgIterations; ++it) {
@@ -50,7 +50,7 @@ StepReport DynamicSurface::stepImplicitCG(double dt) {
             cg_.r -= alpha * cg_.q;
             rnorm = std::sqrt(cg_.r.squaredNorm());
             if (rnorm <= 1e-14 * bnorm) break;
-            cg_.z = cg_.invDiag.asDiagonal() * cg_.r;
+            cg_.z = systems_[system_].invDiag.asDiagonal() * cg_.r;
             const double rzNew = cg_.r.cwiseProduct(cg_.z).sum();
             cg_.p = cg_.z + (rzNew / rz) * cg_.p;
             rz = rzNew;

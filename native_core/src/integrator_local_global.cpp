@@ -135,7 +135,7 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
         if (!constraints_.empty()) constraints_.addProjections(*iterate, meshTmp2_, terms_, h * h);
         A_.applyTransposed(meshTmp2_, fp_);
         held_.reduce(fp_);
-        systemSolver_.solve(fp_, acc_);
+        systems_[system_].solver.solve(fp_, acc_);
         held_.expand(acc_);
         change = acc_.cwiseAbs().maxCoeff();
         x_ += acc_;

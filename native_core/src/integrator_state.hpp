@@ -17,10 +17,10 @@ struct ExplicitState {
     double energy = 0;
 };
 
-/// Linearised backward Euler: the conjugate-gradient vectors and the Jacobi preconditioner.
+/// Linearised backward Euler: the conjugate-gradient vectors (the Jacobi preconditioner is the
+/// system's, DynamicSurface::SystemSlot).
 struct CgState {
     Points r, z, p, q;
-    Eigen::VectorXd invDiag;
 };
 
 /// Local/global BDF2: the state one step back (poles, velocities, mesh, A v) taken at step `dt`,

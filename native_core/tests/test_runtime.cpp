@@ -514,3 +514,30 @@ TEST(HapticRuntime, LatencyIsMeasuredAndTheTimingSettingsAreChecked) {
         EXPECT_THROW(HapticRuntime(patch(), lift(0.1, 1.0), b), std::invalid_argument);
     }
 }
+
+TEST(HapticRuntime, ASimulationBehindRealTimeCatchesUpWithDoubleSteps) {
+    // 16,384 mass points at 0.1 ms steps: no machine keeps real time, so the simulation is always
+    // behind; it takes steps of twice its length (prepared before the clock starts) and stays
+    // stable and finite; with catch-up off it only drops backlog.
+    for (const bool catchUp : {true, false}) {
+        auto s = std::make_shared<DynamicSurface>(BSplineSurface::plane(32, 32, 3, 3, 100, 100), 128, 128);
+        RuntimeSettings settings;
+        settings.simDt = 1e-4;
+        settings.catchUp = catchUp;
+        settings.stopWhenFinished = true;
+        HapticRuntime rt(s, lift(0.6, 20.0), settings);
+        rt.start();
+        EXPECT_TRUE(waitFor([&] { return !rt.running(); }, 60.0));
+        rt.stop();
+        const RuntimeStatus st = rt.status();
+        EXPECT_EQ(st.error, "") << catchUp;
+        EXPECT_EQ(st.refusedSteps, 0u) << catchUp;
+        EXPECT_TRUE(s->poles().allFinite()) << catchUp;
+        if (catchUp) EXPECT_GT(st.doubledSteps, 10u);
+        else EXPECT_EQ(st.doubledSteps, 0u);
+        EXPECT_GT(st.droppedSimTime, 0.0) << catchUp;  // (even doubled, it cannot keep up)
+        StrokeSnapshot stroke;
+        ASSERT_TRUE(rt.takeStroke(stroke)) << catchUp;
+        EXPECT_GT(stroke.poles.col(2).maxCoeff(), 0.05) << catchUp;  // it still pulled
+    }
+}
