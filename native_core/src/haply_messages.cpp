@@ -151,7 +151,7 @@ std::size_t writeForceCommand(char* out, std::size_t capacity, const char* devic
                                 : "";
     const int n = std::snprintf(out, capacity,
                                 "{%s\"inverse3\":[{\"device_id\":\"%s\",\"commands\":{\"set_cursor_force\":"
-                                "{\"vector\":{\"x\":%.6f,\"y\":%.6f,\"z\":%.6f}}}}]}",
+                                "{\"vector\":{\"x\":%.9g,\"y\":%.9g,\"z\":%.9g}}}}]}",
                                 session, deviceId, f.x(), f.y(), f.z());
     return n > 0 && static_cast<std::size_t>(n) < capacity ? static_cast<std::size_t>(n) : 0;
 }
