@@ -212,7 +212,7 @@ def list(firmware: str | None = None, libraries: dict[str, Any] | None = None) -
             out.append({"kind": kind, "name": name, "force": True, "usable": False,
                         "why": f"the vendor's library is not installed: {p['why']}"})
     for d in list_devices():
-        access = os.access(d["path"], os.R_OK | os.W_OK)
+        access = not os.path.exists(d["path"]) or os.access(d["path"], os.R_OK | os.W_OK)  # (hidraw: a node)
         out.append({"kind": d["kind"], "name": d["spacemouse"] or d["name"], "path": d["path"], "force": False,
                     "usable": access,
                     "why": "" if access else "no permission to open it: install the udev rules (sudo make install-udev)"
