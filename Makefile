@@ -11,7 +11,7 @@ SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 PHONY_TSAN := build-tsan test-tsan
 PHONY_LONG := stress fuzz bench-peers
 .PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-gui-repeat test-cpp test-asan test-python \
-        test-gui test-freecad test-addon wheel ocp-venv demo bench install install-udev uninstall clean test-other-debian \
+        test-gui test-freecad test-addon wheel ocp-venv demo bench install install-udev install-realtime uninstall clean test-other-debian \
         test-gui-repeat-other-debian
 # The fake vendor libraries (libusb with an emulated Falcon, OpenHaptics, DHD) the device tests
 # load instead of the system's: built with the C++ tests.
@@ -174,7 +174,16 @@ install: build
 # SpaceMouse access for the logged-in user (uaccess; nothing broader).
 install-udev:
 	$(SUDO) install -m 644 udev/70-hapticsculpt.rules /etc/udev/rules.d/70-hapticsculpt.rules
-	$(SUDO) udevadm control --reload-rules && $(SUDO) udevadm trigger --subsystem-match=hidraw || true
+	$(SUDO) udevadm control --reload-rules && $(SUDO) udevadm trigger --subsystem-match=hidraw --subsystem-match=usb || true
+
+# Real-time priority for the haptic thread (README, "Sessions"): an rtprio limit for the user who
+# runs FreeCAD (sudo make install-realtime: the user who ran sudo), applied at their next login.
+LIMITS_DIR ?= /etc/security/limits.d
+RT_USER    ?= $(or $(SUDO_USER),$(USER))
+install-realtime:
+	@[ -n "$(RT_USER)" ] || { echo "install-realtime: whose limit? give RT_USER=..."; exit 1; }
+	echo "$(RT_USER) - rtprio 50" | $(SUDO) tee $(LIMITS_DIR)/90-hapticsculpt.conf > /dev/null
+	@echo "$(RT_USER) may give the haptic thread real-time priority from their next login"
 
 uninstall:
 	@mod="$(FREECAD_MOD)"; [ -n "$$mod" ] || { echo "FreeCAD's Mod folder not found: give FREECAD_MOD=..."; exit 1; }; \

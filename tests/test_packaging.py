@@ -105,3 +105,11 @@ def test_addon_manager_reads_the_core_as_a_python_dependency(tmp_path):
         answer({{"python": sorted(found)}})
     """, str(tmp_path))
     assert got["python"] == ["hapticsculpt-core", "numpy"]
+
+
+def test_install_realtime_grants_the_user_an_rtprio_limit(tmp_path):
+    out = subprocess.run(["make", "-s", "install-realtime", f"LIMITS_DIR={tmp_path}", "RT_USER=alice", "SUDO="],
+                         cwd=ROOT, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert (tmp_path / "90-hapticsculpt.conf").read_text() == "alice - rtprio 50\n"
+    assert "next login" in out.stdout

@@ -533,8 +533,12 @@ TEST(HapticRuntime, ASimulationBehindRealTimeCatchesUpWithDoubleSteps) {
         EXPECT_EQ(st.error, "") << catchUp;
         EXPECT_EQ(st.refusedSteps, 0u) << catchUp;
         EXPECT_TRUE(s->poles().allFinite()) << catchUp;
-        if (catchUp) EXPECT_GT(st.doubledSteps, 10u);
-        else EXPECT_EQ(st.doubledSteps, 0u);
+        if (catchUp) {  // (how many depends on the machine: under ASan a step takes tens of ms)
+            EXPECT_GT(st.doubledSteps, 0u);
+            EXPECT_LE(st.doubledSteps, st.simSteps);
+        } else {
+            EXPECT_EQ(st.doubledSteps, 0u);
+        }
         EXPECT_GT(st.droppedSimTime, 0.0) << catchUp;  // (even doubled, it cannot keep up)
         StrokeSnapshot stroke;
         ASSERT_TRUE(rt.takeStroke(stroke)) << catchUp;
