@@ -30,7 +30,8 @@ public:
         lws_set_log_level(LLL_ERR, nullptr);
         lws_context_creation_info info{};
         info.port = 0;  // the kernel picks
-        info.iface = "127.0.0.1";
+        info.iface = "lo";  // loopback only (an interface name: libwebsockets 4.3 takes no address here)
+        info.options = LWS_SERVER_OPTION_DISABLE_IPV6;
         info.protocols = protocols;
         info.user = this;
         context_ = lws_create_context(&info);
@@ -51,7 +52,7 @@ public:
     int port() const { return port_; }
 
     // set before the client connects, or under lock()
-    std::mutex lock;
+    std::recursive_mutex lock;  // (libwebsockets 4.3 calls back from inside its own calls: re-entrant)
     fake::Mechanism mechanism;  // Haply's frame, m
     long malformedEvery = 0, closeAfter = -1;
     bool inUse = false;
@@ -64,7 +65,7 @@ private:
     static int callback(lws* wsi, lws_callback_reasons reason, void*, void* in, size_t len) {
         auto* self = static_cast<MockService*>(lws_context_user(lws_get_context(wsi)));
         if (!self) return 0;
-        std::lock_guard<std::mutex> g(self->lock);
+        std::lock_guard<std::recursive_mutex> g(self->lock);
         switch (reason) {
             case LWS_CALLBACK_ESTABLISHED:
                 ++self->connections;

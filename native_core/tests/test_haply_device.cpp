@@ -35,7 +35,7 @@ constexpr double kRest[3] = {0.0, -0.12, 0.15};
 void script(haply::MockService& service, const std::vector<std::array<double, 5>>& rows) {  // t, dx, dy, dz, buttons
     std::vector<double> flat;
     for (const auto& r : rows) flat.insert(flat.end(), {r[0], kRest[0] + r[1], kRest[1] + r[2], kRest[2] + r[3], r[4]});
-    std::lock_guard<std::mutex> g(service.lock);
+    std::lock_guard<std::recursive_mutex> g(service.lock);
     service.mechanism.setScript(flat.data(), static_cast<int>(rows.size()));
 }
 
@@ -93,7 +93,7 @@ TEST(HaplyDevice, TracksTheCursorAndRendersASpring) {
     dev.start();
     EXPECT_EQ(dev.deviceId(), "049D");
     {
-        std::lock_guard<std::mutex> g(service.lock);
+        std::lock_guard<std::recursive_mutex> g(service.lock);
         EXPECT_NE(service.firstCommand.find("\"profile\""), std::string::npos) << service.firstCommand;
         EXPECT_NE(service.firstCommand.find("\"permutation\":\"XYZ\""), std::string::npos) << service.firstCommand;
     }
@@ -102,7 +102,7 @@ TEST(HaplyDevice, TracksTheCursorAndRendersASpring) {
     EXPECT_NEAR(s.position.z(), 20.0 * 300 / 700, 0.3);  // the two springs' balance (Haply's z is up)
     EXPECT_NEAR(s.position.x(), 0.0, 1e-6);
     EXPECT_EQ(s.buttons, 1u);
-    std::lock_guard<std::mutex> g(service.lock);
+    std::lock_guard<std::recursive_mutex> g(service.lock);
     EXPECT_GT(service.mechanism.largestForce, 2.5);  // N
     EXPECT_EQ(service.repliesSent, service.commands);  // one state per message
 }
@@ -166,7 +166,7 @@ TEST(HaplyDevice, ARopeStrokeInAThreadedSessionThenTheLinkDrops) {
     StrokeSnapshot stroke;
     ASSERT_TRUE(rt.takeStroke(stroke));
     EXPECT_GT(stroke.poles.col(2).maxCoeff(), kSanitized ? 0.05 : 0.5);  // the surface was pulled up
-    std::lock_guard<std::mutex> g(service.lock);
+    std::lock_guard<std::recursive_mutex> g(service.lock);
     EXPECT_GT(service.mechanism.largestForce, 0.05);  // and pulled the grip back
 }
 
