@@ -3,7 +3,8 @@
 (fuzz_hid_recording), their report descriptors (fuzz_report_descriptor) and their input reports,
 each prefixed with its length as the harness reads them (fuzz_spacemouse_report); the Falcon's
 status stream (fuzz_falcon_frames, from ../falcon next to the HID fixtures); the Haply service's
-messages (fuzz_haply_messages, from ../haply).
+messages (fuzz_haply_messages, from ../haply); and for every harness the inputs that once broke it,
+kept by name in findings/HARNESS/ beside this script.
 
     seed_corpus.py FIXTURE_DIR CORPUS_DIR
 """
@@ -25,6 +26,9 @@ def main(fixtures: str, corpus: str) -> None:
         (out / name).mkdir(parents=True, exist_ok=True)
     for path in sorted(pathlib.Path(fixtures).parent.joinpath("haply").glob("*.json")):
         shutil.copy(path, out / "fuzz_haply_messages" / path.name)
+    for findings in sorted(pathlib.Path(__file__).parent.joinpath("findings").iterdir()):
+        for path in sorted(findings.iterdir()):
+            shutil.copy(path, out / findings.name / path.name)
     for path in sorted(pathlib.Path(fixtures).parent.joinpath("falcon").glob("*.bin")):
         shutil.copy(path, out / "fuzz_falcon_frames" / path.name)
     for path in sorted(pathlib.Path(fixtures).glob("*.hid")):

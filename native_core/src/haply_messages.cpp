@@ -9,10 +9,14 @@
 
 namespace hs::haply {
 
-namespace od = simdjson::ondemand;
+namespace dom = simdjson::dom;
 
+// The DOM parser validates a whole message before anything is read from it, so a malformed message
+// is refused as a whole. (The on-demand parser reads as it goes: a message broken after the fields
+// already read left its iterator in an error state that a later lookup asserted on; two such
+// messages are kept in fuzz/findings/fuzz_haply_messages.)
 struct Reader::Parser {
-    od::parser parser{kMaxMessage};
+    dom::parser parser{kMaxMessage};
 };
 
 Reader::Reader() : parser_(std::make_unique<Parser>()), buffer_(new char[kMaxMessage + simdjson::SIMDJSON_PADDING]()) {
@@ -22,12 +26,8 @@ Reader::Reader() : parser_(std::make_unique<Parser>()), buffer_(new char[kMaxMes
 Reader::~Reader() = default;
 
 namespace {
-// simdjson's on-demand document must not be touched again after a hard error (a field that is
-// merely absent is not one): every read below hands its error up.
-bool hard(simdjson::error_code e) { return e && e != simdjson::NO_SUCH_FIELD; }
-
-simdjson::error_code readVec(od::object parent, const char* key, Vec3& out) {
-    od::object v;
+simdjson::error_code readVec(dom::object parent, const char* key, Vec3& out) {
+    dom::object v;
     double x = 0, y = 0, z = 0;
     simdjson::error_code e = parent[key].get_object().get(v);
     if (!e) e = v["x"].get_double().get(x);
@@ -39,26 +39,30 @@ simdjson::error_code readVec(od::object parent, const char* key, Vec3& out) {
 }
 
 // A Verse Grip's button ("button": bool) or a wireless one's ("buttons": {"a": bool, ...}).
-simdjson::error_code gripButtons(od::object state, std::uint32_t& bits) {
+simdjson::error_code gripButtons(dom::object state, std::uint32_t& bits) {
     bool pressed = false;
     simdjson::error_code e = state["button"].get_bool().get(pressed);
     if (!e) {
         bits = pressed ? 1u : 0u;
         return e;
     }
-    if (hard(e)) return e;
-    od::object buttons;
+    if (e != simdjson::NO_SUCH_FIELD) return e;
+    dom::object buttons;
     if ((e = state["buttons"].get_object().get(buttons))) return e;
-    bits = 0;
-    std::uint32_t bit = 1;
-    for (auto item : buttons) {
-        od::field f;
+    std::uint32_t next = 0, bit = 1;
+    for (const dom::key_value_pair field : buttons) {
         bool b = false;
-        if ((e = std::move(item).get(f)) || (e = f.value().get_bool().get(b))) return e;
-        if (b) bits |= bit;
+        if ((e = field.value.get_bool().get(b))) return e;
+        if (b) next |= bit;
         bit <<= 1;
     }
+    bits = next;
     return simdjson::SUCCESS;
+}
+
+// The "inverse3" list of a whole, valid message.
+bool devicesOf(dom::parser& parser, const char* buffer, std::size_t n, dom::element& doc, dom::array& devices) {
+    return !parser.parse(buffer, n, false).get(doc) && !doc["inverse3"].get_array().get(devices);
 }
 }  // namespace
 
@@ -68,34 +72,38 @@ bool Reader::inventory(std::size_t n, std::vector<Inverse3Info>& out, std::strin
         why = "message too long";
         return false;
     }
-    od::document doc;
-    od::array devices;
-    if (parser_->parser.iterate(buffer_.get(), n, kMaxMessage + simdjson::SIMDJSON_PADDING).get(doc) ||
-        doc["inverse3"].get_array().get(devices)) {
+    dom::element doc;
+    dom::array devices;
+    if (!devicesOf(parser_->parser, buffer_.get(), n, doc, devices)) {
         why = "not an inventory (no \"inverse3\" list)";
         return false;
     }
-    for (auto item : devices) {
-        od::object device;
+    for (const dom::element item : devices) {
+        dom::object device;
         std::string_view id;
         if (item.get_object().get(device) || device["device_id"].get_string().get(id)) {
             why = "an Inverse3 entry without a device_id";
+            out.clear();
             return false;
         }
         Inverse3Info info;
         info.deviceId = std::string(id);
-        od::object status;
+        dom::object status;
         simdjson::error_code e = device["status"].get_object().get(status);
-        for (auto [key, flag] : {std::pair<const char*, bool*>{"ready", &info.ready}, {"in_use", &info.inUse},
-                                 {"calibrated", &info.calibrated}}) {
-            if (e) break;
-            bool v = false;
-            e = status[key].get_bool().get(v);
-            if (!e) *flag = v;
-            else if (!hard(e)) e = simdjson::SUCCESS;
+        if (e == simdjson::NO_SUCH_FIELD) e = simdjson::SUCCESS;
+        else if (!e) {
+            for (auto [key, flag] : {std::pair<const char*, bool*>{"ready", &info.ready}, {"in_use", &info.inUse},
+                                     {"calibrated", &info.calibrated}}) {
+                bool v = false;
+                e = status[key].get_bool().get(v);
+                if (!e) *flag = v;
+                else if (e == simdjson::NO_SUCH_FIELD) e = simdjson::SUCCESS;
+                else break;
+            }
         }
-        if (hard(e)) {
+        if (e) {
             why = "a malformed status";
+            out.clear();
             return false;
         }
         out.push_back(std::move(info));
@@ -105,15 +113,13 @@ bool Reader::inventory(std::size_t n, std::vector<Inverse3Info>& out, std::strin
 
 bool Reader::state(std::size_t n, const char* deviceId, State& state) {
     if (n > kMaxMessage) return false;
-    od::document doc;
-    od::array devices;
-    if (parser_->parser.iterate(buffer_.get(), n, kMaxMessage + simdjson::SIMDJSON_PADDING).get(doc) ||
-        doc["inverse3"].get_array().get(devices))
-        return false;
+    dom::element doc;
+    dom::array devices;
+    if (!devicesOf(parser_->parser, buffer_.get(), n, doc, devices)) return false;
     State next = state;
     next.found = false;
-    for (auto item : devices) {
-        od::object device, st;
+    for (const dom::element item : devices) {
+        dom::object device, st;
         std::string_view id;
         if (item.get_object().get(device) || device["device_id"].get_string().get(id)) return false;
         if (id != deviceId) continue;
@@ -121,21 +127,21 @@ bool Reader::state(std::size_t n, const char* deviceId, State& state) {
         Vec3 v;
         const simdjson::error_code e = readVec(st, "cursor_velocity", v);
         if (!e) next.velocity = v;
-        else if (hard(e)) return false;
+        else if (e != simdjson::NO_SUCH_FIELD) return false;
         next.found = true;
         break;
     }
     if (!next.found) return false;
     for (const char* grips : {"verse_grip", "wireless_verse_grip"}) {
-        od::array list;
+        dom::array list;
         simdjson::error_code e = doc[grips].get_array().get(list);
         if (e == simdjson::NO_SUCH_FIELD) continue;
         if (e) return false;
-        for (auto item : list) {  // the first grip's buttons
-            od::object grip, st;
+        for (const dom::element item : list) {  // the first grip's buttons
+            dom::object grip, st;
             if ((e = item.get_object().get(grip)) || (e = grip["state"].get_object().get(st)) ||
                 (e = gripButtons(st, next.buttons)))
-                if (hard(e)) return false;
+                if (e != simdjson::NO_SUCH_FIELD) return false;
             break;
         }
         break;

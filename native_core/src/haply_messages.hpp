@@ -1,7 +1,8 @@
 // The Haply Inverse Service's simulation-channel messages (WebSocket JSON, port 10001; Haply's
 // "Simulation Channel" and "Control Commands" docs): the inventory it sends on connecting and the
-// state update it sends for each message it receives, read with simdjson's on-demand parser into
-// fixed buffers (no allocation per message once the parser is sized), and the command the client
+// state update it sends for each message it receives, read with simdjson's DOM parser (a whole
+// message validated before any field is read) into fixed buffers (no allocation per message once
+// the parser is sized), and the command the client
 // sends each tick (set_cursor_force), written into a caller's buffer.
 #pragma once
 #include <array>
