@@ -297,7 +297,7 @@ void HapticRuntime::hapticLoop() {
     auto last = t0_;
     bool first = true;
     DeviceSample sample;
-    const HapticEstimate none;  // before the first snapshot: no force
+    const HapticEstimate none{};  // before the first snapshot: no force (value-initialised: Eigen members zero)
     try {
         bool idle = false, wasIdle = false;
         while (!stopRequested_.load(std::memory_order_acquire)) {
