@@ -317,12 +317,16 @@ class TestReadme(DocumentTestCase):
         from freecad_support import ROOT
         with open(os.path.join(ROOT, "README.md")) as f:
             block = re.search(r"## Scripting.*?```python\n(.*?)```", f.read(), re.S).group(1)
-        block = block.replace("face = hs.to_cadquery(obj)", "")  # cadquery lives in its own venv here
         block = block.replace('"/tmp/sculpt.step"', repr(os.path.join(self.tmp, "sculpt.step")))
         scope = {}
         exec(compile(block, "README.md", "exec"), scope)
-        self.assertTrue(scope["solid"].isValid())
-        self.assertEqual(scope["obj"].Strokes, 0)  # the example ends with an undo
+        self.assertEqual(scope["obj"].Strokes, 1)
+        self.assertGreater(scope["obj"].Shape.BoundBox.ZMax, 1.0)  # the rope lifted the patch
+        self.assertTrue(os.path.getsize(os.path.join(self.tmp, "sculpt.step")) > 0)
+        shape = scope["solid"].Shape
+        self.assertTrue(shape.isValid())
+        self.assertEqual(len(shape.Solids), 1)
+        self.assertGreater(shape.BoundBox.ZMax, 31.0)  # the box's top pulled up
         FreeCAD.closeDocument(scope["doc"].Name)
 
 
