@@ -119,9 +119,13 @@ HOST_SUITE  := $(shell . /etc/os-release 2>/dev/null; echo $$VERSION_CODENAME)
 OTHER_SUITE := $(if $(filter trixie,$(HOST_SUITE)),bookworm,trixie)
 OTHER_PACKAGES := $(APT_PACKAGES) make ca-certificates
 OTHER := tools/debian-root $(OTHER_SUITE) run make BUILD=build/$(OTHER_SUITE) DEMO_OUT=build/$(OTHER_SUITE)/demo
+# Where no root can be made (no mount namespace: tools/debian-root exits 77 with one line saying what
+# is missing), the rest of make test still counts.
 test-other-debian: deps
-	tools/debian-root $(OTHER_SUITE) ensure $(OTHER_PACKAGES)
-	$(OTHER) test-cpp test-asan test-python test-addon demo
+	@set +e; tools/debian-root $(OTHER_SUITE) ensure $(OTHER_PACKAGES) && \
+	  $(OTHER) test-cpp test-asan test-python test-addon demo; rc=$$?; \
+	  if [ $$rc = 77 ]; then echo "make test: the other Debian's FreeCAD was not tested (see the line above)"; exit 0; fi; \
+	  exit $$rc
 
 test-gui-repeat-other-debian: deps
 	tools/debian-root $(OTHER_SUITE) ensure $(OTHER_PACKAGES)
