@@ -532,8 +532,6 @@ def make_thickness(obj: Any, thickness: float, name: str = "Thickness") -> Any:
         feature.Thickness = thickness
         feature.Shape = shape
         attach_view_provider(feature)
-        if feature.ViewObject is not None and obj.ViewObject is not None:
-            obj.ViewObject.Visibility = False  # (as Part's Offset hides what it offsets)
         feature.purgeTouched()
     return feature
 
