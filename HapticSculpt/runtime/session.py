@@ -330,7 +330,9 @@ class Session:
             return
         # Only a held stroke previews on the objects built from the sculpt (a SculptedSolid's
         # faces as a compound): once it is let go they show the committed state, a closed solid.
-        held = bool(runtime.status()["grab"])
+        # (A spray moves no pole: nothing to preview.)
+        status = runtime.status()
+        held = bool(status["grab"]) and not status["spraying"]
         poles = runtime.take_poles()
         if poles is not None and _alive(obj):
             self._latest_poles = poles
