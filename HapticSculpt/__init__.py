@@ -16,6 +16,7 @@ from .app.api import (
                       hold_boundary,
                       keep_shape,
                       make_sculpt,
+                      make_thickness,
                       material_of,
                       paint,
                       record_state,
@@ -39,6 +40,6 @@ legacy_paths.install()
 __all__ = ["make_sculpt", "sculpt_solid", "set_boundary", "boundary_of", "seam_report_of", "run", "add_constraint", "remove_constraint", "hold_boundary", "held_boundary",
            "set_material", "material_of", "keep_shape",
            "set_tool", "set_uniform", "set_curvature_target", "paint", "record_state",
-           "export_step", "thicken",
+           "export_step", "thicken", "make_thickness",
            "to_cadquery", "ReplayDevice", "CursorSample", "CursorSource", "RunReport", "Session", "stop_all",
            "__version__"]

@@ -26,13 +26,17 @@ try:
     hs.run(obj, 1.5, device=hs.ReplayDevice.stroke((0, 0, 0), (0, 0, 35.0), seconds=1.0))
     Gui.Selection.clearSelection()
     Gui.Selection.addSelection(obj)
-    Gui.runCommand("HapticSculpt_Thicken")
+    Gui.runCommand("HapticSculpt_Thicken")  # (asks the thickness in a task panel: test_gui_thickness types one)
+    out["thicken_panel"] = Gui.Control.activeDialog()
+    Gui.Control.closeDialog()
+    hs.make_thickness(obj, 2.0)
     doc.recompute()
     out["objects"] = [o.Name for o in doc.Objects]
     out["icon"] = obj.ViewObject.Proxy.getIcon()
     view = Gui.ActiveDocument.ActiveView
     obj.ViewObject.ShapeColor = (0.9, 0.3, 0.1)
-    doc.getObject("Sculpt_Solid").ViewObject.Visibility = False
+    doc.getObject("Thickness").ViewObject.Visibility = False
+    obj.ViewObject.Visibility = True
     Gui.Selection.clearSelection()  # (selection is drawn green)
     view.viewIsometric()
     view.fitAll()
@@ -93,7 +97,7 @@ def test_workbench_loads_and_commands_run(tmp_path):
     assert out["workbench"] == "HapticSculptWorkbench"
     assert set(out["commands"]) >= {"HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Thicken",
                                     "HapticSculpt_ExportStep"}
-    assert {"Sculpt", "Sculpt_Solid"} <= set(out["objects"])
+    assert {"Sculpt", "Thickness"} <= set(out["objects"]) and out["thicken_panel"]
     assert np.all(np.isfinite(out["mouse_centre"])) and np.all(np.isfinite(out["mouse_corner"]))
     assert abs(out["mouse_centre"][2]) < 60.0  # on the sculpt (a bump up to ~35 mm), not the far plane
     assert out["mouse_sample"] == 1

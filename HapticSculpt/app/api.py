@@ -502,21 +502,38 @@ def export_step(objs: Any, path: str | os.PathLike[str]) -> str:
 
 def thicken(obj: Any, thickness: float, tolerance: float = 1e-6) -> Any:
     """A solid made by offsetting the sculpt face by ``thickness`` (mm; negative: the other side)
-    and closing the gap; raises ``ValueError`` when OCCT cannot make a valid solid."""
+    and closing the gap; raises ``ValueError`` when OCCT cannot make a valid solid. A plain shape:
+    :func:`make_thickness` makes one that follows the sculpt."""
+    from .thickness import thickened
     _sculpt(obj)
     thickness = _finite(thickness, "thickness")
     if thickness == 0:
         raise ValueError("thickness: must be non-zero")
     tolerance = _finite(tolerance, "tolerance", positive=True)
-    face = obj.Shape.Faces[0]
-    try:
-        shape = face.makeOffsetShape(thickness, tolerance, fill=True)
-    except Exception as exc:  # OCCT raises Part.OCCError and others
-        raise ValueError(f"thickness: OCCT could not offset the face by {thickness} ({exc})") from exc
-    solids = shape.Solids
-    if len(solids) != 1 or not solids[0].isValid():
-        raise ValueError(f"thickness: offsetting by {thickness} does not give one valid solid")
-    return solids[0]
+    return thickened(obj.Shape.Faces[0], thickness, tolerance)
+
+
+def make_thickness(obj: Any, thickness: float, name: str = "Thickness") -> Any:
+    """A parametric solid of the sculpt ``obj``: its face offset by ``thickness`` mm (> 0) along its
+    normal and closed, as a Thickness object that recomputes after each stroke and when its
+    Thickness property is edited. One undo step; ``ValueError`` (nothing added) when the face
+    cannot be thickened by that much."""
+    from .thickness import ThicknessFeature, attach_view_provider, thickened
+    _sculpt(obj)
+    thickness = _finite(thickness, "thickness", positive=True)
+    if not isinstance(name, str) or not name:
+        raise TypeError("name: expected a non-empty string")
+    shape = thickened(obj.Shape.Faces[0], thickness)  # (raises before anything is added)
+    doc = obj.Document
+    with transaction(doc, "Thicken"):
+        feature = doc.addObject("Part::FeaturePython", name)
+        ThicknessFeature(feature)
+        feature.Source = obj
+        feature.Thickness = thickness
+        feature.Shape = shape
+        attach_view_provider(feature)
+        feature.purgeTouched()
+    return feature
 
 
 def to_cadquery(obj: Any) -> Any:

@@ -190,17 +190,20 @@ class LiveSurface:
         self._shadow_stale = True
         if geometry:
             notify_dependents(obj)
+            recompute_dependents(obj)
 
-    def show_poles(self, poles: np.ndarray, base: sculpt_state.SculptState) -> None:
+    def show_poles(self, poles: np.ndarray, base: sculpt_state.SculptState, preview: bool = True) -> None:
         """Redraws the Shape from intermediate poles on the knots and weights of ``base`` (a GUI
-        frame during a session; not stored, not an undo step)."""
+        frame during a session; not stored, not an undo step); with ``preview`` (a stroke is held)
+        the objects built from the sculpt show it too, else they keep the stored state's shape."""
         frame = sculpt_state.SculptState({**base.arrays, "Poles": np.asarray(poles, dtype=float).ravel()}, base.settings)
         self.writing = True
         try:
             self._obj.Shape = face_of(frame)
         finally:
             self.writing = False
-        notify_dependents(self._obj, frame)
+        if preview:
+            notify_dependents(self._obj, frame)
 
     def reset_shape(self) -> None:
         """Puts the Shape back to the stored state's face after a session's frames redrew it. Done
@@ -266,3 +269,19 @@ def notify_dependents(obj: Any, frame: sculpt_state.SculptState | None = None) -
         hook = getattr(proxy, "sculpt_changed" if frame is None else "sculpt_frame", None)
         if hook is not None:
             hook(parent) if frame is None else hook(parent, frame)
+
+
+def recompute_dependents(obj: Any) -> None:
+    """The features built on this sculpt (a Thickness, a Part Cut or a PartDesign Body on its
+    SculptedSolid) recompute now, in the caller's transaction, so they follow each stroke and one
+    undo step restores them too. The sculpt and its SculptedSolids are up to date already (their
+    shapes were just written): they are not recomputed again."""
+    built = [p for p in obj.InList if hasattr(getattr(p, "Proxy", None), "sculpt_changed")]
+    users = [u for o in [obj] + built for u in o.InList if u not in built]
+    if not users:
+        return
+    for o in [obj] + built:
+        o.purgeTouched()
+    for user in users:
+        user.touch()
+    obj.Document.recompute([o for o in obj.InListRecursive if o not in built])

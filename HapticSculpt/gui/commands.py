@@ -28,17 +28,21 @@ def _selected_sculpts() -> list[Any]:
 
 
 class NewPatch:
-    """A flat 8x8 sculpt patch (100 x 100 mm) in the active document."""
+    """A flat 8x8 sculpt patch (100 x 100 mm) in the active document, or in a new one when none is
+    open (as Part's primitives do)."""
 
     def GetResources(self) -> dict[str, str]:
         return {"Pixmap": icon("HapticSculpt"), "MenuText": "New sculpt patch",
-                "ToolTip": "Create a flat 100 x 100 mm B-spline patch (8 x 8 poles, degree 3) to sculpt"}
+                "ToolTip": "Create a flat 100 x 100 mm B-spline patch (8 x 8 poles, degree 3) to sculpt "
+                           "(in a new document when none is open)"}
 
     def IsActive(self) -> bool:
-        return FreeCAD.ActiveDocument is not None
+        return True
 
     def Activated(self) -> None:
         from .echo import run_echoed
+        if FreeCAD.ActiveDocument is None:
+            run_echoed("App.newDocument()", modules=())
         # clay: designers expect what they pull to stay
         run_echoed(f"HapticSculpt.make_sculpt(App.getDocument({FreeCAD.ActiveDocument.Name!r}), material='clay')")
         FreeCAD.ActiveDocument.recompute()
@@ -106,27 +110,19 @@ class SculptFace:
 
 
 class Thicken:
-    """Thicken the selected sculpt into a solid (2 mm)."""
+    """Thicken the selected sculpt into a parametric solid: a task panel asks the thickness."""
 
     def GetResources(self) -> dict[str, str]:
         return {"Pixmap": icon("HapticSculpt"), "MenuText": "Thicken",
-                "ToolTip": "Offset the selected sculpt surface by 2 mm into a new solid"}
+                "ToolTip": "Offset the selected sculpt surface into a solid that follows it (asks the thickness; "
+                           "double-click the Thickness to change it)"}
 
     def IsActive(self) -> bool:
-        return bool(_selected_sculpts())
+        return len(_selected_sculpts()) == 1 and not Gui.Control.activeDialog()
 
     def Activated(self) -> None:
-        from .echo import ref, run_echoed
-        for obj in _selected_sculpts():
-            doc = f"App.getDocument({obj.Document.Name!r})"
-            run_echoed(f"{doc}.openTransaction('Thicken')", modules=())
-            try:
-                run_echoed(f"Part.show(HapticSculpt.thicken({ref(obj)}, 2.0), {obj.Name + '_Solid'!r})",
-                           modules=("Part", "HapticSculpt"))
-            except Exception:
-                obj.Document.abortTransaction()
-                raise
-            run_echoed(f"{doc}.commitTransaction()", modules=())
+        from .thickness_panel import ThicknessPanel
+        Gui.Control.showDialog(ThicknessPanel(sculpt=_selected_sculpts()[0]))
 
 
 class ExportStep:

@@ -67,3 +67,48 @@ class SolidViewProvider(_Stateless):
         if base is not None and base.ViewObject is not None:
             base.ViewObject.Visibility = True
         return True
+
+
+class ThicknessViewProvider(_Stateless):
+    """A Thickness shows as Part shows a solid, its sculpt as its child in the tree (hidden);
+    double-click opens the panel that edits its thickness."""
+
+    def __init__(self, vobj: Any) -> None:
+        vobj.Proxy = self
+        source = vobj.Object.Source
+        if source is not None and source.ViewObject is not None:
+            source.ViewObject.Visibility = False  # (as Part's Offset hides what it offsets)
+
+    def attach(self, vobj: Any) -> None:
+        self.Object = vobj.Object
+
+    def getIcon(self) -> str:
+        return icon("HapticSculpt")
+
+    def claimChildren(self) -> list[Any]:
+        source = getattr(self.Object, "Source", None)
+        return [source] if source is not None else []
+
+    def doubleClicked(self, vobj: Any) -> bool:
+        import FreeCADGui as Gui
+        Gui.ActiveDocument.setEdit(vobj.Object, 0)
+        return True
+
+    def setEdit(self, vobj: Any, mode: int) -> bool:
+        if mode != 0:
+            return False
+        import FreeCADGui as Gui
+        from .thickness_panel import ThicknessPanel
+        Gui.Control.showDialog(ThicknessPanel(feature=vobj.Object))
+        return True
+
+    def unsetEdit(self, vobj: Any, mode: int) -> bool:
+        import FreeCADGui as Gui
+        Gui.Control.closeDialog()
+        return True
+
+    def onDelete(self, vobj: Any, subelements: Any) -> bool:
+        source = getattr(vobj.Object, "Source", None)
+        if source is not None and source.ViewObject is not None:
+            source.ViewObject.Visibility = True
+        return True

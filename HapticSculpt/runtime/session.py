@@ -62,6 +62,7 @@ class Session:
         self._error = ""
         self._timer: Any = None
         self._frame_base: Any = None  # knots, weights, degrees for GUI frames (they do not change)
+        self._previewed = False  # a held stroke's frames previewed on the objects built from the sculpt
         self._airbrush: dict[str, Any] = {"map": None}
         self._latest_poles: np.ndarray | None = None  # the newest pole snapshot the GUI received
         self._latest_maps: dict[str, np.ndarray] = {}  # the newest snapshot of each map sprayed this run
@@ -103,6 +104,7 @@ class Session:
         live.attach(self)  # from here on the runtime steps the surface, starting at rest
         self._runtime, self._obj, self._device, self._error = runtime, obj, native, ""
         self._latest_poles, self._latest_maps, self._edits, self.applied_edits = None, {}, {}, []
+        self._previewed = False
         runtime.set_airbrush(**self._airbrush)
         runtime.start()
         _ACTIVE.add(self)
@@ -326,14 +328,24 @@ class Session:
         runtime, obj = self._runtime, self._obj
         if runtime is None or obj is None:
             return
+        # Only a held stroke previews on the objects built from the sculpt (a SculptedSolid's
+        # faces as a compound): once it is let go they show the committed state, a closed solid.
+        # (A spray moves no pole: nothing to preview.)
+        status = runtime.status()
+        held = bool(status["grab"]) and not status["spraying"]
         poles = runtime.take_poles()
         if poles is not None and _alive(obj):
             self._latest_poles = poles
-            obj.Proxy.live.show_poles(poles, self._frame_base)
+            obj.Proxy.live.show_poles(poles, self._frame_base, preview=held)
+            self._previewed = self._previewed or held
         painted = runtime.take_painted_map()
         if painted is not None:
             self._latest_maps[painted["map"]] = painted["values"]
-        self.poll()
+        committed = self.poll()
+        if self._previewed and not held and self._obj is not None:
+            self._previewed = False
+            if not committed:  # (a press that grabbed nothing: no commit rebuilds them)
+                obj.Proxy.live.reset_shape()
 
 
 def _tell_commit(obj: Any, before: sculpt_state.SculptState, title: str, strokes: int) -> None:

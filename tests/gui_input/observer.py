@@ -52,6 +52,50 @@ def _solids(doc):
     return out
 
 
+def _features(doc):
+    """Every object with a shape: its type, recompute state and what its shape is (and a Thickness's
+    thickness)."""
+    out = {}
+    for o in doc.Objects:
+        shape = getattr(o, "Shape", None)
+        if shape is None or not hasattr(shape, "Solids"):
+            continue
+        out[o.Name] = {"type": o.TypeId, "state": list(o.State), "valid": not shape.isNull() and shape.isValid(),
+                       "solids": len(shape.Solids), "volume": shape.Volume if not shape.isNull() else 0.0,
+                       "zmax": shape.BoundBox.ZMax if not shape.isNull() else None,
+                       "thickness": o.Thickness.Value if hasattr(o, "Thickness") else None,
+                       "visible": bool(o.ViewObject.Visibility) if o.ViewObject is not None else None}
+    return out
+
+
+_TREE = []
+
+
+def _tree_items():
+    """Where each item of the model tree is on the screen ({label: [x, y]}, its centre, in the
+    screen's pixels: Qt's are scaled by the device pixel ratio), for a double-click on it (found by
+    class name: no Qt import)."""
+    if not _TREE:
+        stack = list(Gui.getMainWindow().children())
+        while stack:
+            w = stack.pop()
+            if hasattr(w, "metaObject") and w.metaObject().className() == "Gui::TreeWidget":
+                _TREE.append(w)  # (the combo view's and the tree view's, which is hidden)
+            stack.extend(w.children())
+    tree, out = next((t for t in _TREE if t.isVisible()), None), {}
+    if tree is None:
+        return out
+    items = [tree.topLevelItem(k) for k in range(tree.topLevelItemCount())]
+    while items:
+        item = items.pop()
+        items.extend(item.child(k) for k in range(item.childCount()))
+        rect = tree.visualItemRect(item)
+        if rect.height() > 0:
+            p, scale = tree.viewport().mapToGlobal(rect.center()), tree.devicePixelRatioF()
+            out[item.text(0)] = [round(p.x() * scale), round(p.y() * scale)]
+    return out
+
+
 def _mirror_distance(o):
     """How far a symmetric SculptedSolid's sculpted face is from its own mirror image (None if it
     has no mirror plane), on a 21 x 21 grid."""
@@ -103,12 +147,13 @@ def _views():
 def write(*_):
     state = {"version": [int(x) for x in FreeCAD.Version()[:2]],
              "workbench": Gui.activeWorkbench().name() if Gui.activeWorkbench() else "",
-             "active": FreeCAD.ActiveDocument.Name if FreeCAD.ActiveDocument else None, "docs": {}, "views": _views()}
+             "active": FreeCAD.ActiveDocument.Name if FreeCAD.ActiveDocument else None, "docs": {}, "views": _views(),
+             "task_dialog": bool(Gui.Control.activeDialog()), "tree": _tree_items()}
     for name, doc in FreeCAD.listDocuments().items():
         state["docs"][name] = {"undo": list(doc.UndoNames), "redo": list(doc.RedoNames), "file": doc.FileName,
                                "modified": bool(getattr(doc, "isTouched", lambda: False)()),
                                "sculpts": _sculpts(doc), "objects": [o.Name for o in doc.Objects],
-                               "solids": _solids(doc),
+                               "solids": _solids(doc), "features": _features(doc),
                                "screen": {o.Name: _on_screen(o) for o in doc.Objects if hasattr(o, "Shape")}}
     try:
         import HapticSculpt.gui.workbench as hg

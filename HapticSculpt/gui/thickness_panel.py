@@ -1,0 +1,69 @@
+"""The task panel that asks a thickness (resources/ui/thickness.ui, a Gui::QuantitySpinBox in mm):
+for a new Thickness of a sculpt (the Thicken command) or to edit one (double-click). OK runs the
+scripting call through FreeCADGui.doCommand, as one undo step; Cancel changes nothing."""
+from __future__ import annotations
+
+import os
+from typing import Any
+
+import FreeCAD
+import FreeCADGui as Gui
+
+from .echo import ref, run_echoed
+
+UI = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "resources", "ui", "thickness.ui")
+#: The thickness a new Thickness is offered (mm).
+DEFAULT = 2.0
+
+
+class ThicknessPanel:
+    """Asks the thickness of ``sculpt``'s new Thickness, or of ``feature`` (an existing one)."""
+
+    def __init__(self, sculpt: Any = None, feature: Any = None) -> None:
+        self.sculpt, self.feature = sculpt, feature
+        self.form = Gui.PySideUic.loadUi(UI)
+        self.form.setWindowTitle("Thickness" if feature is None else f"Thickness of {feature.Label}")
+        value = DEFAULT if feature is None else float(feature.Thickness.Value)
+        self.form.thickness.setProperty("rawValue", value)
+
+    def open(self) -> None:
+        """Shown: the value is selected, so typing replaces it (as in FreeCAD's own dialogs)."""
+        self.form.thickness.setFocus()
+        self.form.thickness.selectAll()
+
+    def thickness(self) -> float:
+        """The value in the field (mm)."""
+        return float(self.form.thickness.property("rawValue"))
+
+    def accept(self) -> bool:
+        t = self.thickness()
+        try:
+            if self.feature is None:
+                run_echoed(f"HapticSculpt.make_thickness({ref(self.sculpt)}, {t!r})")
+            else:
+                self._edit(t)
+        except (ValueError, TypeError) as exc:
+            FreeCAD.Console.PrintError(f"HapticSculpt: Thicken: {exc}\n")
+            return False  # (the panel stays open for another value)
+        self._close()
+        return True
+
+    def reject(self) -> bool:
+        self._close()
+        return True
+
+    def _edit(self, t: float) -> None:
+        """The Thickness property set and recomputed, one undo step."""
+        doc = f"App.getDocument({self.feature.Document.Name!r})"
+        run_echoed(f"{doc}.openTransaction('Edit thickness')", modules=())
+        try:
+            run_echoed(f"{ref(self.feature)}.Thickness = {t!r}", modules=())
+            run_echoed(f"{doc}.recompute()", modules=())
+        finally:
+            run_echoed(f"{doc}.commitTransaction()", modules=())
+
+    def _close(self) -> None:
+        if self.feature is not None and Gui.ActiveDocument is not None and Gui.ActiveDocument.getInEdit():
+            Gui.ActiveDocument.resetEdit()
+        else:
+            Gui.Control.closeDialog()

@@ -1,0 +1,75 @@
+"""A designer's first minutes, with real X events (xdotool) in FreeCAD's GUI under Xvfb: New patch
+with no document open makes one (its button is never greyed); Thicken asks the thickness in a task
+panel (typed, Enter), makes a Thickness that is one undo step and follows the next stroke, and a
+double-click on it opens the panel again to change it. Screenshots in build/screenshots/real_thick_*.png."""
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+
+import pytest
+from test_gui_real_input import NEEDS, SHOTS, Desktop, sculpt, undo
+
+
+def doc(s: dict) -> dict:
+    return s["docs"][s["active"]]
+
+
+def shot_changed(d: Desktop, name: str, before: np.ndarray, timeout: float = 20.0) -> np.ndarray:
+    """Screenshots until the 3D view's part of the screen differs from ``before`` (redrawn)."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        picture = d.shot(name)
+        if np.mean(np.abs(picture[160:720, 300:1250] - before[160:720, 300:1250]) > 0.1) > 1e-2:
+            return picture
+    raise AssertionError(f"{name}: the screen did not change")
+
+
+def thickness(s: dict) -> dict:
+    return next(f for f in doc(s)["features"].values() if f["thickness"] is not None)
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_new_patch_without_a_document_then_thicken_choosing_the_thickness(tmp_path):
+    os.makedirs(SHOTS, exist_ok=True)
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        assert d.state()["active"] is None and not d.state()["docs"], "FreeCAD started with no document"
+        d.click_button("NewPatch")  # (once: it is active with no document, as FreeCAD's Part primitives are)
+        s = d.wait(lambda s: s["active"] and doc(s)["sculpts"] and sculpt(s)["screen"], "a new document with a patch")
+        assert len(s["docs"]) == 1 and undo(s)[0] == "Create sculpt"
+        d.shot("thick_new_patch")
+        d.calibrate()
+        centre = d.to_screen(sculpt(s)["screen"][0])
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.wait(lambda s: s["mouse_point"] is not None, "the mouse over the patch")
+        d.xdo("click", "1")  # select the patch
+        d.wait(lambda s: sculpt(s)["selected"], "the patch selected")
+        d.press_button("Thicken", lambda s: s["task_dialog"], "the thickness panel")
+        d.shot("thick_panel")
+        d.xdo("key", "--delay", "100", "ctrl+a", "5", "Return")  # the value is selected: typing replaces it
+        s = d.wait(lambda s: not s["task_dialog"] and any(f["thickness"] for f in doc(s)["features"].values()),
+                   "the Thickness made", timeout=30)
+        made = thickness(s)
+        assert made["thickness"] == 5.0 and made["valid"] and made["solids"] == 1, made
+        assert made["state"] == ["Up-to-date"] and made["visible"], made
+        assert 0.85 * 5e4 < made["volume"] < 1.15 * 5e4, made  # 100 x 100 mm by 5 mm (a flat patch)
+        assert undo(s)[0] == "Thicken", undo(s)[:3]
+        top = d.shot("thick_made")
+        d.xdo("mousemove", "640", "500", "key", "0")  # isometric: the slab's side shows
+        shot_changed(d, "thick_made_isometric", top)
+        item = d.wait(lambda s: "Thickness" in s["tree"], "the Thickness in the tree")["tree"]["Thickness"]
+        d.xdo("mousemove", str(item[0]), str(item[1]), "click", "--repeat", "2", "--delay", "80", "1")
+        d.wait(lambda s: s["task_dialog"], "the panel to edit the thickness")
+        d.xdo("key", "--delay", "100", "ctrl+a", "2", "Return")
+        s = d.wait(lambda s: not s["task_dialog"] and thickness(s)["thickness"] == 2.0, "the thickness changed")
+        assert thickness(s)["valid"] and 0.85 * 2e4 < thickness(s)["volume"] < 1.15 * 2e4, thickness(s)
+        assert undo(s)[:2] == ["Edit thickness", "Thicken"], undo(s)[:3]
+        d.shot("thick_edited")
+        d.xdo("key", "ctrl+z")
+        s = d.wait(lambda s: thickness(s)["thickness"] == 5.0 and abs(thickness(s)["volume"] - made["volume"]) < 1e-6,
+                   "Undo of the edit")
+    finally:
+        d.close()
