@@ -35,16 +35,18 @@ FrameClock = Callable[[Callable[[], None]], Callable[[], None]]
 _frame_clocks: list[FrameClock] = []
 
 
-#: Called after each commit a session makes that no scripting call made (a stroke, a spray, the
-#: session's end) with the object, its state before, the undo step's title and the strokes it
-#: counts: the GUI layer installs one that echoes HapticSculpt.record_state, so a macro records it.
+#: Called inside the transaction of each commit a session makes that no scripting call made (a
+#: stroke, a spray, the session's end) with the object, its state before, the undo step's title and
+#: the strokes it counts: the GUI layer installs one that keeps the stroke in the sculpt and echoes
+#: HapticSculpt.replay_stroke, so a macro records it (and Undo forgets it with the stroke).
 CommitListener = Callable[[Any, sculpt_state.SculptState, str, int], None]
 _commit_listeners: list[CommitListener] = []
 
 
-def set_commit_listener(listener: CommitListener) -> None:
-    """Installs the listener told of every stroke, spray and session end a session commits."""
-    _commit_listeners[:] = [listener]
+def set_commit_listener(listener: CommitListener | None) -> None:
+    """Installs the listener told of every stroke, spray and session end a session commits (None:
+    none, as in console mode)."""
+    _commit_listeners[:] = [listener] if listener is not None else []
 
 
 def set_frame_clock(clock: FrameClock) -> None:
@@ -287,9 +289,8 @@ class Session:
                 live.write(_with_event(state, event))
                 if strokes:
                     obj.Strokes = obj.Strokes + strokes
+                    _tell_commit(obj, state, title, strokes)
                 obj.purgeTouched()
-            if strokes:
-                _tell_commit(obj, state, title, strokes)
             n += strokes
         return n
 
@@ -309,8 +310,10 @@ class Session:
             live.document_changed()  # the stored state stays the truth
             return
         live.reset_shape()
-        live.commit("Sculpt session end")
-        _tell_commit(obj, stored, "Sculpt session end", 0)
+        with transaction(obj.Document, "Sculpt session end"):
+            live.write(current)
+            _tell_commit(obj, stored, "Sculpt session end", 0)
+            obj.purgeTouched()
 
     # --- GUI: shape at graphics rate, strokes as they end ----------------------------------------
     def _start_timer(self) -> None:
