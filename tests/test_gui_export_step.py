@@ -1,0 +1,69 @@
+"""Export STEP as a designer uses it, with real X input (tests/test_gui_real_input.py's Desktop):
+with nothing selected it takes the document's only sculpt, its task panel offers
+<home>/<label>.step in FreeCAD's file chooser, OK writes it through one echoed
+HapticSculpt.export_step call, and an independent reader (cadquery's OCP) reads the surface back."""
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+import pytest
+from freecad_support import run_ocp
+from test_freecad_step_ocp import READ_STEP
+from test_gui_real_input import NEEDS, RECORD_BUTTON, Desktop, sculpt
+
+
+def start_macro(d: Desktop, name: str) -> None:
+    """Macro > Macro recording..., the name typed, Record clicked (real keys and clicks)."""
+    d.xdo("key", "alt+m")
+    d.xdo("key", "m")
+    d.wait_window("Macro recording")
+    d.xdo("key", "ctrl+a")
+    d.xdo("type", name)
+    d.xdo("mousemove", str(RECORD_BUTTON[0]), str(RECORD_BUTTON[1]), "click", "1")
+    d.xdo("mousemove", "640", "500", "click", "1")
+
+
+def stop_macro(d: Desktop, name: str) -> str:
+    """Macro > Stop macro recording; the macro's text once FreeCAD has written it."""
+    d.xdo("mousemove", "640", "500")
+    d.xdo("key", "alt+m")
+    d.xdo("key", "t")
+    path = os.path.join(d.home, name + ".FCMacro")
+    end, text = time.monotonic() + 30, ""
+    while "# Macro End" not in text and time.monotonic() < end:  # (written when the recording stops)
+        time.sleep(0.05)
+        text = open(path).read() if os.path.exists(path) else ""
+    return text
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_export_step_with_nothing_selected_writes_the_only_sculpt(tmp_path, monkeypatch):
+    home = tmp_path / "designer"
+    home.mkdir()
+    monkeypatch.setenv("HOME", str(home))  # (the panel offers the home folder for an unsaved document)
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        start_macro(d, "export")
+        d.xdo("key", "ctrl+n")
+        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
+        d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        d.xdo("mousemove", "1100", "900", "click", "1")  # an empty corner of the view: nothing selected
+        d.wait(lambda s: not sculpt(s)["selected"], "the selection to be cleared")
+        s = d.press_button("ExportStep", lambda s: "OK" in s["task_buttons"], "the Export STEP panel")
+        d.shot("export_step_panel")
+        ok = s["task_buttons"]["OK"]
+        d.xdo("mousemove", str(ok[0]), str(ok[1]), "click", "1")
+        target = home / "Sculpt.step"
+        s = d.wait(lambda s: not s["task_buttons"] and target.exists(), "the panel to close and the STEP file")
+        d.shot("export_step_done")
+        poles = np.array(sculpt(s)["poles"]).reshape(8, 8, 3)
+        macro = stop_macro(d, "export")
+    finally:
+        d.close()
+    out = run_ocp(f"PATH = {str(target)!r}\nPARAMS = [[(0.5, 0.5)]]\n" + READ_STEP, str(tmp_path))
+    assert len(out) == 1 and out[0]["type"] == "Geom_BSplineSurface"
+    np.testing.assert_allclose(np.array(out[0]["poles"]), poles, atol=1e-9)
+    calls = [line for line in macro.splitlines() if line.startswith("HapticSculpt.export_step")]
+    assert calls == [f"HapticSculpt.export_step([App.getDocument('Unnamed').getObject('Sculpt')], {str(target)!r})"], macro
