@@ -68,6 +68,7 @@ class Session:
         self._latest_poles: np.ndarray | None = None  # the newest pole snapshot the GUI received
         self._latest_maps: dict[str, np.ndarray] = {}  # the newest snapshot of each map sprayed this run
         self._next_edit = 1
+        self._committed = False
         self._edits: dict[int, tuple[str, sculpt_state.SculptState | None, int]] = {}  # posted, not yet applied
         #: each edit the simulation applied this run: its title, the simulation steps taken when it
         #: was posted and when it applied (it applies between two steps, so these differ by 0 to 2),
@@ -105,6 +106,7 @@ class Session:
         live.attach(self)  # from here on the runtime steps the surface, starting at rest
         self._runtime, self._obj, self._device, self._error = runtime, obj, native, ""
         self._latest_poles, self._latest_maps, self._edits, self.applied_edits = None, {}, {}, []
+        self._committed = False  # a stroke, spray or edit this run (else its end commits nothing)
         runtime.set_airbrush(**self._airbrush)
         runtime.start()
         _ACTIVE.add(self)
@@ -291,15 +293,20 @@ class Session:
                     obj.Strokes = obj.Strokes + strokes
                     _tell_commit(obj, state, title, strokes)
                 obj.purgeTouched()
+            self._committed = True
             n += strokes
         return n
 
     def _commit_final(self, obj: Any) -> None:
         """The state after the last stroke as its own transaction, if the surface moved on after it
-        (an elastic patch springing back, a swing settling). Round-off drift of a resting patch
-        (below a nanometre), and a clay patch's rest lengths relaxed at the start, are no edit: the
-        document keeps its state and the surface is reloaded."""
+        (an elastic patch springing back, a swing settling). A session without a stroke, spray or
+        edit changed nothing (whatever its constraints made the surface do meanwhile), and
+        round-off drift of a resting patch (below a nanometre), and a clay patch's rest lengths
+        relaxed at the start, are no edit: the document keeps its state and the surface is reloaded."""
         live = obj.Proxy.live
+        if not self._committed:
+            live.document_changed()
+            return
         current = sculpt_state.capture(live.surface)
         stored = read_state(obj)
         drift = float(np.max(np.abs(current.arrays["Poles"] - stored.arrays["Poles"]), initial=0.0))
