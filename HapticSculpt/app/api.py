@@ -187,8 +187,8 @@ def record_state(obj: Any, packed: str, title: str = "Sculpt stroke", strokes: i
     """Gives ``obj`` a recorded state: ``packed`` is what a stroke (or a spray, or a session's end)
     in a threaded session changed, as :func:`HapticSculpt.app.recorded_state.pack` writes it. One
     undo step named ``title``, counting ``strokes``. Returns False and does nothing if ``obj``
-    holds that state already: the GUI echoes this call after each stroke it commits, so FreeCAD's
-    macro recorder records the stroke, and a recorded macro replays it exactly in console mode."""
+    holds that state already. The GUI echoed this call after each stroke before it kept strokes in
+    the sculpt (:func:`replay_stroke`); macros recorded then still replay exactly with it."""
     obj = _sculpt(obj, solids=True)
     if not isinstance(title, str) or not title:
         raise TypeError("title: expected a non-empty string")
