@@ -99,6 +99,9 @@ try:
     res["patch"] = patch.Name
     res["active_selected"] = command.isActive()
     Gui.Selection.clearSelection()
+    Gui.Selection.addSelection(box)  # (any part selected goes: a thickened sculpt is a plain Part feature)
+    res["part"] = [o.Name for o in export_panel.exportable(Gui.Selection.getSelection(), doc)]
+    Gui.Selection.clearSelection()
     doc.saveAs(os.path.join(TMP, "parts.FCStd"))
     panel = export_panel.ExportStepPanel([solid])
     res["default"] = panel.path()
@@ -143,6 +146,7 @@ def test_export_step_chooses_the_only_sculpted_solid_and_refuses_a_bad_file_name
     assert out["only_solid"] == ["SculptedSolid"] and out["active_solid"]  # (not its own hidden sculpt)
     assert out["two"] == [] and not out["active_two"]  # two candidates and none selected: which one?
     assert out["selected"] == [out["patch"]] and out["active_selected"]
+    assert out["part"] == ["Box"]
     assert out["default"] == str(tmp_path / "SculptedSolid.step")  # (the saved document's folder, its label)
     assert out["refused"] is False  # (said in the report view; the panel stays open)
     assert out["accepted"] is True and out["written"] == str(tmp_path / "part.step")

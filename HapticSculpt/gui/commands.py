@@ -130,12 +130,12 @@ class Thicken:
 
 
 class ExportStep:
-    """Export the selected sculpts and sculpted solids, else the document's only one, to a STEP
-    file named in a task panel (FreeCAD's file chooser, STEP preselected)."""
+    """Export the selection, else the document's only sculpt or sculpted solid, to a STEP file
+    named in a task panel (FreeCAD's file chooser, STEP preselected)."""
 
     def GetResources(self) -> dict[str, str]:
         return {"Pixmap": icon("HapticSculpt"), "MenuText": "Export STEP",
-                "ToolTip": "Export the selected sculpt surfaces and sculpted solids (else the document's only one) "
+                "ToolTip": "Export the selected objects (else the document's only sculpt or sculpted solid) "
                            "to a STEP file"}
 
     def IsActive(self) -> bool:

@@ -15,18 +15,16 @@ _OK, _CANCEL = 0x00000400, 0x00400000  # QDialogButtonBox's Ok and Cancel (no Qt
 
 
 def exportable(selection: list[Any], doc: Any) -> list[Any]:
-    """The sculpts and sculpted solids to export: the selected ones, else the document's only one
-    (a SculptedSolid's own hidden sculpt is not one of its own); empty if there is no such choice."""
+    """What to export: the selected objects that have a shape (a sculpt, a sculpted solid, a
+    thickened solid, any part), else the document's only sculpt or sculpted solid (a SculptedSolid's
+    own hidden sculpt does not count); empty if there is no such choice."""
     from ..app.sculpt_feature import is_sculpt
     from ..app.sculpted_solid import is_sculpted_solid, solid_of
 
-    def wanted(o: Any) -> bool:
-        return is_sculpted_solid(o) or (is_sculpt(o) and solid_of(o) is None)
-
-    picked = [o for o in selection if wanted(o)]
+    picked = [o for o in selection if hasattr(o, "Shape") and not o.Shape.isNull()]
     if picked or doc is None:
         return picked
-    found = [o for o in doc.Objects if wanted(o)]
+    found = [o for o in doc.Objects if is_sculpted_solid(o) or (is_sculpt(o) and solid_of(o) is None)]
     return found if len(found) == 1 else []
 
 
