@@ -166,3 +166,17 @@ def test_replay_stroke_refuses_what_is_not_a_stroke_name(bad):
             hs.replay_stroke(doc, "Stroke001")
     finally:
         FreeCAD.closeDocument(doc.Name)
+
+
+class TestAFailingListener(DocumentTestCase):
+    def test_a_listener_that_fails_does_not_cost_the_stroke(self):
+        def fails(obj, before, title, strokes):
+            raise RuntimeError("no console")
+        session_module.set_commit_listener(fails)
+        try:
+            obj = hs.make_sculpt(self.doc, material="clay")
+            pull(obj, 20.0)
+        finally:
+            session_module.set_commit_listener(None)
+        self.assertEqual(obj.Strokes, 1)
+        self.assertIn("Sculpt stroke", self.doc.UndoNames)

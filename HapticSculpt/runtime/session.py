@@ -347,8 +347,14 @@ class Session:
 
 
 def _tell_commit(obj: Any, before: sculpt_state.SculptState, title: str, strokes: int) -> None:
+    """Tells the listeners, inside the commit's transaction; one that fails is reported and the
+    stroke is committed all the same (an echo must not cost the stroke)."""
     for listener in _commit_listeners:
-        listener(obj, before, title, strokes)
+        try:
+            listener(obj, before, title, strokes)
+        except Exception as exc:  # noqa: BLE001 - reported, not raised: see the docstring
+            import FreeCAD
+            FreeCAD.Console.PrintError(f"HapticSculpt: {title} committed, but not echoed: {exc}\n")
 
 
 def stop_all(commit: bool = True) -> None:
