@@ -91,6 +91,8 @@ class TestStrokeLog(DocumentTestCase):
             self.assertTrue(hs.replay_stroke(fresh, name))
             self.assertEqual(replay.UndoNames[0], kept[name]["title"])
         self.assertFalse(hs.replay_stroke(fresh, sorted(kept)[-1]))  # the state it gives: nothing to do
+        with self.assertRaisesRegex(ValueError, "Stroke001 starts from another state than Sculpt holds"):
+            hs.replay_stroke(fresh, "Stroke001")
         self.assertEqual(len(replay.UndoNames), 1 + len(kept))
         assert_same_state(fresh, saved)
         self.assertEqual(fresh.Strokes, saved.Strokes)
