@@ -1,7 +1,8 @@
 """Export STEP as a designer uses it, with real X input (tests/test_gui_real_input.py's Desktop):
 with nothing selected it takes the document's only sculpt, its task panel offers
-<home>/<label>.step in FreeCAD's file chooser, OK writes it through one echoed
-HapticSculpt.export_step call, and an independent reader (cadquery's OCP) reads the surface back."""
+<home>/<label>.step in FreeCAD's file chooser (its save dialog filtered to STEP), OK writes it
+through one echoed HapticSculpt.export_step call, and an independent reader (cadquery's OCP) reads
+the surface back."""
 from __future__ import annotations
 
 import os
@@ -53,9 +54,18 @@ def test_export_step_with_nothing_selected_writes_the_only_sculpt(tmp_path, monk
         d.wait(lambda s: not sculpt(s)["selected"], "the selection to be cleared")
         s = d.press_button("ExportStep", lambda s: "OK" in s["task_buttons"], "the Export STEP panel")
         d.shot("export_step_panel")
+        # the chooser's button: FreeCAD's save dialog, STEP preselected; a name typed without suffix
+        choose = s["task_buttons"]["..."]
+        d.xdo("mousemove", str(choose[0]), str(choose[1]), "click", "1")
+        d.wait_window("Select a file")
+        d.shot("export_step_save_dialog")
+        d.xdo("key", "ctrl+a")
+        d.xdo("type", str(home / "renamed"))
+        d.xdo("key", "Return")
+        s = d.wait(lambda s: "OK" in s["task_buttons"] and len(s["task_buttons"]) == 3, "the panel back")
         ok = s["task_buttons"]["OK"]
         d.xdo("mousemove", str(ok[0]), str(ok[1]), "click", "1")
-        target = home / "Sculpt.step"
+        target = home / "renamed.step"
         s = d.wait(lambda s: not s["task_buttons"] and target.exists(), "the panel to close and the STEP file")
         d.shot("export_step_done")
         poles = np.array(sculpt(s)["poles"]).reshape(8, 8, 3)

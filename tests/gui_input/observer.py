@@ -101,8 +101,8 @@ def _views():
 
 
 def _task_buttons():
-    """The visible buttons of the open task dialog (OK, Cancel, ...) by text, at their centres on the
-    screen; empty when there is none. (Walked from the main window: no Qt import in the project.)"""
+    """The visible buttons of the open task dialog (OK, Cancel, ...) by text, at their centres in
+    screen pixels; empty when there is none. (Walked from the main window: no Qt import in the project.)"""
     if not Gui.Control.activeDialog():
         return {}
     found, stack = {}, [Gui.getMainWindow()]
@@ -114,8 +114,8 @@ def _task_buttons():
             found.clear()
             w = stack.pop()
         if name == "QPushButton" and w.isVisible() and w.text():
-            centre = w.mapToGlobal(w.rect().center())
-            found[w.text().replace("&", "")] = [centre.x(), centre.y()]
+            centre, ratio = w.mapToGlobal(w.rect().center()), w.devicePixelRatioF()  # (Qt's pixels to the screen's)
+            found[w.text().replace("&", "")] = [round(centre.x() * ratio), round(centre.y() * ratio)]
         stack.extend(c for c in w.children() if c.isWidgetType())
     return found
 
