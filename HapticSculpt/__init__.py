@@ -21,6 +21,7 @@ from .app.api import (
                       paint,
                       record_state,
                       remove_constraint,
+                      replay_stroke,
                       run,
                       set_curvature_target,
                       set_material,
@@ -39,7 +40,7 @@ legacy_paths.install()
 
 __all__ = ["make_sculpt", "sculpt_solid", "set_boundary", "boundary_of", "seam_report_of", "run", "add_constraint", "remove_constraint", "hold_boundary", "held_boundary",
            "set_material", "material_of", "keep_shape",
-           "set_tool", "set_uniform", "set_curvature_target", "paint", "record_state",
+           "set_tool", "set_uniform", "set_curvature_target", "paint", "record_state", "replay_stroke",
            "export_step", "thicken", "make_thickness",
            "to_cadquery", "ReplayDevice", "CursorSample", "CursorSource", "RunReport", "Session", "stop_all",
            "__version__"]

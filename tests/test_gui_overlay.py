@@ -229,6 +229,7 @@ try:
     Gui.runCommand("HapticSculpt_Combs")  # (off: the density command switched them on)
     Gui.runCommand("HapticSculpt_Combs")
     Gui.runCommand("HapticSculpt_Panel")
+    surface = obj.Proxy.surface  # (the SpaceMouse session changed nothing: its end reloaded the document's state)
     ov.cursor = (np.array(ov.panel.layout(np.array(surface.mesh))["stiffness"][0]), np.array([1.0, 0, 0, 0]), False)
     shot("panel")
     # the panel operated with the cursor: grab the stiffness track, drag to the top, release

@@ -300,8 +300,9 @@ def test_workbench_first_keys_stroke_undo_redo_paint(tmp_path, style):
 @pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
 def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
     """Every command and key echoes its scripting call (FreeCADGui.doCommand): FreeCAD's own macro
-    recorder, started from its menu with real keys, records a session that freecadcmd replays to
-    the bit-identical sculpt state."""
+    recorder, started from its menu with real keys, records a session that freecadcmd replays, with
+    the saved document (which keeps the strokes) open, to the bit-identical sculpt state. A stroke
+    is one short replay_stroke line; a session without a stroke echoes nothing."""
     d = Desktop(str(tmp_path), "CAD")
     try:
         d.xdo("key", "alt+m")  # Macro > Macro recording...
@@ -320,12 +321,17 @@ def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
             s = d.press_button(button, lambda s: undo(s)[0] == title, title)
         # A stroke in a threaded session (its shape depends on the device's timing): the macro
         # records the state it left, and the elastic patch's motion after it as the session's end.
-        d.press_button("ToolRope", lambda s: undo(s)[0] == "Tool: rope", "Tool: rope")
+        s = d.press_button("ToolRope", lambda s: undo(s)[0] == "Tool: rope", "Tool: rope")
+        quiet = len(undo(s))
+        d.press_button("Session", lambda s: sculpt(s)["session"], "a session without a stroke")
+        s = d.press_button("Session", lambda s: not sculpt(s)["session"], "that session to stop")
+        assert len(undo(s)) == quiet, undo(s)[:4]  # (it changed nothing)
         d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
         d.drag([south] + [(south[0], south[1] - 10 * k) for k in range(1, 12)], seconds=0.6)
         d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the session's stroke")
         s = d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
         assert sculpt(s)["strokes"] == 1
+        d.shot("stroke_echo")  # (the Python console: one replay_stroke line a commit)
         gui_digest = sculpt(s)["digest"]
         d.xdo("mousemove", "640", "500")
         d.xdo("key", "alt+m")  # Macro > Stop macro recording
@@ -335,17 +341,29 @@ def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
         while "# Macro End" not in text and time.monotonic() < end:  # (written when the recording stops)
             time.sleep(0.05)
             text = open(macro).read() if os.path.exists(macro) else ""
+        saved = str(tmp_path / "strokes.FCStd")
+        d.xdo("key", "ctrl+s")  # (after the recording: the macro must not save over it)
+        d.wait_window("Save FreeCAD Document")
+        d.xdo("type", saved)
+        d.xdo("key", "Return")
+        s = d.wait(lambda s: s["docs"][s["active"]]["file"] == saved, "the document saved")
+        commits = [t for t in undo(s) if t in ("Sculpt stroke", "Sculpt session end")]
     finally:
         d.close()
-    for call in ("make_sculpt", "add_constraint", "paint", "set_tool", "set_material", "record_state"):
+    for call in ("make_sculpt", "add_constraint", "paint", "set_tool", "set_material", "replay_stroke"):
         assert f"HapticSculpt.{call}(" in text, text
+    strokes = [line for line in text.splitlines() if "replay_stroke" in line]
+    assert len(strokes) == len(commits), (commits, text)  # (one short line each; none for the quiet session)
+    assert all(len(line) <= 200 for line in strokes), strokes
     out = run_freecadcmd(f"""
         import sys
         sys.path.insert(0, {os.path.join(ROOT, "tests", "gui_input")!r})
+        import FreeCAD
+        FreeCAD.openDocument({saved!r})
         exec(open({macro!r}).read())
         import FreeCAD, observer_digest
-        obj = FreeCAD.ActiveDocument.getObject("Sculpt")
-        answer({{"digest": observer_digest.digest(obj), "undo": FreeCAD.ActiveDocument.UndoNames,
+        obj = FreeCAD.getDocument("Unnamed").getObject("Sculpt")
+        answer({{"digest": observer_digest.digest(obj), "undo": FreeCAD.getDocument("Unnamed").UndoNames,
                  "strokes": obj.Strokes}})
         """, str(tmp_path / "replay"))
     assert out["digest"] == gui_digest, (out["undo"], text)

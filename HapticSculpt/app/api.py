@@ -15,7 +15,7 @@ from typing import Any, Iterable, Protocol, Sequence
 import numpy as np
 
 from .. import core
-from . import recorded_state, sculpt_state
+from . import recorded_state, sculpt_state, stroke_log
 from .sculpt_feature import SculptFeature, attach_view_provider, is_sculpt
 from .sculpt_properties import face_of, read_state
 from .sculpted_solid import is_sculpted_solid, sculpt_of
@@ -187,8 +187,8 @@ def record_state(obj: Any, packed: str, title: str = "Sculpt stroke", strokes: i
     """Gives ``obj`` a recorded state: ``packed`` is what a stroke (or a spray, or a session's end)
     in a threaded session changed, as :func:`HapticSculpt.app.recorded_state.pack` writes it. One
     undo step named ``title``, counting ``strokes``. Returns False and does nothing if ``obj``
-    holds that state already: the GUI echoes this call after each stroke it commits, so FreeCAD's
-    macro recorder records the stroke, and a recorded macro replays it exactly in console mode."""
+    holds that state already. The GUI echoed this call after each stroke before it kept strokes in
+    the sculpt (:func:`replay_stroke`); macros recorded then still replay exactly with it."""
     obj = _sculpt(obj, solids=True)
     if not isinstance(title, str) or not title:
         raise TypeError("title: expected a non-empty string")
@@ -205,6 +205,39 @@ def record_state(obj: Any, packed: str, title: str = "Sculpt stroke", strokes: i
         live.write(state)
         if strokes:
             obj.Strokes = obj.Strokes + strokes
+        obj.purgeTouched()
+    live.document_changed()
+    live.restore_into_session()  # (a running session takes it up, at rest, as after an Undo)
+    return True
+
+
+def replay_stroke(obj: Any, stroke: str) -> bool:
+    """Replays stroke ``stroke`` (a name such as "Stroke003") that a threaded session in the GUI made
+    on ``obj`` and kept in its ``StrokeLog``: the state it left, bit for bit, as one undo step with
+    the stroke's own title. In a new document (a recorded macro replayed) the record is taken from
+    the open document it was made in (see :mod:`HapticSculpt.app.stroke_log`). Returns False and
+    does nothing if ``obj`` holds that state already: the GUI echoes this call after each stroke."""
+    obj = _sculpt(obj, solids=True)
+    if not isinstance(stroke, str) or not stroke:
+        raise TypeError(f"stroke: expected a stroke's name such as 'Stroke001', got {stroke!r}")
+    before = read_state(obj)
+    found = stroke_log.find(obj, stroke, before)
+    now = stroke_log.fingerprint(before)
+    if now == found["after"]:
+        return False
+    if now != found["before"]:
+        raise ValueError(f"stroke: {stroke} starts from another state than {obj.Name} holds "
+                         "(replay the strokes before it first, in order)")
+    state = recorded_state.unpack(found["change"], before)
+    if stroke_log.fingerprint(state) != found["after"]:
+        raise ValueError(f"stroke: the record of {stroke} does not give the state it was recorded with")
+    sculpt_state.restore(state)  # (raises ValueError naming what does not fit, before anything changes)
+    live = obj.Proxy.live
+    with transaction(obj.Document, found["title"]):
+        live.write(state)
+        if found["strokes"]:
+            obj.Strokes = obj.Strokes + int(found["strokes"])
+        stroke_log.keep(obj, stroke, found)
         obj.purgeTouched()
     live.document_changed()
     live.restore_into_session()  # (a running session takes it up, at rest, as after an Undo)

@@ -7,7 +7,7 @@ are echoed as scripting calls (so macros record them).
 """
 from ..app import sculpt_feature, sculpted_solid, thickness
 from ..runtime import session
-from .echo import echo_recorded_state
+from .echo import echo_stroke
 from .frame_clock import coin_frame_clock
 from .view_provider import SculptViewProvider, SolidViewProvider, ThicknessViewProvider
 
@@ -15,4 +15,4 @@ sculpt_feature.set_view_provider(SculptViewProvider)
 sculpted_solid.set_view_provider(SolidViewProvider)
 thickness.set_view_provider(ThicknessViewProvider)
 session.set_frame_clock(coin_frame_clock)
-session.set_commit_listener(echo_recorded_state)
+session.set_commit_listener(echo_stroke)

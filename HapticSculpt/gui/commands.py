@@ -126,20 +126,23 @@ class Thicken:
 
 
 class ExportStep:
-    """Export the selected sculpts and sculpted solids with FreeCAD's own export dialog (it asks
-    before overwriting)."""
+    """Export the selection, else the document's only sculpt or sculpted solid, to a STEP file
+    named in a task panel (FreeCAD's file chooser, STEP preselected)."""
 
     def GetResources(self) -> dict[str, str]:
         return {"Pixmap": icon("HapticSculpt"), "MenuText": "Export STEP",
-                "ToolTip": "Export the selected sculpt surfaces and sculpted solids (FreeCAD's export dialog: "
-                           "choose STEP and a file name)"}
+                "ToolTip": "Export the selected objects (else the document's only sculpt or sculpted solid) "
+                           "to a STEP file"}
 
     def IsActive(self) -> bool:
-        from ..app.sculpted_solid import is_sculpted_solid
-        return bool(_selected_sculpts()) or any(is_sculpted_solid(o) for o in Gui.Selection.getSelection())
+        from .export_panel import exportable
+        return bool(exportable(Gui.Selection.getSelection(), FreeCAD.ActiveDocument))
 
     def Activated(self) -> None:
-        Gui.runCommand("Std_Export")
+        from .export_panel import ExportStepPanel, exportable
+        objs = exportable(Gui.Selection.getSelection(), FreeCAD.ActiveDocument)
+        if objs and not Gui.Control.activeDialog():
+            Gui.Control.showDialog(ExportStepPanel(objs))
 
 
 def _ctl() -> Any:

@@ -22,11 +22,11 @@ def ref(obj: Any) -> str:
     return f"App.getDocument({obj.Document.Name!r}).getObject({obj.Name!r})"
 
 
-def echo_recorded_state(obj: Any, before: Any, title: str, strokes: int) -> None:
-    """Echoes a stroke, spray or session end that a threaded session committed as the
-    ``HapticSculpt.record_state`` call that gives the state it left: run here it changes nothing
-    (the object holds that state), and in a recorded macro it replays the stroke exactly."""
-    from ..app.recorded_state import pack
-    from ..app.sculpt_properties import read_state
-    packed = pack(before, read_state(obj))
-    run_echoed(f"HapticSculpt.record_state({ref(obj)}, {packed!r}, {title!r}, strokes={strokes})")
+def echo_stroke(obj: Any, before: Any, title: str, strokes: int) -> None:
+    """Keeps a stroke, spray or session end that a threaded session committed in the sculpt's
+    StrokeLog and echoes the one short ``HapticSculpt.replay_stroke`` line that names it: run here
+    it changes nothing (the object holds that state), and in a recorded macro it replays the stroke
+    exactly. Called inside the commit's transaction (see runtime.session.set_commit_listener)."""
+    from ..app import stroke_log
+    name = stroke_log.record(obj, before, title, strokes)
+    run_echoed(f"HapticSculpt.replay_stroke({ref(obj)}, {name!r})")

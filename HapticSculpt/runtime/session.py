@@ -35,16 +35,18 @@ FrameClock = Callable[[Callable[[], None]], Callable[[], None]]
 _frame_clocks: list[FrameClock] = []
 
 
-#: Called after each commit a session makes that no scripting call made (a stroke, a spray, the
-#: session's end) with the object, its state before, the undo step's title and the strokes it
-#: counts: the GUI layer installs one that echoes HapticSculpt.record_state, so a macro records it.
+#: Called inside the transaction of each commit a session makes that no scripting call made (a
+#: stroke, a spray, the session's end) with the object, its state before, the undo step's title and
+#: the strokes it counts: the GUI layer installs one that keeps the stroke in the sculpt and echoes
+#: HapticSculpt.replay_stroke, so a macro records it (and Undo forgets it with the stroke).
 CommitListener = Callable[[Any, sculpt_state.SculptState, str, int], None]
 _commit_listeners: list[CommitListener] = []
 
 
-def set_commit_listener(listener: CommitListener) -> None:
-    """Installs the listener told of every stroke, spray and session end a session commits."""
-    _commit_listeners[:] = [listener]
+def set_commit_listener(listener: CommitListener | None) -> None:
+    """Installs the listener told of every stroke, spray and session end a session commits (None:
+    none, as in console mode)."""
+    _commit_listeners[:] = [listener] if listener is not None else []
 
 
 def set_frame_clock(clock: FrameClock) -> None:
@@ -67,6 +69,7 @@ class Session:
         self._latest_poles: np.ndarray | None = None  # the newest pole snapshot the GUI received
         self._latest_maps: dict[str, np.ndarray] = {}  # the newest snapshot of each map sprayed this run
         self._next_edit = 1
+        self._committed = False
         self._edits: dict[int, tuple[str, sculpt_state.SculptState | None, int]] = {}  # posted, not yet applied
         #: each edit the simulation applied this run: its title, the simulation steps taken when it
         #: was posted and when it applied (it applies between two steps, so these differ by 0 to 2),
@@ -105,6 +108,7 @@ class Session:
         self._runtime, self._obj, self._device, self._error = runtime, obj, native, ""
         self._latest_poles, self._latest_maps, self._edits, self.applied_edits = None, {}, {}, []
         self._previewed = False
+        self._committed = False  # a stroke, spray or edit this run (else its end commits nothing)
         runtime.set_airbrush(**self._airbrush)
         runtime.start()
         _ACTIVE.add(self)
@@ -289,18 +293,22 @@ class Session:
                 live.write(_with_event(state, event))
                 if strokes:
                     obj.Strokes = obj.Strokes + strokes
+                    _tell_commit(obj, state, title, strokes)
                 obj.purgeTouched()
-            if strokes:
-                _tell_commit(obj, state, title, strokes)
+            self._committed = True
             n += strokes
         return n
 
     def _commit_final(self, obj: Any) -> None:
         """The state after the last stroke as its own transaction, if the surface moved on after it
-        (an elastic patch springing back, a swing settling). Round-off drift of a resting patch
-        (below a nanometre), and a clay patch's rest lengths relaxed at the start, are no edit: the
-        document keeps its state and the surface is reloaded."""
+        (an elastic patch springing back, a swing settling). A session without a stroke, spray or
+        edit changed nothing (whatever its constraints made the surface do meanwhile), and
+        round-off drift of a resting patch (below a nanometre), and a clay patch's rest lengths
+        relaxed at the start, are no edit: the document keeps its state and the surface is reloaded."""
         live = obj.Proxy.live
+        if not self._committed:
+            live.document_changed()
+            return
         current = sculpt_state.capture(live.surface)
         stored = read_state(obj)
         drift = float(np.max(np.abs(current.arrays["Poles"] - stored.arrays["Poles"]), initial=0.0))
@@ -311,8 +319,10 @@ class Session:
             live.document_changed()  # the stored state stays the truth
             return
         live.reset_shape()
-        live.commit("Sculpt session end")
-        _tell_commit(obj, stored, "Sculpt session end", 0)
+        with transaction(obj.Document, "Sculpt session end"):
+            live.write(current)
+            _tell_commit(obj, stored, "Sculpt session end", 0)
+            obj.purgeTouched()
 
     # --- GUI: shape at graphics rate, strokes as they end ----------------------------------------
     def _start_timer(self) -> None:
@@ -349,8 +359,14 @@ class Session:
 
 
 def _tell_commit(obj: Any, before: sculpt_state.SculptState, title: str, strokes: int) -> None:
+    """Tells the listeners, inside the commit's transaction; one that fails is reported and the
+    stroke is committed all the same (an echo must not cost the stroke)."""
     for listener in _commit_listeners:
-        listener(obj, before, title, strokes)
+        try:
+            listener(obj, before, title, strokes)
+        except Exception as exc:  # noqa: BLE001 - reported, not raised: see the docstring
+            import FreeCAD
+            FreeCAD.Console.PrintError(f"HapticSculpt: {title} committed, but not echoed: {exc}\n")
 
 
 def stop_all(commit: bool = True) -> None:

@@ -144,11 +144,32 @@ def _views():
     return out
 
 
+def _task_buttons():
+    """The visible buttons of the open task dialog (OK, Cancel, ...) by text, at their centres in
+    screen pixels; empty when there is none. (Walked from the main window: no Qt import in the project.)"""
+    if not Gui.Control.activeDialog():
+        return {}
+    found, stack = {}, [Gui.getMainWindow()]
+    while stack:
+        w = stack.pop()
+        name = w.metaObject().className()
+        if name == "Gui::TaskView::TaskView":
+            stack = [w]  # (only its buttons: the main window has others with the same texts)
+            found.clear()
+            w = stack.pop()
+        if name == "QPushButton" and w.isVisible() and w.text():
+            centre, ratio = w.mapToGlobal(w.rect().center()), w.devicePixelRatioF()  # (Qt's pixels to the screen's)
+            found[w.text().replace("&", "")] = [round(centre.x() * ratio), round(centre.y() * ratio)]
+        stack.extend(c for c in w.children() if c.isWidgetType())
+    return found
+
+
 def write(*_):
     state = {"version": [int(x) for x in FreeCAD.Version()[:2]],
              "workbench": Gui.activeWorkbench().name() if Gui.activeWorkbench() else "",
              "active": FreeCAD.ActiveDocument.Name if FreeCAD.ActiveDocument else None, "docs": {}, "views": _views(),
-             "task_dialog": bool(Gui.Control.activeDialog()), "tree": _tree_items()}
+             "task_dialog": bool(Gui.Control.activeDialog()), "tree": _tree_items(),
+             "task_buttons": _task_buttons()}
     for name, doc in FreeCAD.listDocuments().items():
         state["docs"][name] = {"undo": list(doc.UndoNames), "redo": list(doc.RedoNames), "file": doc.FileName,
                                "modified": bool(getattr(doc, "isTouched", lambda: False)()),

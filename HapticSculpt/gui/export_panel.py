@@ -1,0 +1,75 @@
+"""Export STEP's task panel (GUI only): what is exported and a STEP file name in FreeCAD's own file
+chooser (Gui::FileChooser in save mode, filtered to STEP), from a .ui file as FreeCAD's workbenches
+load theirs; OK writes the file through the echoed ``HapticSculpt.export_step`` call."""
+from __future__ import annotations
+
+import os
+import re
+from typing import Any
+
+import FreeCAD
+import FreeCADGui as Gui
+
+UI = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "resources", "ui", "ExportStep.ui")
+_OK, _CANCEL = 0x00000400, 0x00400000  # QDialogButtonBox's Ok and Cancel (no Qt import here)
+
+
+def exportable(selection: list[Any], doc: Any) -> list[Any]:
+    """What to export: the selected objects that have a shape (a sculpt, a sculpted solid, a
+    thickened solid, any part), else the document's only sculpt or sculpted solid (a SculptedSolid's
+    own hidden sculpt does not count); empty if there is no such choice."""
+    from ..app.sculpt_feature import is_sculpt
+    from ..app.sculpted_solid import is_sculpted_solid, solid_of
+
+    picked = [o for o in selection if hasattr(o, "Shape") and not o.Shape.isNull()]
+    if picked or doc is None:
+        return picked
+    found = [o for o in doc.Objects if is_sculpted_solid(o) or (is_sculpt(o) and solid_of(o) is None)]
+    return found if len(found) == 1 else []
+
+
+def default_path(objs: list[Any]) -> str:
+    """<the document's folder, else the home folder>/<the object's label, or the document's>.step."""
+    doc = objs[0].Document
+    folder = os.path.dirname(doc.FileName) if doc.FileName else os.path.expanduser("~")
+    label = objs[0].Label if len(objs) == 1 else doc.Label
+    return os.path.join(folder, (re.sub(r'[\\/:*?"<>|]+', "_", label).strip() or "sculpt") + ".step")
+
+
+def with_suffix(path: str) -> str:
+    """``path`` with .step added unless it ends in .step or .stp (as FreeCAD's save dialog does)."""
+    path = os.path.expanduser(path.strip())
+    return path if path.lower().endswith((".step", ".stp")) else path + ".step"
+
+
+class ExportStepPanel:
+    """The task panel: the objects named, the file chosen (prefilled), OK exports, Cancel closes."""
+
+    def __init__(self, objs: list[Any]) -> None:
+        self.objs = objs
+        self.form = Gui.PySideUic.loadUi(UI)
+        self.form.objects.setText("Export " + ", ".join(o.Label for o in objs))
+        self.form.file.setProperty("fileName", default_path(objs))
+
+    def path(self) -> str:
+        """The file name the chooser holds, with .step added if it has no STEP suffix."""
+        return with_suffix(str(self.form.file.property("fileName") or ""))
+
+    def getStandardButtons(self) -> int:
+        return _OK | _CANCEL
+
+    def accept(self) -> bool:
+        from .echo import ref, run_echoed
+        try:
+            run_echoed(f"HapticSculpt.export_step([{', '.join(ref(o) for o in self.objs)}], {self.path()!r})")
+        except Exception as exc:  # noqa: BLE001 - said in the report view; the panel stays open to fix the name
+            FreeCAD.Console.PrintError(f"HapticSculpt: Export STEP: {exc}\n")
+            return False
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: exported {', '.join(o.Label for o in self.objs)} to "
+                                     f"{self.path()}\n")
+        Gui.Control.closeDialog()
+        return True
+
+    def reject(self) -> bool:
+        Gui.Control.closeDialog()
+        return True

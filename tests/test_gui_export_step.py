@@ -1,0 +1,166 @@
+"""Export STEP as a designer uses it, with real X input (tests/test_gui_real_input.py's Desktop):
+with nothing selected it takes the document's only sculpt, its task panel offers
+<home>/<label>.step in FreeCAD's file chooser (its save dialog filtered to STEP), OK writes it
+through one echoed HapticSculpt.export_step call, and an independent reader (cadquery's OCP) reads
+the surface back."""
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+import pytest
+from freecad_support import GUI_AVAILABLE, run_freecad_gui, run_ocp
+from test_freecad_step_ocp import READ_STEP
+from test_gui_real_input import NEEDS, RECORD_BUTTON, Desktop, sculpt
+
+
+def start_macro(d: Desktop, name: str) -> None:
+    """Macro > Macro recording..., the name typed, Record clicked (real keys and clicks)."""
+    d.xdo("key", "alt+m")
+    d.xdo("key", "m")
+    d.wait_window("Macro recording")
+    d.xdo("key", "ctrl+a")
+    d.xdo("type", name)
+    d.xdo("mousemove", str(RECORD_BUTTON[0]), str(RECORD_BUTTON[1]), "click", "1")
+    d.xdo("mousemove", "640", "500", "click", "1")
+
+
+def stop_macro(d: Desktop, name: str) -> str:
+    """Macro > Stop macro recording; the macro's text once FreeCAD has written it."""
+    d.xdo("mousemove", "640", "500")
+    d.xdo("key", "alt+m")
+    d.xdo("key", "t")
+    path = os.path.join(d.home, name + ".FCMacro")
+    end, text = time.monotonic() + 30, ""
+    while "# Macro End" not in text and time.monotonic() < end:  # (written when the recording stops)
+        time.sleep(0.05)
+        text = open(path).read() if os.path.exists(path) else ""
+    return text
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_export_step_with_nothing_selected_writes_the_only_sculpt(tmp_path, monkeypatch):
+    home = tmp_path / "designer"
+    home.mkdir()
+    monkeypatch.setenv("HOME", str(home))  # (the panel offers the home folder for an unsaved document)
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        start_macro(d, "export")
+        d.xdo("key", "ctrl+n")
+        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
+        d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        d.xdo("mousemove", "1100", "900", "click", "1")  # an empty corner of the view: nothing selected
+        d.wait(lambda s: not sculpt(s)["selected"], "the selection to be cleared")
+        s = d.press_button("ExportStep", lambda s: "OK" in s["task_buttons"], "the Export STEP panel")
+        d.shot("export_step_panel")
+        # the chooser's button: FreeCAD's save dialog, STEP preselected; a name typed without suffix
+        choose = s["task_buttons"]["..."]
+        d.xdo("mousemove", str(choose[0]), str(choose[1]), "click", "1")
+        d.wait_window("Select a file")
+        d.shot("export_step_save_dialog")
+        d.xdo("key", "ctrl+a")
+        d.xdo("type", str(home / "renamed"))
+        d.xdo("key", "Return")
+        s = d.wait(lambda s: "OK" in s["task_buttons"] and len(s["task_buttons"]) == 3, "the panel back")
+        ok = s["task_buttons"]["OK"]
+        d.xdo("mousemove", str(ok[0]), str(ok[1]), "click", "1")
+        target = home / "renamed.step"
+        s = d.wait(lambda s: not s["task_buttons"] and target.exists(), "the panel to close and the STEP file")
+        d.shot("export_step_done")
+        poles = np.array(sculpt(s)["poles"]).reshape(8, 8, 3)
+        macro = stop_macro(d, "export")
+    finally:
+        d.close()
+    out = run_ocp(f"PATH = {str(target)!r}\nPARAMS = [[(0.5, 0.5)]]\n" + READ_STEP, str(tmp_path))
+    assert len(out) == 1 and out[0]["type"] == "Geom_BSplineSurface"
+    np.testing.assert_allclose(np.array(out[0]["poles"]), poles, atol=1e-9)
+    calls = [line for line in macro.splitlines() if line.startswith("HapticSculpt.export_step")]
+    assert calls == [f"HapticSculpt.export_step([App.getDocument('Unnamed').getObject('Sculpt')], {str(target)!r})"], macro
+
+
+PANEL_SCRIPT = """
+import json, os, traceback
+import FreeCAD, FreeCADGui as Gui
+import Part
+res = {}
+try:
+    Gui.activateWorkbench("HapticSculptWorkbench")
+    import HapticSculpt as hs
+    from HapticSculpt.gui import export_panel
+    from HapticSculpt.gui.workbench import controller
+    from HapticSculpt.app import stroke_log
+    command = Gui.Command.get("HapticSculpt_ExportStep")
+    doc = FreeCAD.newDocument("Parts")
+    box = doc.addObject("Part::Box", "Box")
+    doc.recompute()
+    solid = hs.sculpt_solid(doc, box, ["Face6"])
+    Gui.Selection.clearSelection()
+    Gui.updateGui()
+    res["only_solid"] = [o.Name for o in export_panel.exportable([], doc)]
+    res["active_solid"] = command.isActive()
+    patch = hs.make_sculpt(doc)
+    Gui.updateGui()
+    res["two"] = [o.Name for o in export_panel.exportable([], doc)]
+    res["active_two"] = command.isActive()
+    Gui.Selection.addSelection(patch)
+    Gui.updateGui()
+    res["selected"] = [o.Name for o in export_panel.exportable(Gui.Selection.getSelection(), doc)]
+    res["patch"] = patch.Name
+    res["active_selected"] = command.isActive()
+    Gui.Selection.clearSelection()
+    Gui.Selection.addSelection(box)  # (any part selected goes: a thickened sculpt is a plain Part feature)
+    res["part"] = [o.Name for o in export_panel.exportable(Gui.Selection.getSelection(), doc)]
+    Gui.Selection.clearSelection()
+    doc.saveAs(os.path.join(TMP, "parts.FCStd"))
+    panel = export_panel.ExportStepPanel([solid])
+    res["default"] = panel.path()
+    undo = list(doc.UndoNames)
+    panel.form.file.setProperty("fileName", os.path.join(TMP, "no such folder", "x.step"))
+    res["refused"] = panel.accept()
+    panel.form.file.setProperty("fileName", os.path.join(TMP, "part"))
+    res["accepted"] = panel.accept()
+    res["written"] = panel.path()
+    shape = Part.read(panel.path())
+    res["solids"] = len(shape.Solids)
+    res["volume"] = [shape.Volume, solid.Shape.Volume]
+    res["undo_same"] = list(doc.UndoNames) == undo
+    # A session that changes nothing, ended by switching workbench: no commit, nothing kept or echoed.
+    quiet = FreeCAD.newDocument("Quiet")
+    obj = hs.make_sculpt(quiet, material="elastic")
+    hs.add_constraint(obj, "curvature", uv=(0.5, 0.5))
+    Gui.Selection.addSelection(obj)
+    undo = list(quiet.UndoNames)
+    still = hs.ReplayDevice([0.0, 60.0], [[0, 0, 80], [0, 0, 80]], buttons=[0, 0])
+    controller().start_session(still)
+    import time
+    end = time.monotonic() + 1.0
+    while time.monotonic() < end:
+        Gui.updateGui()
+    res["running"] = obj.Proxy.live.session is not None
+    Gui.activateWorkbench("PartWorkbench")
+    Gui.updateGui()
+    res["stopped"] = obj.Proxy.live.session is None or not obj.Proxy.live.session.running
+    res["quiet_undo_same"] = list(quiet.UndoNames) == undo
+    res["quiet_log"] = stroke_log.records(obj)
+except Exception:
+    res["error"] = traceback.format_exc()
+json.dump(res, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and FreeCAD")
+def test_export_step_chooses_the_only_sculpted_solid_and_refuses_a_bad_file_name(tmp_path):
+    out = run_freecad_gui(f"TMP = {str(tmp_path)!r}\n" + PANEL_SCRIPT, str(tmp_path))
+    assert out["only_solid"] == ["SculptedSolid"] and out["active_solid"]  # (not its own hidden sculpt)
+    assert out["two"] == [] and not out["active_two"]  # two candidates and none selected: which one?
+    assert out["selected"] == [out["patch"]] and out["active_selected"]
+    assert out["part"] == ["Box"]
+    assert out["default"] == str(tmp_path / "SculptedSolid.step")  # (the saved document's folder, its label)
+    assert out["refused"] is False  # (said in the report view; the panel stays open)
+    assert out["accepted"] is True and out["written"] == str(tmp_path / "part.step")
+    assert out["solids"] == 1 and out["volume"][0] == pytest.approx(out["volume"][1], rel=1e-6)
+    assert out["undo_same"]  # exporting is no edit
+    assert out["running"] and out["stopped"]
+    assert out["quiet_undo_same"] and out["quiet_log"] == {}
