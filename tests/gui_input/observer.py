@@ -117,7 +117,9 @@ def write(*_):
         state["inputs"] = len(ctl.inputs)
         state["mouse_point"] = None if ctl.mouse_point is None else [float(x) for x in ctl.mouse_point]
         state["overlays"] = [{"display": ov.display, "frames": ov.frames, "view_size": list(ov.view.getSize()),
-                              "hud": ov.hud.boxes() if ov.hud is not None else {}}
+                              "hud": ov.hud.boxes() if ov.hud is not None else {},
+                              "sliders": ov.panel.values(ov.obj) if ov.panel_visible else [],
+                              "stripes": ov.stripes, "active_view": ov.view is getattr(Gui.ActiveDocument, "ActiveView", None)}
                              for ov in ctl.overlays.values()]
     except Exception as exc:  # noqa: BLE001 - the workbench not loaded yet
         state["controller_error"] = str(exc)
