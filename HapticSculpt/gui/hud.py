@@ -18,7 +18,8 @@ import numpy as np
 
 from ..app import analysis
 
-FONT_SIZE = 16.0  # points: each text line is about this many pixels high
+FONT_SIZE = 16.0  # points: a text line is about this many pixels high from baseline to cap
+CHAR_WIDTH = 0.7 * FONT_SIZE  # pixels a character, a little over what the view's font takes (10.7 measured)
 CUBE_CORNER = 170  # pixels kept free in the top-right corner (FreeCAD's navigation cube)
 MARGIN = 12
 BAR_WIDTH = 18
@@ -91,12 +92,16 @@ class Hud:
         self.camera.aspectRatio = w / max(h, 1)
         self.content.removeAllChildren()
         self._boxes = {}
+        lines = _wrap(status, int((w - 2 * MARGIN - 2 * PAD) // CHAR_WIDTH)) if status else []
+        floor = MARGIN + len(lines) * LINE + 2 * PAD + 8  # the legend stays above the status lines
         if legend is not None:
-            self._group("legend", lambda: self._legend(w, h, *legend, zebra_bands), w, h)
+            self._group("legend", lambda: self._legend(w, h, *legend, zebra_bands, floor), w, h)
         if sliders:
             self._group("sliders", lambda: self._sliders(w, h, sliders), w, h)
-        if status:
-            self._group("status", lambda: self._text(status, MARGIN + PAD, MARGIN + PAD, TEXT, "status", w), w, h)
+        if lines:
+            self._group("status", lambda: [self._text(line, MARGIN + PAD, MARGIN + PAD + (len(lines) - 1 - k) * LINE,
+                                                      TEXT, "status" if k == 0 else f"status{k + 1}", w)
+                                           for k, line in enumerate(lines)], w, h)
 
     def _sliders(self, w: int, h: int, sliders: list[tuple[str, float, bool, float]]) -> None:
         """Each slider: its number, label and value, and under them its track with the knob."""
@@ -147,18 +152,18 @@ class Hud:
         return sep
 
     # --- items --------------------------------------------------------------------------------------
-    def _legend(self, w: int, h: int, display: str, rng: tuple[float, float], zebra_bands: int) -> None:
+    def _legend(self, w: int, h: int, display: str, rng: tuple[float, float], zebra_bands: int, floor: float) -> None:
         """Colour bar(s) on the right edge below the cube's corner, range to their left, name above;
         zebra: ``zebra_bands`` black and white bands, one per stripe the display shows."""
         titles = 2 if display == "curvature" else 1  # text rows above the bar
         head = titles * (FONT_SIZE + 4) + 8
         x1 = w - MARGIN - PAD
         top = h - CUBE_CORNER - head
-        bottom = max(MARGIN + LINE + 2 * PAD + 8, top - 0.45 * h)
+        bottom = max(floor, top - 0.45 * h)
         if top - bottom < 60:  # a low view: no room below the cube's corner, so beside it, full height
             x1 = w - CUBE_CORNER - MARGIN
             top = h - MARGIN - PAD - head
-            bottom = max(MARGIN + LINE + 2 * PAD + 8, top - 0.6 * h)
+            bottom = max(floor, top - 0.6 * h)
         t = np.linspace(0.0, 1.0, 33)
         if display == "curvature":  # two bars: u in green, v in blue, each from 0 to the top value
             bars = [("u", np.outer(t, U_COLOUR), U_LABEL), ("v", np.outer(t, V_COLOUR), V_LABEL)]
@@ -204,9 +209,9 @@ class Hud:
 
     def _text(self, text: str, x: float, y: float, colour: Any, name: str, w: int, right: bool = False) -> None:
         """One line with its baseline at y, starting at x (ending at x if ``right``); its box is an
-        estimate from the font size (0.6 em a character)."""
+        estimate from the font size (CHAR_WIDTH)."""
         from pivy import coin
-        width = 0.6 * FONT_SIZE * len(text)
+        width = CHAR_WIDTH * len(text)
         if not right:
             x = min(x, w - MARGIN - width)  # (a long status line stays inside a narrow view)
         sep = coin.SoSeparator()
@@ -224,3 +229,14 @@ class Hud:
         self.content.addChild(sep)
         x0 = x - width if right else x
         self._boxes[name] = (float(x0), float(y), float(x0 + width), float(y + FONT_SIZE))
+
+
+def _wrap(text: str, width: int) -> list[str]:
+    """The status line in lines of at most ``width`` characters, broken between its parts."""
+    lines: list[str] = []
+    for part in text.split("  |  "):
+        if lines and len(lines[-1]) + 5 + len(part) <= width:
+            lines[-1] += "  |  " + part
+        else:
+            lines.append(part)
+    return lines

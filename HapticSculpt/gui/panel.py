@@ -19,6 +19,7 @@ SLIDERS = (("mass", "mass", 1e-2, 1e2), ("damping", "damping", 1e-2, 1e3), ("sti
            ("curvature_u", "curvature u (1/mm)", 1e-4, 1e-1), ("curvature_v", "curvature v (1/mm)", 1e-4, 1e-1))
 
 Box = tuple[float, float, float, float]  # x0, y0, x1, y1 in view pixels, origin bottom-left
+REACH = 8  # pixels beyond a track's ends that still take it (a knob at an end sticks out by half)
 
 
 class SliderPanel:
@@ -67,7 +68,8 @@ class SliderPanel:
     @staticmethod
     def track_at(x: float, y: float, tracks: dict[str, Box]) -> str | None:
         """The slider whose track (``tracks``: name -> its box, from the HUD) is under pixel (x, y)."""
-        return next((name for name, (x0, y0, x1, y1) in tracks.items() if x0 <= x <= x1 and y0 <= y <= y1), None)
+        return next((name for name, (x0, y0, x1, y1) in tracks.items()
+                     if x0 - REACH <= x <= x1 + REACH and y0 <= y <= y1), None)
 
     def press(self, x: float, y: float, tracks: dict[str, Box]) -> bool:
         """Button down at (x, y): takes the slider there, if any (True)."""

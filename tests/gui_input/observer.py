@@ -85,6 +85,19 @@ def _on_screen(o):
         return []
 
 
+_pixels = {}  # id(view) -> [the mouse's last position in its viewport pixels, as Coin's events give it]
+
+
+def _pixel(v):
+    """Where the view's own events put the mouse (the HUD's pixels; getCursorPos is off by tens of
+    pixels in x there under FreeCAD 0.20)."""
+    if id(v) not in _pixels:
+        _pixels[id(v)] = [None, v.addEventCallbackPivy(
+            coin.SoLocation2Event.getClassTypeId(),
+            lambda cb, key=id(v): _pixels[key].__setitem__(0, list(cb.getEvent().getPosition())))]
+    return _pixels[id(v)][0]
+
+
 def _views():
     out = []
     for name in FreeCAD.listDocuments():
@@ -92,6 +105,7 @@ def _views():
         for v in gdoc.mdiViewsOfType("Gui::View3DInventor") if gdoc else []:
             try:
                 out.append({"doc": name, "size": list(v.getSize()), "cursor": list(v.getCursorPos()),
+                            "pixel": _pixel(v),
                             "camera": v.getCamera(),
                             "active": v is getattr(Gui.ActiveDocument, "ActiveView", None),
                             "redirect": bool(v.getViewer().isRedirectedToSceneGraph())})
