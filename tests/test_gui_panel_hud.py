@@ -33,8 +33,8 @@ def set_view(d: Desktop, name: str) -> None:
 
 
 def calibrate(d: Desktop) -> None:
-    """Desktop.calibrate on the pixels the view's events give (the HUD's; getCursorPos is off by
-    tens of pixels in x under FreeCAD 0.20), waiting for a state written after each move (the
+    """Desktop.calibrate on the pixels the view's events give (the HUD's; FreeCAD 0.20's getCursorPos
+    differed from them by 4 % and more), waiting for a state written after each move (the
     overlay's frame count is the clock), checked on a third point."""
     def cursor_at(x: int, y: int) -> list[float]:
         d.xdo("mousemove", str(x), str(y))

@@ -89,8 +89,8 @@ _pixels = {}  # id(view) -> [the mouse's last position in its viewport pixels, a
 
 
 def _pixel(v):
-    """Where the view's own events put the mouse (the HUD's pixels; getCursorPos is off by tens of
-    pixels in x there under FreeCAD 0.20)."""
+    """Where the view's own events put the mouse (the HUD's pixels; FreeCAD 0.20's getCursorPos
+    differed from them by 4 % and more: a calibration on it put drags beside the sliders)."""
     if id(v) not in _pixels:
         _pixels[id(v)] = [None, v.addEventCallbackPivy(
             coin.SoLocation2Event.getClassTypeId(),
