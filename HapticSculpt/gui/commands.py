@@ -428,7 +428,7 @@ class ZebraDirection(_SculptCommand):
 
 class Panel(_SculptCommand):
     icon_name, menu = "Panel", "Slider panel"
-    tip = "Toggle the 3D slider panel (mass, damping, stiffness, curvature targets), operated with the cursor"
+    tip = "Toggle the slider panel (mass, damping, stiffness, curvature targets) in the view's corner: drag a knob"
 
     def Activated(self) -> None:
         ov = _ctl().overlay()

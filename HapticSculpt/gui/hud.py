@@ -1,11 +1,14 @@
-"""The overlay's screen-space layer (GUI only): legends, the slider panel's labels and values, the
-active tool and mode, drawn in view pixels by a scene of its own with an orthographic camera,
-superimposed on the 3D view as FreeCAD's navigation cube is. So it stays inside the view at every
-zoom and window size, keeps its size on screen, and Fit All does not see it. No Qt: pivy only.
+"""The overlay's screen-space layer (GUI only): legends, the slider panel (labels, values, tracks
+and knobs), the active tool and mode, drawn in view pixels by a scene of its own with an
+orthographic camera, superimposed on the 3D view as FreeCAD's navigation cube is (after the scene,
+its depth buffer cleared: nothing in 3D draws over it). So it stays inside the view at every zoom
+and window size, keeps its size on screen, and Fit All does not see it. No Qt: pivy only.
 
 Layout (pixels, origin bottom-left): the display's legend on the right edge below the navigation
-cube's corner, the slider values in the top-left corner, the tool and mode in the bottom-left.
-:meth:`Hud.boxes` gives where each item went, for tests and for anything placed beside it.
+cube's corner, the sliders in the top-left corner (each a text line over its track, one under
+another), the tool and mode in the bottom-left. Each group stands on a semi-opaque dark backing,
+so its white text reads on any background (white zebra stripes too).
+:meth:`Hud.boxes` gives where each item went: the panel grabs its tracks there, tests check them.
 """
 from __future__ import annotations
 
@@ -15,7 +18,8 @@ import numpy as np
 
 from ..app import analysis
 
-FONT_SIZE = 16.0  # points: each text line is about this many pixels high
+FONT_SIZE = 16.0  # points: a text line is about this many pixels high from baseline to cap
+CHAR_WIDTH = 0.7 * FONT_SIZE  # pixels a character, a little over what the view's font takes (10.7 measured)
 CUBE_CORNER = 170  # pixels kept free in the top-right corner (FreeCAD's navigation cube)
 MARGIN = 12
 BAR_WIDTH = 18
@@ -25,6 +29,14 @@ HELD = (1.0, 0.6, 0.0)
 U_COLOUR, V_COLOUR = (0.0, 0.85, 0.0), (0.15, 0.35, 1.0)  # the paper's u green, v blue
 U_LABEL, V_LABEL = (0.4, 1.0, 0.4), (0.55, 0.7, 1.0)  # the same, light enough to read on any background
 UNITS = {"curvature": " 1/mm", "mean": " 1/mm", "gauss": " 1/mm^2"}
+LINE = FONT_SIZE + 4  # a text line's height
+TRACK_ROW = 18  # a slider's track row under its text line
+TRACK_WIDTH = 220
+KNOB = (10, 14)  # a knob's width and height
+TRACK_COLOUR, KNOB_COLOUR = (0.6, 0.6, 0.6), (0.3, 0.8, 1.0)
+PAD = 6  # a backing's margin around what it backs
+BACKING, BACKING_ALPHA = (0.08, 0.08, 0.1), 0.75  # dark, and opaque enough for white text on white
+BACK_Z, FRONT_Z = -0.5, 0.0  # backings behind the items they back (the camera looks down -z from z = 1)
 
 
 class Hud:
@@ -43,6 +55,9 @@ class Hud:
         light = coin.SoLightModel()
         light.model = coin.SoLightModel.BASE_COLOR
         self.root.addChild(light)
+        blend = coin.SoTransparencyType()  # backings blend in drawing order, before what they back
+        blend.value = coin.SoTransparencyType.BLEND
+        self.root.addChild(blend)
         font = coin.SoFont()
         font.size = FONT_SIZE
         self.root.addChild(font)
@@ -66,42 +81,95 @@ class Hud:
         self.content.removeAllChildren()
         self._boxes = {}
 
-    def update(self, legend: tuple[str, tuple[float, float]] | None, sliders: list[tuple[str, float, bool]],
-               status: str) -> None:
+    def update(self, legend: tuple[str, tuple[float, float]] | None, sliders: list[tuple[str, float, bool, float]],
+               status: str, zebra_bands: int = 12) -> None:
         """Redraws the layer: ``legend`` = (display, (lo, hi)) or None; ``sliders`` = (label, value,
-        held) per slider in track order, shown while the panel is; ``status`` = the tool and mode."""
+        held, knob position 0..1) per slider, shown while the panel is; ``status`` = the tool and
+        mode; ``zebra_bands``: the black and white bands the zebra legend shows (the stripe count)."""
         w, h = (int(x) for x in self.view.getSize())
         self.camera.position = (w / 2.0, h / 2.0, 1.0)
         self.camera.height = float(h)
         self.camera.aspectRatio = w / max(h, 1)
         self.content.removeAllChildren()
         self._boxes = {}
+        lines = _wrap(status, int((w - 2 * MARGIN - 2 * PAD) // CHAR_WIDTH)) if status else []
+        floor = MARGIN + len(lines) * LINE + 2 * PAD + 8  # the legend stays above the status lines
         if legend is not None:
-            self._legend(w, h, *legend)
-        line = FONT_SIZE + 4
-        for k, (label, value, held) in enumerate(sliders):
-            self._text(f"{k + 1}  {label} {value:.3g}", MARGIN, h - MARGIN - line * (k + 1), HELD if held else TEXT,
-                       f"slider{k + 1}", w)
-        if status:
-            self._text(status, MARGIN, MARGIN, TEXT, "status", w)
+            self._group("legend", lambda: self._legend(w, h, *legend, zebra_bands, floor), w, h)
+        if sliders:
+            self._group("sliders", lambda: self._sliders(w, h, sliders), w, h)
+        if lines:
+            self._group("status", lambda: [self._text(line, MARGIN + PAD, MARGIN + PAD + (len(lines) - 1 - k) * LINE,
+                                                      TEXT, "status" if k == 0 else f"status{k + 1}", w)
+                                           for k, line in enumerate(lines)], w, h)
+
+    def _sliders(self, w: int, h: int, sliders: list[tuple[str, float, bool, float]]) -> None:
+        """Each slider: its number, label and value, and under them its track with the knob."""
+        x0 = MARGIN + PAD
+        top = h - MARGIN - PAD
+        for k, (label, value, held, f) in enumerate(sliders):
+            row = top - k * (LINE + TRACK_ROW)
+            self._text(f"{k + 1}  {label} {value:.3g}", x0, row - FONT_SIZE, HELD if held else TEXT, f"slider{k + 1}", w)
+            yc = row - LINE - TRACK_ROW / 2
+            self._quad(x0, yc - 1.5, x0 + TRACK_WIDTH, yc + 1.5, TRACK_COLOUR)
+            kx = x0 + f * TRACK_WIDTH
+            self._quad(kx - KNOB[0] / 2, yc - KNOB[1] / 2, kx + KNOB[0] / 2, yc + KNOB[1] / 2, HELD if held else KNOB_COLOUR)
+            self._boxes[f"track{k + 1}"] = (float(x0), float(yc - KNOB[1] / 2), float(x0 + TRACK_WIDTH),
+                                            float(yc + KNOB[1] / 2))
+
+    def _group(self, name: str, draw: Any, w: int, h: int) -> None:
+        """Draws a group of items, then its backing behind them: their bounding box and a margin,
+        first in the scene (drawn first, further back), kept inside the view."""
+        before = set(self._boxes)
+        at = self.content.getNumChildren()
+        draw()
+        items = [b for k, b in self._boxes.items() if k not in before]
+        if not items:
+            return
+        box = np.array(items)
+        x0, y0 = max(box[:, 0].min() - PAD, 0.0), max(box[:, 1].min() - PAD, 0.0)
+        x1, y1 = min(box[:, 2].max() + PAD, float(w)), min(box[:, 3].max() + PAD, float(h))
+        self.content.insertChild(self._quad_node(x0, y0, x1, y1, BACKING, BACK_Z, 1.0 - BACKING_ALPHA), at)
+        self._boxes[f"back_{name}"] = (float(x0), float(y0), float(x1), float(y1))
+
+    def _quad(self, x0: float, y0: float, x1: float, y1: float, colour: Any) -> None:
+        self.content.addChild(self._quad_node(x0, y0, x1, y1, colour, FRONT_Z, 0.0))
+
+    @staticmethod
+    def _quad_node(x0: float, y0: float, x1: float, y1: float, colour: Any, z: float, transparency: float) -> Any:
+        from pivy import coin
+        sep = coin.SoSeparator()
+        mat = coin.SoMaterial()
+        mat.diffuseColor = tuple(float(c) for c in colour)
+        mat.transparency = float(transparency)
+        sep.addChild(mat)
+        coords = coin.SoCoordinate3()
+        coords.point.setValues(0, 4, [[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]])
+        sep.addChild(coords)
+        faces = coin.SoFaceSet()
+        faces.numVertices.setValue(4)
+        sep.addChild(faces)
+        return sep
 
     # --- items --------------------------------------------------------------------------------------
-    def _legend(self, w: int, h: int, display: str, rng: tuple[float, float]) -> None:
-        """Colour bar(s) on the right edge below the cube's corner, range to their left, name above."""
+    def _legend(self, w: int, h: int, display: str, rng: tuple[float, float], zebra_bands: int, floor: float) -> None:
+        """Colour bar(s) on the right edge below the cube's corner, range to their left, name above;
+        zebra: ``zebra_bands`` black and white bands, one per stripe the display shows."""
         titles = 2 if display == "curvature" else 1  # text rows above the bar
         head = titles * (FONT_SIZE + 4) + 8
-        x1 = w - MARGIN
+        x1 = w - MARGIN - PAD
         top = h - CUBE_CORNER - head
-        bottom = max(MARGIN + FONT_SIZE + 8, top - 0.45 * h)
+        bottom = max(floor, top - 0.45 * h)
         if top - bottom < 60:  # a low view: no room below the cube's corner, so beside it, full height
             x1 = w - CUBE_CORNER - MARGIN
-            top = h - MARGIN - head
-            bottom = max(MARGIN + FONT_SIZE + 8, top - 0.6 * h)
+            top = h - MARGIN - PAD - head
+            bottom = max(floor, top - 0.6 * h)
         t = np.linspace(0.0, 1.0, 33)
         if display == "curvature":  # two bars: u in green, v in blue, each from 0 to the top value
             bars = [("u", np.outer(t, U_COLOUR), U_LABEL), ("v", np.outer(t, V_COLOUR), V_LABEL)]
         elif display == "zebra":
-            bars = [("", np.repeat((np.floor(t * 8) % 2)[:, None], 3, axis=1), TEXT)]
+            bands = np.arange(int(zebra_bands) + 1) % 2  # (one more: _bar draws n - 1 quads for n colours)
+            bars = [("", np.repeat(bands[:, None].astype(float), 3, axis=1), TEXT)]
         else:
             bars = [("", analysis.pseudo_colour(t, 0.0, 1.0)[0], TEXT)]
         x0 = x1 - len(bars) * BAR_WIDTH - (len(bars) - 1) * 6
@@ -114,8 +182,8 @@ class Hud:
         if display != "zebra":
             self._text(f"{rng[1]:.3g}{units}", x0 - 6, top - FONT_SIZE, TEXT, "legend_hi", w, right=True)
             self._text(f"{rng[0]:.3g}{units}", x0 - 6, bottom, TEXT, "legend_lo", w, right=True)
-        title = {"curvature": "curvature u / v", "mean": "mean curvature", "gauss": "Gaussian curvature"}.get(display,
-                                                                                                          display)
+        title = {"curvature": "curvature u / v", "mean": "mean curvature", "gauss": "Gaussian curvature",
+                 "zebra": f"zebra: {int(zebra_bands)} stripes"}.get(display, display)
         self._text(title, x1, top + 6 + (titles - 1) * (FONT_SIZE + 4), TEXT, "legend_title", w, right=True)
         self._boxes["legend_bar"] = (float(x0), float(bottom), float(x1), float(top))
 
@@ -141,9 +209,9 @@ class Hud:
 
     def _text(self, text: str, x: float, y: float, colour: Any, name: str, w: int, right: bool = False) -> None:
         """One line with its baseline at y, starting at x (ending at x if ``right``); its box is an
-        estimate from the font size (0.6 em a character)."""
+        estimate from the font size (CHAR_WIDTH)."""
         from pivy import coin
-        width = 0.6 * FONT_SIZE * len(text)
+        width = CHAR_WIDTH * len(text)
         if not right:
             x = min(x, w - MARGIN - width)  # (a long status line stays inside a narrow view)
         sep = coin.SoSeparator()
@@ -161,3 +229,14 @@ class Hud:
         self.content.addChild(sep)
         x0 = x - width if right else x
         self._boxes[name] = (float(x0), float(y), float(x0 + width), float(y + FONT_SIZE))
+
+
+def _wrap(text: str, width: int) -> list[str]:
+    """The status line in lines of at most ``width`` characters, broken between its parts."""
+    lines: list[str] = []
+    for part in text.split("  |  "):
+        if lines and len(lines[-1]) + 5 + len(part) <= width:
+            lines[-1] += "  |  " + part
+        else:
+            lines.append(part)
+    return lines

@@ -1,16 +1,19 @@
 """The mouse as a session's device: the 3D cursor follows the pointer in FreeCAD's 3D views."""
 from __future__ import annotations
 
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 from ..core import native as _core
 
 
 class MouseDevice:
     """The 3D cursor follows the mouse in a FreeCAD 3D view: onto the surface under the pointer, or
-    onto the view's focal plane elsewhere; the left button grabs. Only usable with the GUI up."""
+    onto the view's focal plane elsewhere; the left button grabs. Only usable with the GUI up.
+    ``yields(view, pixel)``: True where a press belongs to something else (the slider panel): the
+    device neither grabs nor takes that press, nor its release."""
 
-    def __init__(self, name: str = "mouse") -> None:
+    def __init__(self, name: str = "mouse", yields: Callable[[Any, tuple[int, int]], bool] | None = None) -> None:
+        self.yields = yields
         self.native = _core.ExternalDevice(name)
         self._callbacks: list[Any] = []
         self._buttons = 0
@@ -66,6 +69,9 @@ class MouseDevice:
         event = cb.getEvent()
         if event.getButton() == coin.SoMouseButtonEvent.BUTTON1:
             pos = event.getPosition()
+            down = event.getState() == coin.SoButtonEvent.DOWN
+            if (down and self.yields is not None and self.yields(view, (pos[0], pos[1]))) or (not down and not self._buttons):
+                return
             self.move_to(view, (pos[0], pos[1]))
-            self.press(event.getState() == coin.SoButtonEvent.DOWN)
+            self.press(down)
             cb.setHandled()

@@ -5,8 +5,8 @@ is on) the overlay throws its previous scene away and draws a new one from the c
 surface coloured by the active display (shading, a material map, curvature in the paper's green/blue
 channels, mean or Gaussian curvature, zebra stripes), curvature combs, the constraint jacks (point:
 red cross, normal: blue line, curvature: white circle), the cursor with its axes, the nearest surface
-point with its axes, the rope and the slider panel's tracks; its screen-space layer (:mod:`hud`)
-shows the legend of the display's range, the sliders' values, the tool and the mode. Nothing is
+point with its axes and the rope; its screen-space layer (:mod:`hud`) shows the legend of the
+display's range, the slider panel (operated with the mouse there), the tool and the mode. Nothing is
 retained between frames but the Coin roots it draws into; nothing is computed for a display that is
 off. No Qt: everything is pivy.
 """
@@ -22,7 +22,7 @@ from ..app import analysis
 from . import coin_shapes as shapes
 from . import stripes as stripe_shading
 from .hud import Hud
-from .panel import SliderPanel
+from .panel import SLIDERS, SliderPanel
 
 DISPLAYS = ("shading", "mass", "damping", "stiffness", "curvature", "mean", "gauss", "zebra")
 JACK_COLOURS = {"point": (1.0, 0.0, 0.0), "tangent": (1.0, 0.5, 0.0), "normal": (0.0, 0.3, 1.0), "curvature": (1.0, 1.0, 1.0)}
@@ -158,20 +158,45 @@ class Overlay:
         decor.addChild(self._jacks(s, mesh))
         if self.cursor is not None:
             decor.addChild(self._cursor(s, mesh))
-        if self.panel_visible:
-            grab = self.cursor[2] if self.cursor is not None else False
-            if self.cursor is not None:
-                self.panel.operate(self.cursor[0], grab, self.obj)
-            decor.addChild(self.panel.draw(self.obj, mesh))
         scene.addChild(decor)
         self._root.removeAllChildren()
         self._root.addChild(scene)
         if self.hud is None:
             self.hud = Hud(self.view)
         sliders = self.panel.values(self.obj) if self.panel_visible else []
-        self.hud.update(legend, sliders, self._status(s))
+        self.hud.update(legend, sliders, self._status(s), zebra_bands=int(self.stripes))
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
+
+    # --- the slider panel, operated with the mouse in view pixels -------------------------------------
+    def tracks(self) -> dict[str, tuple[float, float, float, float]]:
+        """Each shown slider's track in view pixels (where the HUD drew it last): name -> box."""
+        if not self.panel_visible or self.hud is None:
+            return {}
+        boxes = self.hud.boxes()
+        return {name: boxes[f"track{k + 1}"] for k, (name, _, _, _) in enumerate(SLIDERS) if f"track{k + 1}" in boxes}
+
+    def panel_press(self, x: float, y: float) -> bool:
+        """Button down at view pixel (x, y): True if it took a slider (shown at once)."""
+        if not self.panel.press(x, y, self.tracks()):
+            return False
+        self.frame()
+        return True
+
+    def panel_drag(self, x: float) -> bool:
+        """The mouse moved to view pixel column x: True if a slider is held (it followed)."""
+        if self.panel.held is None:
+            return False
+        self.panel.drag(x)
+        self.frame()
+        return True
+
+    def panel_release(self) -> bool:
+        """Button up: True if a slider was held (its value is now one undo step)."""
+        if not self.panel.release(self.obj):
+            return False
+        self.frame()
+        return True
 
     def _stripes(self, s: core.DynamicSurface) -> Any:
         """Zebra stripes per pixel on the exact surface (sampled again only when the poles moved)."""
@@ -220,7 +245,7 @@ class Overlay:
             return analysis.map_colours(self.obj.Proxy.live.map_values(self.display), (g, h))
         if self.display == "zebra":
             d = self.view.getViewDirection()
-            return analysis.zebra_colours(mesh, np.array([d[0], d[1], d[2]]))
+            return analysis.zebra_colours(mesh, np.array([d[0], d[1], d[2]]), self.stripes)
         curv = s.curvature_grid().reshape(g, h, 6)
         if self.display == "curvature":
             return analysis.curvature_channels(curv)

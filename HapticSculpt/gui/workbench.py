@@ -209,6 +209,9 @@ class Controller:
 
     def on_move(self, view: Any, cb: Any) -> None:
         pos = cb.getEvent().getPosition()
+        if any(ov.panel_drag(float(pos[0])) for ov in self.overlays.values()):
+            cb.setHandled()  # a slider drag: neither a stroke nor a rotation
+            return
         self.mouse_view = view
         self.mouse_point = self.point_at(view, int(pos[0]), int(pos[1]))
         if self._paint_stroke is not None:
@@ -223,6 +226,9 @@ class Controller:
         event = cb.getEvent()
         if event.getButton() != coin.SoMouseButtonEvent.BUTTON1:
             return
+        if self._panel_button(view, event):
+            cb.setHandled()
+            return
         if self.mouse is not None:
             return  # the left button belongs to the session's mouse device (it follows every view)
         if self.painting is None:
@@ -235,6 +241,20 @@ class Controller:
         else:
             self.end_paint_stroke()
         cb.setHandled()
+
+    def panel_at(self, view: Any, pixel: tuple[int, int]) -> bool:
+        """True if a slider of a panel shown in ``view`` is under ``pixel`` (the mouse device leaves
+        a press there to the panel: it is not a stroke)."""
+        return any(ov.panel.track_at(pixel[0], pixel[1], ov.tracks()) is not None
+                   for (vid, _), ov in self.overlays.items() if vid == id(view))
+
+    def _panel_button(self, view: Any, event: Any) -> bool:
+        """Button 1 on a slider panel: a press on a track takes it, the release commits the held one."""
+        from pivy import coin
+        x, y = (float(c) for c in event.getPosition())
+        if event.getState() == coin.SoButtonEvent.DOWN:
+            return any(ov.panel_press(x, y) for (vid, _), ov in self.overlays.items() if vid == id(view))
+        return any([ov.panel_release() for ov in self.overlays.values()])
 
     def on_key(self, view: Any, cb: Any) -> None:
         from pivy import coin
@@ -384,7 +404,7 @@ class Controller:
         if device is None:
             device = self._attached_device(obj, devices)
         if device is None:
-            device = MouseDevice()
+            device = MouseDevice(yields=self.panel_at)
             device.attach_all([i.view for i in self.inputs] or [self.view()])
         self.mouse = device if isinstance(device, MouseDevice) else None
         session = Session()

@@ -129,6 +129,19 @@ def _on_screen(o):
         return []
 
 
+_pixels = {}  # id(view) -> [the mouse's last position in its viewport pixels, as Coin's events give it]
+
+
+def _pixel(v):
+    """Where the view's own events put the mouse (the HUD's pixels; FreeCAD 0.20's getCursorPos
+    differed from them by 4 % and more: a calibration on it put drags beside the sliders)."""
+    if id(v) not in _pixels:
+        _pixels[id(v)] = [None, v.addEventCallbackPivy(
+            coin.SoLocation2Event.getClassTypeId(),
+            lambda cb, key=id(v): _pixels[key].__setitem__(0, list(cb.getEvent().getPosition())))]
+    return _pixels[id(v)][0]
+
+
 def _views():
     out = []
     for name in FreeCAD.listDocuments():
@@ -136,6 +149,7 @@ def _views():
         for v in gdoc.mdiViewsOfType("Gui::View3DInventor") if gdoc else []:
             try:
                 out.append({"doc": name, "size": list(v.getSize()), "cursor": list(v.getCursorPos()),
+                            "pixel": _pixel(v),
                             "camera": v.getCamera(),
                             "active": v is getattr(Gui.ActiveDocument, "ActiveView", None),
                             "redirect": bool(v.getViewer().isRedirectedToSceneGraph())})
@@ -183,7 +197,9 @@ def write(*_):
         state["inputs"] = len(ctl.inputs)
         state["mouse_point"] = None if ctl.mouse_point is None else [float(x) for x in ctl.mouse_point]
         state["overlays"] = [{"display": ov.display, "frames": ov.frames, "view_size": list(ov.view.getSize()),
-                              "hud": ov.hud.boxes() if ov.hud is not None else {}}
+                              "hud": ov.hud.boxes() if ov.hud is not None else {},
+                              "sliders": ov.panel.values(ov.obj) if ov.panel_visible else [],
+                              "stripes": ov.stripes, "active_view": ov.view is getattr(Gui.ActiveDocument, "ActiveView", None)}
                              for ov in ctl.overlays.values()]
     except Exception as exc:  # noqa: BLE001 - the workbench not loaded yet
         state["controller_error"] = str(exc)

@@ -1,0 +1,213 @@
+"""The slider panel and the HUD as a designer meets them: FreeCAD's real GUI under Xvfb, real X
+input (xdotool). The panel's sliders are dragged in the isometric and the front view, with and
+without a mouse session: each drag changes its value as one undo step and never sculpts. The HUD
+over white zebra stripes: its text stands on a dark backing, its items do not overlap, the zebra
+legend shows as many bands as the display has stripes. Screenshots: build/screenshots/real_panel_*.png."""
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+import pytest
+from test_gui_real_input import NEEDS, SHOTS, Desktop, patch_with_keyed_constraints, sculpt, undo
+
+SLIDERS = [("mass", "Set mass"), ("damping", "Set damping"), ("stiffness", "Set stiffness"),
+           ("curvature_u", "Set curvature"), ("curvature_v", "Set curvature")]
+VIEW_KEYS = {"iso": "0", "front": "1", "top": "2"}  # FreeCAD's standard view shortcuts
+pytestmark = pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD")
+
+
+def overlay(s: dict) -> dict:
+    return next(o for o in s["overlays"] if o["active_view"])
+
+
+def camera(s: dict) -> str:
+    return next(v for v in s["views"] if v["active"])["camera"]
+
+
+def set_view(d: Desktop, name: str) -> None:
+    before = camera(d.state())
+    d.xdo("key", VIEW_KEYS[name])
+    d.wait(lambda s: camera(s) != before, f"the {name} view")
+
+
+def calibrate(d: Desktop) -> None:
+    """Desktop.calibrate on the pixels the view's events give (the HUD's; FreeCAD 0.20's getCursorPos
+    differed from them by 4 % and more), waiting for a state written after each move (the
+    overlay's frame count is the clock), checked on a third point."""
+    def cursor_at(x: int, y: int) -> list[float]:
+        d.xdo("mousemove", str(x), str(y))
+        frames = overlay(d.state())["frames"]
+        s = d.wait(lambda s: overlay(s)["frames"] > frames + 12, "a state written after the move")
+        return next(v for v in s["views"] if v["active"])["pixel"]
+
+    # (screen points inside the 3D view of a 1280 x 1024 and of a 1000 x 720 window)
+    (s0, v0), (s1, v1) = ((300, 220), cursor_at(300, 220)), ((700, 380), cursor_at(700, 380))
+    d._map = [(s0[k], v0[k], (s1[k] - s0[k]) / (v1[k] - v0[k])) for k in (0, 1)]
+    check = cursor_at(500, 300)
+    assert max(abs(a - b) for a, b in zip(d.to_screen(check), (500, 300))) <= 2, (check, d._map)
+
+
+def at_rest(d: Desktop, timeout: float = 60.0) -> np.ndarray:
+    """Waits until the shown surface stays within 1e-4 mm over ten observer states (a session
+    bends the patch toward curvature targets the sliders set before it ran); its poles then."""
+    end, still, last = time.monotonic() + timeout, 0, None
+    while still < 10:
+        if time.monotonic() > end:
+            raise AssertionError("the surface never came to rest")
+        time.sleep(0.1)
+        now = np.array(sculpt(d.state())["shape_poles"])
+        still = still + 1 if last is not None and np.abs(now - last).max() < 1e-4 else 0
+        last = now
+    return last
+
+
+def screen_box(d: Desktop, box: list[float]) -> tuple[int, int, int, int]:
+    """A HUD box (view pixels, origin bottom-left) as screen rows and columns (r0, r1, c0, c1)."""
+    (c0, r1), (c1, r0) = d.to_screen([box[0], box[1]]), d.to_screen([box[2], box[3]])
+    return min(r0, r1), max(r0, r1), min(c0, c1), max(c0, c1)
+
+
+def target(f: float) -> float:
+    """Where a drag takes a knob at f: 0.15 of the track toward the middle (values a patch rests
+    with: a light, stiff, hardly damped one, mass 0.06, stiffness 9500, damping 0.09, never did)."""
+    return f + 0.15 if f < 0.5 else f - 0.15
+
+
+def drag_slider(d: Desktop, k: int) -> None:
+    """Drags slider k's knob from where it is to :func:`target`, as a hand does."""
+    s = d.state()
+    x0, y0, x1, y1 = overlay(s)["hud"][f"track{k + 1}"]
+    f = overlay(s)["sliders"][k][3]
+    to = target(f)
+    y = (y0 + y1) / 2
+    points = [d.to_screen([x0 + (f + (to - f) * t) * (x1 - x0), y]) for t in np.linspace(0, 1, 8)]
+    d.drag(points, seconds=0.5)
+
+
+def check_drag(d: Desktop, k: int, still: float | None, what: str) -> None:
+    """Drags slider k: its value moves there as exactly one undo step, no stroke; ``still``: nor
+    does the surface, by more than this many mm."""
+    name, title = SLIDERS[k]
+    poles = at_rest(d) if still is not None else None
+    s = d.state()
+    before, f = undo(s), overlay(s)["sliders"][k][3]
+    drag_slider(d, k)
+    d.wait(lambda s: undo(s)[0] == title and undo(s)[1:6] == before[:5] and not overlay(s)["sliders"][k][2],
+           f"{title}: one undo step ({what})")
+    time.sleep(0.5)  # (a second step would show by now)
+    s = d.state()
+    assert undo(s)[1:6] == before[:5], (what, undo(s), before)
+    assert "Sculpt stroke" not in undo(s), (what, undo(s))
+    moved = overlay(s)["sliders"][k][3]
+    assert abs(moved - target(f)) < 0.03, (what, name, f, moved)
+    if still is not None:
+        change = np.abs(np.array(sculpt(s)["shape_poles"]) - poles).max()
+        assert change < still, f"{name} ({what}) moved the surface by {change} mm"
+
+
+def test_each_slider_drag_is_one_undo_step_and_never_a_stroke(tmp_path):
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        d.xdo("mousemove", "640", "500")
+        patch_with_keyed_constraints(d)  # (the curvature constraint gives the curvature sliders a target)
+        d.press_button("Panel", lambda s: "track5" in overlay(s)["hud"], "the slider panel")
+        calibrate(d)
+        # A mouse session (the left button sculpts there): a stroke would pull millimetres (the
+        # issue's spike); a material slider moves the running patch by hundredths at most (10 times
+        # less damping lets it settle further under its penalty constraints: 0.012 mm seen). A new
+        # curvature target bends it (slowly, not a stroke), so those last and unmeasured.
+        d.press_button("Session", lambda s: sculpt(s)["session"], "a mouse session")
+        for group, still in (((0, 1, 2), 0.05), ((3, 4), None)):
+            for view in ("iso", "front"):
+                d.xdo("mousemove", "640", "500")
+                set_view(d, view)
+                for k in group:
+                    check_drag(d, k, still, f"{view} view, session")
+                d.shot(f"panel_{view}_session_{'materials' if still is not None else 'curvature'}")
+        d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
+        for view in ("iso", "front"):  # without a session nothing moves the surface but a stroke
+            d.xdo("mousemove", "640", "500")
+            set_view(d, view)
+            for k in range(len(SLIDERS)):
+                check_drag(d, k, 1e-6, f"{view} view")
+            d.shot(f"panel_{view}_idle")
+        assert sculpt(d.state())["strokes"] == 0
+    finally:
+        d.close()
+
+
+@pytest.mark.parametrize("window", [(1280, 1024), (1000, 720)])
+def test_the_hud_reads_over_white_zebra_stripes_and_its_legend_counts_the_stripes(tmp_path, window):
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        if window != (1280, 1024):
+            d.xdo("windowsize", "--sync", d.xdo("search", "--name", "FreeCAD").split()[-1], *map(str, window))
+        d.xdo("mousemove", str(window[0] // 2), str(window[1] // 2))
+        patch_with_keyed_constraints(d)  # jacks on the patch
+        d.press_button("Panel", lambda s: "track5" in overlay(s)["hud"], "the slider panel")
+        d.press_button("Zebra", lambda s: overlay(s)["display"] == "zebra", "zebra stripes")
+        calibrate(d)
+        set_view(d, "top")  # the flat patch faces the eye: its reflection lines are all white
+        # zoom in at the patch's centre until it fills the view: white behind every HUD item
+        for _ in range(40):
+            s = d.state()
+            w, h = overlay(s)["view_size"]
+            centre, east, west, north, south = sculpt(s)["screen"]
+            if west[0] < 0 and east[0] > w and south[1] < 0 and north[1] > h:
+                break
+            d.xdo("mousemove", *(str(c) for c in d.to_screen(centre)))
+            d.xdo("click", "4")
+            d.wait(lambda s2: sculpt(s2)["screen"] != sculpt(s)["screen"], "the zoom")
+        else:
+            raise AssertionError("the patch never filled the view")
+        for stripes in (6, 12, 24):
+            for _ in range(3):
+                if d.state()["overlays"] and overlay(d.state())["stripes"] == stripes:
+                    break
+                current = overlay(d.state())["stripes"]
+                d.press_button("ZebraStripes", lambda s: overlay(s)["stripes"] != current, "the stripe count")
+            s = d.wait(lambda s: overlay(s)["stripes"] == stripes and "legend_bar" in overlay(s)["hud"], "the legend")
+            time.sleep(0.5)  # (the frame after the change has been drawn: the HUD redraws at 60 Hz)
+            img = d.shot(f"panel_zebra_{window[0]}_{stripes}")
+            boxes = overlay(d.state())["hud"]
+            luminance = img.mean(axis=2)
+            # the legend: as many black and white bands as the display has stripes
+            r0, r1, c0, c1 = screen_box(d, boxes["legend_bar"])
+            column = luminance[r0 + 2:r1 - 2, (c0 + c1) // 2] > 0.5
+            bands = 1 + int(np.count_nonzero(column[1:] != column[:-1]))
+            assert bands == stripes, f"the legend shows {bands} bands for {stripes} stripes"
+            # no two items overlap, nor two backings
+            items = {k: b for k, b in boxes.items() if not k.startswith("back_")}
+            for group in (items, {k: b for k, b in boxes.items() if k.startswith("back_")}):
+                names = sorted(group)
+                for i, a in enumerate(names):
+                    for b in names[i + 1:]:
+                        (ax0, ay0, ax1, ay1), (bx0, by0, bx1, by1) = group[a], group[b]
+                        assert ax1 <= bx0 or bx1 <= ax0 or ay1 <= by0 or by1 <= ay0, f"{a} overlaps {b}"
+            # every text reads: bright glyphs on a dark ground, with white stripes all around the backing
+            for name in [k for k in items if k.startswith(("slider", "status", "legend_title"))]:
+                r0, r1, c0, c1 = screen_box(d, items[name])
+                patch = luminance[r0:r1, c0:c1]
+                assert np.percentile(patch, 50) < 0.4 and patch.max() > 0.85, (name, np.percentile(patch, 50), patch.max())
+                text, ground = _linear(patch.max()), _linear(np.percentile(patch, 50))
+                assert (text + 0.05) / (ground + 0.05) > 4.5, f"{name}: contrast {(text + 0.05) / (ground + 0.05):.1f}"
+            for back in ("back_sliders", "back_legend", "back_status"):
+                r0, r1, c0, c1 = screen_box(d, boxes[back])
+                ring = np.concatenate([luminance[r0 - 6:r0 - 2, c0:c1].ravel(), luminance[r1 + 2:r1 + 6, c0:c1].ravel()])
+                inside = img[r0 + 1:r1 - 1, c0 + 1:c1 - 1]
+                red, green, blue = inside[..., 0], inside[..., 1], inside[..., 2]
+                assert not np.any((red > 0.8) & (green < 0.3) & (blue < 0.3)), f"a point jack over {back}"
+                if back == "back_sliders":
+                    assert np.mean(ring > 0.9) > 0.5, "the test's premise: white stripes around the slider panel"
+    finally:
+        d.close()
+
+
+def _linear(srgb: float) -> float:
+    """Relative luminance of an sRGB grey (WCAG)."""
+    return srgb / 12.92 if srgb <= 0.04045 else ((srgb + 0.055) / 1.055) ** 2.4
+
+
+os.makedirs(SHOTS, exist_ok=True)
