@@ -112,7 +112,11 @@ def _rect(widget, rect=None):
 def _command_name(action):
     """The command a toolbar or menu action runs (a group's entries name theirs in a property)."""
     name = action.property("CommandName")
-    return bytes(name).decode() if name is not None else action.objectName()
+    if name is None:
+        return action.objectName()
+    if isinstance(name, str):
+        return name
+    return bytes(name if isinstance(name, bytes) else name.data()).decode()  # (a QByteArray: PySide2 and 6)
 
 
 def _entries(menu):
