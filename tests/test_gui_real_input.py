@@ -143,8 +143,8 @@ class Desktop:
         name = "HapticSculpt_" + button
 
         def holder(s: dict) -> str:
-            bar = s["toolbars"]
-            return name if name in bar["buttons"] else next(g for g, entries in bar["groups"].items() if name in entries)
+            bars = s["toolbars"]
+            return name if name in bars["buttons"] else next(g for g, e in bars["groups"].items() if name in e)
         s = self.wait(holder, f"a button or drop-down with {button}", 60)
         try:  # (a click on a disabled button does nothing: wait a while for FreeCAD to enable it)
             s = self.wait(lambda s: s["toolbars"]["buttons"][holder(s)][4], f"{holder(s)} enabled", 20, shot=False)

@@ -29,6 +29,12 @@ def _icon(img: np.ndarray, entry: list[int]) -> np.ndarray:
     return (grey - grey.mean()) / (grey.std() + 1e-9)
 
 
+def _opened(d: Desktop, menu: str) -> dict[str, list[int]]:
+    """The entries of a drop-down or menu once the observer sees it open, by command name."""
+    return d.wait(lambda s: s["toolbars"]["open"][menu] and all(s["toolbars"]["open"][menu].values()),
+                  f"{menu} open")["toolbars"]["open"][menu]
+
+
 @pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick's import and FreeCAD")
 def test_every_command_reachable_and_every_icon_distinct(tmp_path):
     d = Desktop(str(tmp_path), "CAD", screen=f"{WIDTH}x{HEIGHT}")
@@ -58,8 +64,7 @@ def test_every_command_reachable_and_every_icon_distinct(tmp_path):
         for group in groups:
             x, y, w, h, _ = buttons[group]
             d.xdo("mousemove", str(x + w - 5), str(y + h // 2), "click", "1")
-            entries = d.wait(lambda s: s["toolbars"]["open"][group] and all(s["toolbars"]["open"][group].values()),
-                             f"the drop-down {group} open")["toolbars"]["open"][group]
+            entries = _opened(d, group)
             d.shot(f"toolbar_{group.removeprefix('HapticSculpt_')}")
             for name, (ex, ey, ew, eh) in entries.items():
                 assert 0 <= ex and ex + ew <= WIDTH and 0 <= ey and ey + eh <= HEIGHT, (group, name)
@@ -71,12 +76,15 @@ def test_every_command_reachable_and_every_icon_distinct(tmp_path):
         # A drop-down's entry runs its command, and the group's button runs it again from then on.
         d.press_button("ToolMagnet", lambda s: undo(s)[0] == "Tool: magnet", "Tool: magnet from the drop-down")
         d.press_button("ToolRope", lambda s: undo(s)[0] == "Tool: rope", "Tool: rope from the drop-down")
+        d.press_button("Material", lambda s: undo(s)[0] == "Material: elastic", "elastic from the drop-down")
+        x, y, w, h, _ = buttons["HapticSculpt_MaterialGroup"]
+        d.xdo("mousemove", str(x + (w - 12) // 2), str(y + h // 2), "click", "1")  # (the button, not its arrow)
+        d.wait(lambda s: undo(s)[:2] == ["Material: clay", "Material: elastic"], "clay from the group's button")
 
         # The menu lists every command with its icon: all of them side by side, at one size.
         x, y, w, h = s["toolbars"]["menus"]["HapticSculpt"]
         d.xdo("mousemove", str(x + w // 2), str(y + h // 2), "click", "1")
-        menu = d.wait(lambda s: s["toolbars"]["open"]["HapticSculpt"] and all(s["toolbars"]["open"]["HapticSculpt"].values()),
-                      "the HapticSculpt menu open")["toolbars"]["open"]["HapticSculpt"]
+        menu = _opened(d, "HapticSculpt")
         img = d.shot("toolbar_menu")
         d.xdo("key", "Escape")
         commands = set(s["toolbars"]["commands"]) - set(groups)

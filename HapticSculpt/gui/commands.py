@@ -13,7 +13,8 @@ from .view_provider import icon
 GROUPS = {
     "HapticSculpt_OutputGroup": ("Output", "Export STEP, or thicken the selected sculpt into a solid",
                                  ["HapticSculpt_ExportStep", "HapticSculpt_Thicken"], 0),
-    "HapticSculpt_ToolGroup": ("Tools", "Choose the sculpting tool: rope, magnet (and its falloff), orientation, smooth",
+    "HapticSculpt_ToolGroup": ("Tools", "Choose the sculpting tool: rope, magnet (and its falloff), orientation, "
+                               "smooth",
                                ["HapticSculpt_ToolRope", "HapticSculpt_ToolMagnet", "HapticSculpt_MagnetFalloff",
                                 "HapticSculpt_ToolOrientation", "HapticSculpt_ToolSmooth"], 0),
     "HapticSculpt_MaterialGroup": ("Material", "The material: elastic or clay, keep the shape, airbrush the mass, "
