@@ -45,8 +45,11 @@ class Desktop:
         self.xvfb = subprocess.Popen(["Xvfb", "-displayfd", "1", "-screen", "0", screen + "x24", "-nolisten", "tcp"],
                                      stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
         self.display = ":" + self.xvfb.stdout.readline().decode().strip()
+        # (XDG_CONFIG_HOME: Qt keeps the window's layout, toolbars too, in ~/.config/FreeCAD/FreeCAD.conf,
+        # which FREECAD_USER_HOME does not move: every FreeCAD on the machine would start with the
+        # layout the last one left)
         self.env = dict(os.environ, DISPLAY=self.display, QTWEBENGINE_DISABLE_SANDBOX="1", FREECAD_USER_HOME=home,
-                        HS_OBSERVER_OUT=self.state_file)
+                        XDG_CONFIG_HOME=os.path.join(home, "config"), HS_OBSERVER_OUT=self.state_file)
         self.log = open(os.path.join(tmp, "freecad.log"), "a")
         if os.path.exists(self.state_file):  # (a restart: the last FreeCAD's state is not this one's)
             os.remove(self.state_file)
