@@ -141,25 +141,48 @@ class Desktop:
 
     def click_button(self, button: str) -> bool:
         """Clicks a command's toolbar button once, where the observer sees it; a command in a
-        drop-down: clicks the drop-down's arrow, then its entry. False if the drop-down did not
-        open (a disabled group: a user clicks again once it is enabled)."""
+        drop-down: clicks the drop-down's arrow, then its entry; a button behind its toolbar's "»"
+        (a window made narrower than the toolbars): clicks "»" before and after. False if the
+        drop-down did not open (a disabled group: a user clicks again once it is enabled)."""
         name = "HapticSculpt_" + button
 
-        def holder(s: dict) -> str:
-            bars = s["toolbars"]
-            return name if name in bars["buttons"] else next(g for g, e in bars["groups"].items() if name in e)
-        s = self.wait(holder, f"a button or drop-down with {button}", 60)
+        def holder(s: dict) -> str:  # (the button or the drop-down with the command)
+            return next(g for g, entries in s["toolbars"]["groups"].items() if name in entries) \
+                if name in sum(s["toolbars"]["groups"].values(), []) else name
+
+        def shown(s: dict) -> bool:
+            return holder(s) in s["toolbars"]["buttons"]
+
+        def behind(s: dict) -> list[str]:  # (the toolbar hiding it behind its "»")
+            return [n for n, b in s["toolbars"]["bars"].items() if holder(s) in b["behind_extension"]]
+
+        def extension(bar: str) -> None:
+            x, y, w, h = self.state()["toolbars"]["bars"][bar]["extension"]
+            self.xdo("mousemove", str(x + w // 2), str(y + h // 2), "click", "1")
+
+        s = self.wait(lambda s: shown(s) or behind(s), f"a button or drop-down with {button}", 60)
+        expanded = None if shown(s) else behind(s)[0]
+        if expanded:
+            extension(expanded)
+            s = self.wait(shown, f"{holder(s)} out from behind »")
+        try:
+            return self._click(name, holder(s))
+        finally:
+            if expanded:
+                extension(expanded)
+                self.wait(lambda s: behind(s), f"{expanded} folded again")
+
+    def _click(self, name: str, group: str) -> bool:
+        """Clicks command ``name``'s button (``group`` is ``name``) or entry of drop-down ``group``."""
+        s = self.state()
         try:  # (a click on a disabled button does nothing: wait a while for FreeCAD to enable it)
-            s = self.wait(lambda s: s["toolbars"]["buttons"][holder(s)][4], f"{holder(s)} enabled", 20, shot=False)
+            s = self.wait(lambda s: s["toolbars"]["buttons"][group][4], f"{group} enabled", 20, shot=False)
         except AssertionError:
             pass
-        s = s["toolbars"]
-        if name in s["buttons"]:
-            x, y, w, h, _ = s["buttons"][name]
+        x, y, w, h, _ = s["toolbars"]["buttons"][group]
+        if group == name:
             self.xdo("mousemove", str(x + w // 2), str(y + h // 2), "click", "1")
             return True
-        group = next(g for g, entries in s["groups"].items() if name in entries)
-        x, y, w, h, _ = s["buttons"][group]
         self.xdo("mousemove", str(x + w - 5), str(y + h // 2), "click", "1")  # (the arrow)
         try:
             entry = self.wait(lambda s: s["toolbars"]["open"][group][name], f"the drop-down {group}", 10,

@@ -51,7 +51,8 @@ def test_every_command_reachable_and_every_icon_distinct(tmp_path):
         d.shot("toolbar")
         bars = s["toolbars"]["bars"]
         ours = [name for name in bars if name.startswith("HapticSculpt")]
-        assert ours == ["HapticSculpt create", "HapticSculpt sculpt", "HapticSculpt tools", "HapticSculpt analysis"]
+        assert ours == ["HapticSculpt create", "HapticSculpt output", "HapticSculpt sculpt", "HapticSculpt tools",
+                        "HapticSculpt analysis"]
         assert not [name for name, bar in bars.items() if bar["hidden"]], "a toolbar hides buttons behind »"
         buttons = {n: b for n, b in s["toolbars"]["buttons"].items() if n.startswith("HapticSculpt_")}
         for name, (x, y, w, h, _) in buttons.items():
@@ -94,5 +95,15 @@ def test_every_command_reachable_and_every_icon_distinct(tmp_path):
         closest = max(same, key=lambda t: t[2])
         print(f"{len(icons)} icons; the most alike: {closest[0]} and {closest[1]}, correlation {closest[2]:.3f}")
         assert closest[2] < SAME_PICTURE, [t for t in same if t[2] >= SAME_PICTURE]
+
+        # The window made narrower than the toolbars (Qt does not wrap them again): buttons go behind
+        # "»", Export STEP's does not.
+        name = d.xdo("search", "--name", "FreeCAD").split()[-1]
+        d.xdo("windowsize", "--sync", name, "1000", "720")
+        s = d.wait(lambda s: any(bar["hidden"] for bar in s["toolbars"]["bars"].values()), "buttons behind »")
+        d.shot("toolbar_narrow")
+        assert "HapticSculpt_OutputGroup" in s["toolbars"]["buttons"], s["toolbars"]["bars"]
+        x, y, w, h, _ = s["toolbars"]["buttons"]["HapticSculpt_OutputGroup"]
+        assert x + w <= 1000, (x, w)
     finally:
         d.close()

@@ -33,10 +33,12 @@ GROUPS = {
                                    "HapticSculpt_ZebraMode", "HapticSculpt_ZebraStripes",
                                    "HapticSculpt_ZebraDirection"], 0),
 }
-#: The toolbars: few buttons, so that all show at 1280 px beside FreeCAD's own (Output comes first:
-#: Export STEP never hides behind "»").
+#: The toolbars: few buttons, so that all show at 1280 px beside FreeCAD's own. Output is a toolbar
+#: of its own: a toolbar squeezed by a narrow window keeps its first button, so Export STEP never
+#: hides behind "»" (next to create, as FreeCAD's File toolbar holds New and Save).
 TOOLBARS = {
-    "HapticSculpt create": ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_OutputGroup"],
+    "HapticSculpt create": ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace"],
+    "HapticSculpt output": ["HapticSculpt_OutputGroup"],
     "HapticSculpt sculpt": ["HapticSculpt_Session", "HapticSculpt_ToolGroup", "HapticSculpt_MaterialGroup"],
     "HapticSculpt tools": ["HapticSculpt_ConstraintGroup"],
     "HapticSculpt analysis": ["HapticSculpt_DisplayGroup"],

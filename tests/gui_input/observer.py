@@ -128,27 +128,30 @@ def _entries(menu):
 def _toolbars():
     """What the main window shows of the toolbars and menus, read through FreeCAD's main window
     object (no Qt import): each shown toolbar's buttons on screen by command name (a group's
-    button also lists its drop-down's entries), whether the toolbar hides any behind its "»"
-    extension, and the open drop-down or menu's entries."""
+    button also lists its drop-down's entries), the buttons it hides behind its "»" extension and
+    where that is, and the open drop-down or menu's entries."""
     mw = Gui.getMainWindow()
     bars, buttons, groups, open_menus = {}, {}, {}, {}
     for bar in mw.children():
         if bar.metaObject().className() != "QToolBar" or not bar.isVisible():
             continue
-        shown, hidden = [], False
-        for tb in bar.children():  # (the "»" button is a QToolBarExtension)
-            kind = tb.metaObject().className()
-            if tb.objectName() == "qt_toolbar_ext_button":
-                hidden = hidden or tb.isVisible()
-            elif kind == "QToolButton" and tb.defaultAction() is not None and tb.isVisible():
+        shown, hidden, extension = [], [], None
+        for tb in bar.children():
+            if tb.objectName() == "qt_toolbar_ext_button":  # (a QToolBarExtension)
+                extension = _rect(tb) if tb.isVisible() else None
+            elif tb.metaObject().className() == "QToolButton" and tb.defaultAction() is not None:
                 name = _command_name(tb.defaultAction())
-                buttons[name] = _rect(tb) + [tb.isEnabled()]
-                shown.append(name)
+                if tb.isVisible():
+                    buttons[name] = _rect(tb) + [tb.isEnabled()]
+                    shown.append(name)
+                elif tb.defaultAction().isVisible():
+                    hidden.append(name)
                 if tb.menu() is not None:
                     groups[name] = list(_entries(tb.menu()))
                     if tb.menu().isVisible():
                         open_menus[name] = _entries(tb.menu())
-        bars[bar.objectName()] = {"rect": _rect(bar), "buttons": shown, "hidden": hidden}
+        bars[bar.objectName()] = {"rect": _rect(bar), "buttons": shown, "hidden": extension is not None,
+                                  "behind_extension": hidden, "extension": extension}
     menus = {}
     for a in mw.menuBar().actions():
         if a.menu() is not None and a.isVisible():
