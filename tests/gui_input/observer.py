@@ -160,8 +160,7 @@ def _toolbars():
             if a.menu().isVisible():
                 open_menus[title] = _entries(a.menu())
     return {"bars": bars, "buttons": buttons, "groups": groups, "menus": menus, "open": open_menus,
-            "commands": [c for c in Gui.listCommands() if c.startswith("HapticSculpt_")],
-            "screen": _rect(mw)}
+            "commands": [c for c in Gui.listCommands() if c.startswith("HapticSculpt_")]}
 
 
 def write(*_):
