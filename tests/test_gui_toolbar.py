@@ -1,7 +1,8 @@
 """The workbench's toolbars as a designer first meets them: FreeCAD's real GUI at 1280 x 800 under
 Xvfb, FreeCAD's default layout. Every command can be reached (a shown toolbar button, or an entry
-of a drop-down opened with a real click), no toolbar hides buttons behind "»", and no two commands
-show the same icon (compared as FreeCAD draws them, in its menu). Screenshots go to
+of a drop-down opened with a real click), no toolbar hides buttons behind "»", a drop-down's button
+repeats its entry picked last, no two commands show the same icon (compared as FreeCAD draws them,
+in its menu), and Export STEP stays shown when the window is narrowed to 1000 px. Screenshots go to
 build/screenshots/real_toolbar*.png."""
 from __future__ import annotations
 
