@@ -8,9 +8,11 @@ recorded macro replays in ``freecadcmd``."""
 
 
 def register() -> None:
-    """Adds every HapticSculpt command to FreeCAD (once, from the workbench's Initialize)."""
+    """Adds every HapticSculpt command and drop-down group to FreeCAD (once, from the workbench's Initialize)."""
     import FreeCADGui as Gui
 
     from HapticSculpt.gui import commands
     for name, cls in commands.COMMANDS.items():
         Gui.addCommand(name, cls())
+    for name, group in commands.GROUPS.items():  # (after their commands: a group reads theirs)
+        Gui.addCommand(name, commands.Group(*group))

@@ -28,7 +28,8 @@ class HapticSculptWorkbench(Gui.Workbench):
         import HapticSculptGui
         from HapticSculpt.gui import commands
         HapticSculptGui.register()
-        self.appendToolbar("HapticSculpt", commands.TOOLBAR)
+        for name, buttons in commands.TOOLBARS.items():
+            self.appendToolbar(name, buttons)
         self.appendMenu("HapticSculpt", commands.MENU)
 
     def Activated(self):

@@ -5,7 +5,6 @@ reads document state (tests/gui_input/observer.py); every action is a real key o
 Screenshots go to build/screenshots/real_*.png."""
 from __future__ import annotations
 
-import ast
 import json
 import os
 import shutil
@@ -17,19 +16,6 @@ import pytest
 from freecad_support import ROOT, SCREENSHOTS, make_addon_home, run_freecadcmd
 
 SHOTS = SCREENSHOTS
-# The HapticSculpt toolbar in FreeCAD's default layout at 1280 x 1024, by FreeCAD version: the
-# centre of its first button, the distance between buttons and the row (measured on screenshots).
-TOOLBAR = {(0, 20): (30, 34.4, 122), (1, 0): (28, 32.97, 117)}
-def _toolbar() -> list[str]:
-    """The toolbar's commands in order, read from gui/commands.py (not imported: importing the GUI
-    layer would install its hooks in this test process)."""
-    tree = ast.parse(open(os.path.join(ROOT, "HapticSculpt", "gui", "commands.py")).read())
-    names = next(ast.literal_eval(n.value) for n in tree.body if isinstance(n, ast.Assign)
-                 and any(getattr(t, "id", "") == "TOOLBAR" for t in n.targets))
-    return [name.removeprefix("HapticSculpt_") for name in names]
-
-
-BUTTONS = _toolbar()
 RECORD_BUTTON = (536, 552)  # the Record button of FreeCAD's macro recording dialog
 STYLES = {"CAD": "Gui::CADNavigationStyle", "OpenInventor": "Gui::InventorNavigationStyle",
           "Blender": "Gui::BlenderNavigationStyle", "Gesture": "Gui::GestureNavigationStyle"}
@@ -47,7 +33,7 @@ USER_CFG = """<?xml version="1.0" encoding="UTF-8" standalone="no" ?>
 class Desktop:
     """Xvfb, FreeCAD with the observer, and real input through xdotool."""
 
-    def __init__(self, tmp: str, style: str, open_file: str | None = None) -> None:
+    def __init__(self, tmp: str, style: str, open_file: str | None = None, screen: str = "1280x1024") -> None:
         self.tmp = tmp
         home = os.path.join(tmp, "home")
         if not os.path.isdir(home):  # (a restart keeps the home, as a user's does)
@@ -56,11 +42,14 @@ class Desktop:
                 f.write(USER_CFG.format(style=STYLES[style]))
         self.home = home
         self.state_file = os.path.join(tmp, "state.json")
-        self.xvfb = subprocess.Popen(["Xvfb", "-displayfd", "1", "-screen", "0", "1280x1024x24", "-nolisten", "tcp"],
+        self.xvfb = subprocess.Popen(["Xvfb", "-displayfd", "1", "-screen", "0", screen + "x24", "-nolisten", "tcp"],
                                      stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
         self.display = ":" + self.xvfb.stdout.readline().decode().strip()
+        # (XDG_CONFIG_HOME: Qt keeps the window's layout, toolbars too, in ~/.config/FreeCAD/FreeCAD.conf,
+        # which FREECAD_USER_HOME does not move: every FreeCAD on the machine would start with the
+        # layout the last one left)
         self.env = dict(os.environ, DISPLAY=self.display, QTWEBENGINE_DISABLE_SANDBOX="1", FREECAD_USER_HOME=home,
-                        HS_OBSERVER_OUT=self.state_file)
+                        XDG_CONFIG_HOME=os.path.join(home, "config"), HS_OBSERVER_OUT=self.state_file)
         self.log = open(os.path.join(tmp, "freecad.log"), "a")
         if os.path.exists(self.state_file):  # (a restart: the last FreeCAD's state is not this one's)
             os.remove(self.state_file)
@@ -150,20 +139,70 @@ class Desktop:
         subprocess.run(["import", "-window", "root", path], env=self.env, check=True)
         return mpimg.imread(path)[..., :3]
 
-    def click_button(self, button: str) -> None:
-        """Clicks a toolbar button once."""
-        x0, step, y = TOOLBAR[tuple(self.version)]
-        self.xdo("mousemove", str(int(round(x0 + step * BUTTONS.index(button)))), str(y), "click", "1")
+    def click_button(self, button: str) -> bool:
+        """Clicks a command's toolbar button once, where the observer sees it; a command in a
+        drop-down: clicks the drop-down's arrow, then its entry; a button behind its toolbar's "»"
+        (a window made narrower than the toolbars): clicks "»" before and after. False if the
+        drop-down did not open (a disabled group: a user clicks again once it is enabled)."""
+        name = "HapticSculpt_" + button
+
+        def holder(s: dict) -> str:  # (the button or the drop-down with the command)
+            return next(g for g, entries in s["toolbars"]["groups"].items() if name in entries) \
+                if name in sum(s["toolbars"]["groups"].values(), []) else name
+
+        def shown(s: dict) -> bool:
+            return holder(s) in s["toolbars"]["buttons"]
+
+        def behind(s: dict) -> list[str]:  # (the toolbar hiding it behind its "»")
+            return [n for n, b in s["toolbars"]["bars"].items() if holder(s) in b["behind_extension"]]
+
+        def extension(bar: str) -> None:
+            x, y, w, h = self.state()["toolbars"]["bars"][bar]["extension"]
+            self.xdo("mousemove", str(x + w // 2), str(y + h // 2), "click", "1")
+
+        s = self.wait(lambda s: shown(s) or behind(s), f"a button or drop-down with {button}", 60)
+        expanded = None if shown(s) else behind(s)[0]
+        if expanded:
+            extension(expanded)
+            s = self.wait(shown, f"{holder(s)} out from behind »")
+        try:
+            return self._click(name, holder(s))
+        finally:
+            if expanded:
+                extension(expanded)
+                self.wait(lambda s: behind(s), f"{expanded} folded again")
+
+    def _click(self, name: str, group: str) -> bool:
+        """Clicks command ``name``'s button (``group`` is ``name``) or entry of drop-down ``group``."""
+        s = self.state()
+        try:  # (a click on a disabled button does nothing: wait a while for FreeCAD to enable it)
+            s = self.wait(lambda s: s["toolbars"]["buttons"][group][4], f"{group} enabled", 20, shot=False)
+        except AssertionError:
+            pass
+        x, y, w, h, _ = s["toolbars"]["buttons"][group]
+        if group == name:
+            self.xdo("mousemove", str(x + w // 2), str(y + h // 2), "click", "1")
+            return True
+        self.xdo("mousemove", str(x + w - 5), str(y + h // 2), "click", "1")  # (the arrow)
+        try:
+            entry = self.wait(lambda s: s["toolbars"]["open"][group][name], f"the drop-down {group}", 10,
+                              shot=False)["toolbars"]["open"][group][name]
+        except AssertionError:
+            if group in self.state().get("toolbars", {}).get("open", {}):
+                self.xdo("key", "Escape")  # (open without the entry: FreeCAD still updating it)
+            return False
+        x, y, w, h = entry
+        self.xdo("mousemove", str(x + w // 2), str(y + h // 2), "click", "1")
+        self.wait(lambda s: group not in s["toolbars"]["open"], f"the drop-down {group} to close", 10)
+        return True
 
     def press_button(self, button: str, condition, what: str) -> dict:
-        """Clicks a toolbar button until ``condition`` holds (FreeCAD enables a command's button on
-        its next update after the command becomes usable: a click before that does nothing, for a
-        user too, who clicks again). Each click gets 5 s to show: most buttons toggle, and a second
-        click while a loaded machine still works on the first would undo it."""
-        x0, step, y = TOOLBAR[tuple(self.version)]
-        x = int(round(x0 + step * BUTTONS.index(button)))
+        """Clicks a command's button (or drop-down entry) until ``condition`` holds (FreeCAD enables a
+        command's button on its next update after the command becomes usable: a click before that
+        does nothing, for a user too, who clicks again). Each click gets 5 s to show: most buttons
+        toggle, and a second click while a loaded machine still works on the first would undo it."""
         for _ in range(6):
-            self.xdo("mousemove", str(x), str(y), "click", "1")
+            self.click_button(button)
             try:
                 return self.wait(condition, what, timeout=5.0, shot=False)
             except AssertionError:

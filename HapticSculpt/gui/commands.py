@@ -8,18 +8,46 @@ import FreeCADGui as Gui
 
 from .view_provider import icon
 
-TOOLBAR = ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Session", "HapticSculpt_Material",
-           "HapticSculpt_KeepShape", "HapticSculpt_ToolRope",
-           "HapticSculpt_ToolMagnet", "HapticSculpt_MagnetFalloff", "HapticSculpt_ToolOrientation",
-           "HapticSculpt_ToolSmooth", "HapticSculpt_PointConstraint", "HapticSculpt_NormalConstraint",
-           "HapticSculpt_CurvatureConstraint", "HapticSculpt_PaintMass", "HapticSculpt_PaintDamping",
-           "HapticSculpt_PaintStiffness", "HapticSculpt_ShowMap", "HapticSculpt_ShowCurvature",
-           "HapticSculpt_Combs", "HapticSculpt_Zebra", "HapticSculpt_ZebraMode", "HapticSculpt_ZebraStripes",
-           "HapticSculpt_ZebraDirection",
-           "HapticSculpt_Panel", "HapticSculpt_CombDensity", "HapticSculpt_CombScale", "HapticSculpt_Thicken",
-           "HapticSculpt_ExportStep"]
-#: The menu: the toolbar's commands and the ones that are only in the menu.
-MENU = TOOLBAR[:5] + ["HapticSculpt_HoldEdges"] + TOOLBAR[5:]
+#: The drop-down command groups (FreeCAD group commands, as Draft's and PartDesign's): name ->
+#: (menu text, tool tip, the commands, the one the button runs until another entry is picked).
+GROUPS = {
+    "HapticSculpt_OutputGroup": ("Output", "Export STEP, or thicken the selected sculpt into a solid",
+                                 ["HapticSculpt_ExportStep", "HapticSculpt_Thicken"], 0),
+    "HapticSculpt_ToolGroup": ("Tools", "Choose the sculpting tool: rope, magnet (and its falloff), orientation, "
+                               "smooth",
+                               ["HapticSculpt_ToolRope", "HapticSculpt_ToolMagnet", "HapticSculpt_MagnetFalloff",
+                                "HapticSculpt_ToolOrientation", "HapticSculpt_ToolSmooth"], 0),
+    "HapticSculpt_MaterialGroup": ("Material", "The material: elastic or clay, keep the shape, airbrush the mass, "
+                                   "damping or stiffness map, the slider panel",
+                                   ["HapticSculpt_Material", "HapticSculpt_KeepShape", "HapticSculpt_PaintMass",
+                                    "HapticSculpt_PaintDamping", "HapticSculpt_PaintStiffness", "HapticSculpt_Panel"],
+                                   0),
+    "HapticSculpt_ConstraintGroup": ("Constraints and edges", "Hold the edges (free / G0 / G1), or toggle a point, "
+                                     "normal or curvature constraint at the cursor",
+                                     ["HapticSculpt_HoldEdges", "HapticSculpt_PointConstraint",
+                                      "HapticSculpt_NormalConstraint", "HapticSculpt_CurvatureConstraint"], 0),
+    "HapticSculpt_DisplayGroup": ("Displays", "Analysis displays: material map, curvature, combs, zebra stripes "
+                                  "and their settings",
+                                  ["HapticSculpt_ShowMap", "HapticSculpt_ShowCurvature", "HapticSculpt_Combs",
+                                   "HapticSculpt_CombDensity", "HapticSculpt_CombScale", "HapticSculpt_Zebra",
+                                   "HapticSculpt_ZebraMode", "HapticSculpt_ZebraStripes",
+                                   "HapticSculpt_ZebraDirection"], 0),
+}
+#: The toolbars: few buttons, so that all show at 1280 px beside FreeCAD's own. Output is a toolbar
+#: of its own: a toolbar squeezed by a narrow window keeps its first button, so Export STEP never
+#: hides behind "»" (next to create, as FreeCAD's File toolbar holds New and Save).
+TOOLBARS = {
+    "HapticSculpt create": ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace"],
+    "HapticSculpt output": ["HapticSculpt_OutputGroup"],
+    "HapticSculpt sculpt": ["HapticSculpt_Session", "HapticSculpt_ToolGroup", "HapticSculpt_MaterialGroup"],
+    "HapticSculpt tools": ["HapticSculpt_ConstraintGroup"],
+    "HapticSculpt analysis": ["HapticSculpt_DisplayGroup"],
+}
+#: The menu: every command, in sections.
+MENU = ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "Separator", "HapticSculpt_Session", "Separator",
+        *[name for group in ("HapticSculpt_ToolGroup", "HapticSculpt_MaterialGroup", "HapticSculpt_ConstraintGroup",
+                             "HapticSculpt_DisplayGroup", "HapticSculpt_OutputGroup")
+          for name in [*GROUPS[group][2], "Separator"]]][:-1]
 
 
 def _selected_sculpts() -> list[Any]:
@@ -32,7 +60,7 @@ class NewPatch:
     open (as Part's primitives do)."""
 
     def GetResources(self) -> dict[str, str]:
-        return {"Pixmap": icon("HapticSculpt"), "MenuText": "New sculpt patch",
+        return {"Pixmap": icon("NewPatch"), "MenuText": "New sculpt patch",
                 "ToolTip": "Create a flat 100 x 100 mm B-spline patch (8 x 8 poles, degree 3) to sculpt "
                            "(in a new document when none is open)"}
 
@@ -73,7 +101,7 @@ class SculptFace:
     them; with a plane selected too, mirrored in it); a face of anything else a separate patch."""
 
     def GetResources(self) -> dict[str, str]:
-        return {"Pixmap": icon("HapticSculpt"), "MenuText": "Sculpt selected face",
+        return {"Pixmap": icon("SculptFace"), "MenuText": "Sculpt selected face",
                 "ToolTip": "Sculpt the selected faces: in place in their solid (edges held G0, holes kept, faces "
                            "in a row sculpted as one, tangent seams held G1; Hold edges switches G0/G1; select a "
                            "plane too for a mirror-symmetric sculpt), or one face as a separate B-spline patch"}
@@ -113,7 +141,7 @@ class Thicken:
     """Thicken the selected sculpt into a parametric solid: a task panel asks the thickness."""
 
     def GetResources(self) -> dict[str, str]:
-        return {"Pixmap": icon("HapticSculpt"), "MenuText": "Thicken",
+        return {"Pixmap": icon("Thicken"), "MenuText": "Thicken",
                 "ToolTip": "Offset the selected sculpt surface into a solid that follows it (asks the thickness; "
                            "double-click the Thickness to change it)"}
 
@@ -130,7 +158,7 @@ class ExportStep:
     named in a task panel (FreeCAD's file chooser, STEP preselected)."""
 
     def GetResources(self) -> dict[str, str]:
-        return {"Pixmap": icon("HapticSculpt"), "MenuText": "Export STEP",
+        return {"Pixmap": icon("ExportStep"), "MenuText": "Export STEP",
                 "ToolTip": "Export the selected objects (else the document's only sculpt or sculpted solid) "
                            "to a STEP file"}
 
@@ -189,7 +217,7 @@ class Session(_SculptCommand):
 
 
 class Material(_SculptCommand):
-    icon_name, menu = "Session", "Elastic / Clay"
+    icon_name, menu = "Material", "Elastic / Clay"
     tip = ("Switch the sculpt's material: clay (what you pull stays) or elastic (springs back to its rest shape "
            "unless held by constraints)")
 
@@ -203,7 +231,7 @@ class Material(_SculptCommand):
 
 
 class KeepShape(_SculptCommand):
-    icon_name, menu = "Session", "Keep shape"
+    icon_name, menu = "KeepShape", "Keep shape"
     tip = "Make the current shape the rest shape: an elastic sculpt stays as it is now (also while sculpting)"
 
     def Activated(self) -> None:
@@ -212,7 +240,7 @@ class KeepShape(_SculptCommand):
 
 
 class HoldEdges(_SculptCommand):
-    icon_name, menu = "Session", "Hold edges: free / G0 / G1"
+    icon_name, menu = "HoldEdges", "Hold edges: free / G0 / G1"
     tip = ("Hold the sculpt's edges exactly (hard constraints): G0 keeps them where they are, G1 their "
            "tangent planes too; each press goes free, G0, G1, free (a face sculpted in its solid: G0, G1)")
 
@@ -261,7 +289,7 @@ class ToolSmooth(_Tool):
 
 
 class MagnetFalloff(_SculptCommand):
-    icon_name, menu = "Magnet", "Magnet falloff"
+    icon_name, menu = "MagnetFalloff", "Magnet falloff"
     tip = "Cycle the magnet's falloff: constant, spherical, cylindrical (about the cursor axis), conical"
 
     def Activated(self) -> None:
@@ -353,7 +381,7 @@ class Combs(_SculptCommand):
 
 
 class CombDensity(_SculptCommand):
-    icon_name, menu = "Combs", "Combs: density"
+    icon_name, menu = "CombDensity", "Combs: density"
     tip = "Cycle how many iso-lines carry a curvature comb: every 2nd, 4th or 8th"
 
     def Activated(self) -> None:
@@ -365,7 +393,7 @@ class CombDensity(_SculptCommand):
 
 
 class CombScale(_SculptCommand):
-    icon_name, menu = "Combs", "Combs: scale"
+    icon_name, menu = "CombScale", "Combs: scale"
     tip = "Cycle the combs' length: the longest tooth 0.5, 1 or 2 tenths of the patch size"
 
     def Activated(self) -> None:
@@ -387,7 +415,7 @@ class Zebra(_SculptCommand):
 
 
 class ZebraMode(_SculptCommand):
-    icon_name, menu = "Zebra", "Zebra: reflection / isophote"
+    icon_name, menu = "ZebraMode", "Zebra: reflection / isophote"
     tip = ("Switch the zebra stripes between reflection lines (view-dependent: the eye ray mirrored in the "
            "surface) and isophotes (world-fixed: bands of equal angle to the z axis)")
 
@@ -400,7 +428,7 @@ class ZebraMode(_SculptCommand):
 
 
 class ZebraStripes(_SculptCommand):
-    icon_name, menu = "Zebra", "Zebra: stripe count"
+    icon_name, menu = "ZebraStripes", "Zebra: stripe count"
     tip = "Cycle the number of zebra stripes over a half turn: 6, 12, 24"
 
     def Activated(self) -> None:
@@ -411,7 +439,7 @@ class ZebraStripes(_SculptCommand):
 
 
 class ZebraDirection(_SculptCommand):
-    icon_name, menu = "Zebra", "Zebra: direction"
+    icon_name, menu = "ZebraDirection", "Zebra: direction"
     tip = ("Turn the zebra stripes: the reflection lines' light strips vertical, horizontal or diagonal on "
            "the screen; the isophotes' direction +Z, +X, +Y or the space diagonal")
 
@@ -435,6 +463,27 @@ class Panel(_SculptCommand):
         if ov is not None:
             ov.panel_visible = not ov.panel_visible
             ov.refresh()
+
+
+class Group:
+    """A drop-down of commands on a toolbar (FreeCAD's Python group command): the button runs the
+    entry picked last (at first the default), its arrow lists every entry."""
+
+    def __init__(self, menu: str, tip: str, commands: list[str], default: int) -> None:
+        self.menu, self.tip, self.commands, self.default = menu, tip, tuple(commands), default
+
+    def GetResources(self) -> dict[str, Any]:
+        return {"MenuText": self.menu, "ToolTip": self.tip, "DropDownMenu": True, "Exclusive": False}
+
+    def GetCommands(self) -> tuple[str, ...]:
+        return self.commands
+
+    def GetDefaultCommand(self) -> int:
+        return self.default
+
+    def IsActive(self) -> bool:
+        """FreeCAD enables a group's entries together: while any of them can run."""
+        return any(COMMANDS[name]().IsActive() for name in self.commands)
 
 
 COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_SculptFace": SculptFace, "HapticSculpt_Session": Session,

@@ -178,12 +178,75 @@ def _task_buttons():
     return found
 
 
+def _rect(widget, rect=None):
+    """[x, y, width, height] of a widget (or of ``rect`` in its coordinates) in screen pixels (Qt
+    counts in its own units: Xvfb's 100 dpi make Qt scale them by 100/96)."""
+    rect = rect if rect is not None else widget.rect()
+    corner, scale = widget.mapToGlobal(rect.topLeft()), widget.devicePixelRatioF()
+    return [round(corner.x() * scale), round(corner.y() * scale), round(rect.width() * scale),
+            round(rect.height() * scale)]
+
+
+def _command_name(action):
+    """The command a toolbar or menu action runs (a group's entries name theirs in a property)."""
+    name = action.property("CommandName")
+    if name is None:
+        return action.objectName()
+    if isinstance(name, str):
+        return name
+    return bytes(name if isinstance(name, bytes) else name.data()).decode()  # (a QByteArray: PySide2 and 6)
+
+
+def _entries(menu):
+    """The entries of a drop-down or menu, by command name: their place if it is open, else None."""
+    return {_command_name(a): _rect(menu, menu.actionGeometry(a)) if menu.isVisible() else None
+            for a in menu.actions() if not a.isSeparator() and a.isVisible()}
+
+
+def _toolbars():
+    """What the main window shows of the toolbars and menus, read through FreeCAD's main window
+    object (no Qt import): each shown toolbar's buttons on screen by command name (a group's
+    button also lists its drop-down's entries), the buttons it hides behind its "»" extension and
+    where that is, and the open drop-down or menu's entries."""
+    mw = Gui.getMainWindow()
+    bars, buttons, groups, open_menus = {}, {}, {}, {}
+    for bar in mw.children():
+        if bar.metaObject().className() != "QToolBar" or not bar.isVisible():
+            continue
+        shown, hidden, extension = [], [], None
+        for tb in bar.children():
+            if tb.objectName() == "qt_toolbar_ext_button":  # (a QToolBarExtension)
+                extension = _rect(tb) if tb.isVisible() else None
+            elif tb.metaObject().className() == "QToolButton" and tb.defaultAction() is not None:
+                name = _command_name(tb.defaultAction())
+                if tb.isVisible():
+                    buttons[name] = _rect(tb) + [tb.isEnabled()]
+                    shown.append(name)
+                elif tb.defaultAction().isVisible():
+                    hidden.append(name)
+                if tb.menu() is not None:
+                    groups[name] = list(_entries(tb.menu()))
+                    if tb.menu().isVisible():
+                        open_menus[name] = _entries(tb.menu())
+        bars[bar.objectName()] = {"rect": _rect(bar), "buttons": shown, "hidden": extension is not None,
+                                  "behind_extension": hidden, "extension": extension}
+    menus = {}
+    for a in mw.menuBar().actions():
+        if a.menu() is not None and a.isVisible():
+            title = a.text().replace("&", "")
+            menus[title] = _rect(mw.menuBar(), mw.menuBar().actionGeometry(a))
+            if a.menu().isVisible():
+                open_menus[title] = _entries(a.menu())
+    return {"bars": bars, "buttons": buttons, "groups": groups, "menus": menus, "open": open_menus,
+            "commands": [c for c in Gui.listCommands() if c.startswith("HapticSculpt_")]}
+
+
 def write(*_):
     state = {"version": [int(x) for x in FreeCAD.Version()[:2]],
              "workbench": Gui.activeWorkbench().name() if Gui.activeWorkbench() else "",
              "active": FreeCAD.ActiveDocument.Name if FreeCAD.ActiveDocument else None, "docs": {}, "views": _views(),
              "task_dialog": bool(Gui.Control.activeDialog()), "tree": _tree_items(),
-             "task_buttons": _task_buttons()}
+             "task_buttons": _task_buttons(), "toolbars": _toolbars()}
     for name, doc in FreeCAD.listDocuments().items():
         state["docs"][name] = {"undo": list(doc.UndoNames), "redo": list(doc.RedoNames), "file": doc.FileName,
                                "modified": bool(getattr(doc, "isTouched", lambda: False)()),
