@@ -169,15 +169,19 @@ def test_the_hud_reads_over_white_zebra_stripes_and_its_legend_counts_the_stripe
                 current = overlay(d.state())["stripes"]
                 d.press_button("ZebraStripes", lambda s: overlay(s)["stripes"] != current, "the stripe count")
             s = d.wait(lambda s: overlay(s)["stripes"] == stripes and "legend_bar" in overlay(s)["hud"], "the legend")
-            time.sleep(0.5)  # (the frame after the change has been drawn: the HUD redraws at 60 Hz)
+            drawn = overlay(s)["frames"]  # (the frames after the change drawn, not merely queued)
+            d.wait(lambda s: overlay(s)["frames"] >= drawn + 2, "two frames after the change")
             img = d.shot(f"panel_zebra_{window[0]}_{stripes}")
             boxes = overlay(d.state())["hud"]
             luminance = img.mean(axis=2)
-            # the legend: as many black and white bands as the display has stripes
+            # the legend: as many black and white bands as the display has stripes, counted as its
+            # white bands (half of them) down a column through the whole bar and the dark backing
+            # around it (a few pixels each way: the box maps to the screen to within a pixel or two,
+            # and a small window's bands are only 3 px high)
             r0, r1, c0, c1 = screen_box(d, boxes["legend_bar"])
-            column = luminance[r0 + 2:r1 - 2, (c0 + c1) // 2] > 0.5
-            bands = 1 + int(np.count_nonzero(column[1:] != column[:-1]))
-            assert bands == stripes, f"the legend shows {bands} bands for {stripes} stripes"
+            column = luminance[r0 - 3:r1 + 3, (c0 + c1) // 2] > 0.5
+            white = int(np.count_nonzero(column[1:] & ~column[:-1])) + int(column[0])
+            assert 2 * white == stripes, f"the legend shows {white} white bands for {stripes} stripes"
             # no two items overlap, nor two backings
             items = {k: b for k, b in boxes.items() if not k.startswith("back_")}
             for group in (items, {k: b for k, b in boxes.items() if k.startswith("back_")}):
