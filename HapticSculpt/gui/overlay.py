@@ -42,6 +42,7 @@ class Overlay:
         self.panel = SliderPanel()
         self.cursor: tuple[np.ndarray, np.ndarray, bool] | None = None  # position, quaternion (w, x, y, z), grab
         self.contact: np.ndarray | None = None
+        self.cursor_shown = False  # whether the last frame drew the cursor
         self.frame_ms = 0.0  # cost of the last frame
         self.frames = 0
         self.mode = ""  # what the workbench is doing besides (the airbrush), shown in the HUD
@@ -64,6 +65,16 @@ class Overlay:
         """True while anything is to be drawn each frame."""
         return bool(self._session() is not None or self.display != "shading" or self.combs or self.panel_visible)
 
+    @property
+    def shown(self) -> bool:
+        """True while anything is to be drawn at all: what runs each frame, and the constraint jacks,
+        which show whenever the sculpt does (drawn once per change, no timer)."""
+        return self.needed or bool(self._visible() and self.snapshot().constraints)
+
+    def _visible(self) -> bool:
+        vobj = getattr(self.obj, "ViewObject", None)
+        return bool(vobj is None or vobj.Visibility)
+
     def _session(self) -> Any:
         return self.obj.Proxy.live.session
 
@@ -79,6 +90,7 @@ class Overlay:
             self._timer.unschedule()
             self._timer = None
         self._root.removeAllChildren()
+        self.cursor_shown = False
         if self.hud is not None:
             self.hud.clear()
 
@@ -107,8 +119,16 @@ class Overlay:
         if self.needed:
             self.start()
             self.frame()
+        elif self.shown:
+            self.stop()
+            self.frame()
         else:
             self.stop()
+
+    def drop_cursor(self) -> None:
+        """The session stopped: no device cursor, no contact (the mouse's own shows when it moves)."""
+        self.cursor = None
+        self.contact = None
 
     # --- state ------------------------------------------------------------------------------------
     def snapshot(self) -> core.DynamicSurface:
@@ -128,7 +148,7 @@ class Overlay:
         """Rebuilds the whole overlay from the current state."""
         from pivy import coin
         t0 = time.perf_counter()
-        if not self.needed:
+        if not self.shown:
             self.stop()
             return
         self._update_cursor()
@@ -141,6 +161,8 @@ class Overlay:
         glsl = stripe_shading.shaders_work() if self.per_pixel else False
         if self.display == "zebra" and glsl is None:
             scene.addChild(stripe_shading.probe())  # (per vertex this frame; the answer comes with its render)
+        if self.display != "shading":  # the display covers the face: lifted in front of it, the decor with it
+            scene.addChild(self._lift(mesh))
         if self.display == "zebra" and glsl:
             scene.addChild(self._stripes(s))
             legend = (self.display, (0.0, 1.0))
@@ -156,7 +178,8 @@ class Overlay:
                                                    every=self.comb_every, gain=self.comb_gain)
             decor.addChild(shapes.lines(segments, (1.0, 0.0, 1.0), 1.0))
         decor.addChild(self._jacks(s, mesh))
-        if self.cursor is not None:
+        self.cursor_shown = self.cursor is not None and self.needed  # (the jacks alone are not redrawn as the mouse moves)
+        if self.cursor_shown:
             decor.addChild(self._cursor(s, mesh))
         if self.panel_visible:
             grab = self.cursor[2] if self.cursor is not None else False
@@ -168,10 +191,28 @@ class Overlay:
         self._root.addChild(scene)
         if self.hud is None:
             self.hud = Hud(self.view)
+        if not self.needed:  # the jacks alone: nothing for the HUD to say
+            self.hud.clear()
+            self.frames += 1
+            return
         sliders = self.panel.values(self.obj) if self.panel_visible else []
         self.hud.update(legend, sliders, self._status(s))
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
+
+    def _lift(self, mesh: np.ndarray) -> Any:
+        """A translation toward the camera by more than the displays' meshes and the face's own
+        tessellation can be apart (each within its chordal deviation of the exact surface), so
+        neither the face's shading nor its selection highlight shows through a display at any
+        zoom. Along the view direction: the picture does not move (orthographic; by a negligible
+        scale in perspective), only the depth. Redone each frame, as the camera turns."""
+        from pivy import coin
+        move = coin.SoTranslation()
+        d = np.array(tuple(self.view.getViewDirection()), float)
+        d /= np.linalg.norm(d) or 1.0
+        lift = 2.0 * (face_deflection(self.obj) + mesh_sag(mesh)) + 1e-4 * _size(mesh)
+        move.translation.setValue(*(-lift * d))
+        return move
 
     def _stripes(self, s: core.DynamicSurface) -> Any:
         """Zebra stripes per pixel on the exact surface (sampled again only when the poles moved)."""
@@ -267,3 +308,29 @@ class Overlay:
         if self.contact is not None and grab:
             sep.addChild(shapes.lines(np.array([[pos, self.contact]]), (1.0, 0.85, 0.0), 2.0))
         return sep
+
+
+def _size(mesh: np.ndarray) -> float:
+    flat = mesh.reshape(-1, 3)
+    return float(np.linalg.norm(flat.max(0) - flat.min(0))) or 1.0
+
+
+def mesh_sag(mesh: np.ndarray) -> float:
+    """How far a grid of surface points' flat cells can be from the surface (mm): a chord's sag is
+    an eighth of the second difference along it; both directions and the twist, with a margin."""
+    if min(mesh.shape[:2]) < 3:
+        return 0.0
+    du = np.linalg.norm(mesh[2:] - 2 * mesh[1:-1] + mesh[:-2], axis=-1).max()
+    dv = np.linalg.norm(mesh[:, 2:] - 2 * mesh[:, 1:-1] + mesh[:, :-2], axis=-1).max()
+    twist = np.linalg.norm(mesh[1:, 1:] - mesh[1:, :-1] - mesh[:-1, 1:] + mesh[:-1, :-1], axis=-1).max()
+    return float(du + dv + twist) / 4.0
+
+
+def face_deflection(obj: Any) -> float:
+    """The largest distance FreeCAD's tessellation of ``obj``'s face may have from it (mm): Part's
+    view provider meshes with a deflection of Deviation percent of the bounding box's mean side
+    (the sum of its sides / 300 * Deviation)."""
+    vobj = getattr(obj, "ViewObject", None)
+    deviation = float(getattr(vobj, "Deviation", 0.5)) if vobj is not None else 0.5
+    box = obj.Shape.BoundBox
+    return (box.XLength + box.YLength + box.ZLength) / 300.0 * deviation

@@ -75,18 +75,18 @@ class ViewInput:
         self._callbacks.remove()
 
 
-def all_3d_views() -> list[Any]:
-    """Every open 3D view of every document."""
+def all_3d_views() -> list[tuple[Any, Any]]:
+    """Every open 3D view of every document, with its document."""
     import FreeCAD
     import FreeCADGui as Gui
     views = []
-    for name in FreeCAD.listDocuments():
+    for name, doc in FreeCAD.listDocuments().items():
         gdoc = Gui.getDocument(name)
         if gdoc is None:
             continue
         for view in gdoc.mdiViewsOfType("Gui::View3DInventor"):
             if hasattr(view, "addEventCallbackPivy"):
-                views.append(view)
+                views.append((doc, view))
     return views
 
 
@@ -133,9 +133,14 @@ class Controller:
             self.inputs.remove(closed)
         for key in [k for k, ov in self.overlays.items() if not ov.alive()]:
             self.overlays.pop(key).remove()
-        for view in all_3d_views():
+        from ..app.sculpt_feature import is_sculpt
+        for doc, view in all_3d_views():
             if not any(i.view is view for i in self.inputs):
                 self.inputs.append(ViewInput(self, view))
+                if self.mouse is not None:
+                    self.mouse.attach_more([view])  # a mouse session follows the pointer into views opened later
+                for obj in [o for o in doc.Objects if is_sculpt(o)]:
+                    self.overlay(obj, view).refresh()  # its jacks (if any) show in the new view at once
         for i in self.inputs:
             i.events_first(True)  # (each time: FreeCAD's Esc toggles it)
 
@@ -209,6 +214,8 @@ class Controller:
 
     def on_move(self, view: Any, cb: Any) -> None:
         pos = cb.getEvent().getPosition()
+        if view is not self.mouse_view:
+            self._follow(view)
         self.mouse_view = view
         self.mouse_point = self.point_at(view, int(pos[0]), int(pos[1]))
         if self._paint_stroke is not None:
@@ -256,6 +263,15 @@ class Controller:
             import FreeCAD
             FreeCAD.Console.PrintWarning(f"HapticSculpt: {exc}\n")
         cb.setHandled()
+
+    def _follow(self, view: Any) -> None:
+        """The pointer came into ``view``: a running session's sculpt is drawn there too (its cursor
+        and HUD follow the pointer from view to view)."""
+        obj = self.session.obj if self.session is not None else None
+        if obj is not None and _alive(obj) and (id(view), obj.Document.Name + "/" + obj.Name) not in self.overlays:
+            ov = self.overlay(obj, view)
+            if ov is not None:
+                ov.refresh()
 
     # --- the airbrush ------------------------------------------------------------------------------
     def set_painting(self, which: str | None) -> str | None:
@@ -412,7 +428,9 @@ class Controller:
             obj = self.session.obj
             self.session.stop()
             self.session = None
-            if obj is not None:
+            if obj is not None and _alive(obj):
+                for ov in self.overlays_of(obj):
+                    ov.drop_cursor()
                 self.refresh(obj)
         if self.mouse is not None:
             self.mouse.detach()

