@@ -58,7 +58,9 @@ def overlays_of(s: dict, view_id: int) -> list[dict]:
     return [o for o in s["overlays"] if o["view"] == view_id]
 
 
-FIT_ALL = ("30", "80")  # the View toolbar's first button, Fit all (FreeCAD 0.20 at 1280 x 1024)
+# The View toolbar's Fit all and Isometric buttons (FreeCAD 0.20 at 1280 x 1024), and a place off
+# the view for the mouse while a screenshot is taken.
+FIT_ALL, ISOMETRIC, AWAY, OFF_FACE = ("30", "80"), ("356", "80"), ("1100", "40"), ("80", "200")
 needs = pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD")
 
 
@@ -103,5 +105,84 @@ def test_a_focus_click_is_no_stroke_and_an_idle_session_leaves_the_document_unmo
         d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
         s = d.wait(lambda s: sculpt(s)["strokes"] == 1, "one stroke")
         assert doc_state(s)["gui_modified"], "a stroke is a change"
+    finally:
+        d.close()
+
+
+def is_face_colour(img: np.ndarray) -> np.ndarray:
+    """Pixels of the face's own colours: magenta as FreeCAD lights it (pink to salmon) and orange
+    (selected), all red-dominated; a curvature display has no red, zebra stripes are grey, and
+    the pure red of the cursor's x axis is left out."""
+    r, g, b = img[..., 0], img[..., 1], img[..., 2]
+    return (r > 0.6) & (r - g > 0.15) & (g < 0.8 * r) & ((g > 0.1) | (b > 0.1))
+
+
+def in_view(d: Desktop, shape: tuple[int, ...]) -> np.ndarray:
+    """The 3D view's pixels on the screen, without the navigation cube's corner."""
+    w, h = d.state()["views"][0]["size"]
+    (x0, y0), (x1, y1) = d.to_screen((0, 0)), d.to_screen((w - 1, h - 1))
+    inside = np.zeros(shape[:2], bool)
+    inside[min(y0, y1):max(y0, y1) + 1, min(x0, x1):max(x0, x1) + 1] = True
+    inside[min(y0, y1):min(y0, y1) + 170, max(x0, x1) - 170:] = False
+    return inside
+
+
+@needs
+def test_displays_cover_the_face_and_its_selection_at_three_zooms(tmp_path):
+    """The curvature display and the zebra stripes on a bowl seen from inside (where the face's
+    coarser tessellation is nearer the camera than the displays' meshes), isometric, at three zooms,
+    unselected and selected: inside the face's region (3 px in from its outline) not one pixel of
+    the face's own shading or of its selection highlight shows through."""
+    from scipy import ndimage
+    path = str(tmp_path / "bowl.FCStd")
+    run_freecadcmd(f"""
+        import FreeCAD, Part, HapticSculpt
+        doc = FreeCAD.newDocument("Bowl")
+        poles = [[FreeCAD.Vector(x, y, (x * x + y * y) / 100.0) for y in (-50, -17, 17, 50)]
+                 for x in (-50, -17, 17, 50)]
+        surface = Part.BSplineSurface()
+        surface.buildFromPolesMultsKnots(poles, [4, 4], [4, 4], [0.0, 1.0], [0.0, 1.0], False, False, 3, 3)
+        HapticSculpt.make_sculpt(doc, source=surface)
+        doc.recompute()
+        doc.saveAs({path!r})
+        answer({{}})
+        """, str(tmp_path / "make"))
+    d = desktop(tmp_path, path, colours=True)
+    try:
+        camera = d.state()["views"][0]["camera"]
+        d.xdo("mousemove", *ISOMETRIC, "click", "1")
+        d.wait(lambda s: s["views"][0]["camera"] != camera, "the isometric view")
+        leaks = {}
+        for selected in (False, True):
+            camera = d.state()["views"][0]["camera"]
+            d.xdo("mousemove", *FIT_ALL, "click", "1")
+            d.wait(lambda s: s["views"][0]["camera"] != camera or selected, "Fit all")
+            d.calibrate()
+            centre = d.to_screen(sculpt(d.state())["screen"][0])
+            if selected:
+                d.xdo("mousemove", str(centre[0]), str(centre[1]), "click", "1")
+                d.wait(lambda s: sculpt(s)["selected"], "the sculpt selected by a click")
+            for zoom in (0, 4, 8):
+                d.xdo("mousemove", str(centre[0]), str(centre[1]))
+                time.sleep(0.3)
+                if zoom:
+                    camera = d.state()["views"][0]["camera"]
+                    d.xdo("click", "--repeat", "4", "--delay", "100", "4")
+                    d.wait(lambda s: s["views"][0]["camera"] != camera, "the wheel to zoom in")
+                d.xdo("mousemove", *OFF_FACE)  # (the mouse's cursor off the face, no preselection)
+                time.sleep(0.3)
+                d.xdo("mousemove", *AWAY)
+                time.sleep(0.5)
+                name = f"{'selected' if selected else 'plain'}_{zoom}"
+                img = d.shot(f"focus_depth_{name}_face")
+                face = ndimage.binary_erosion(is_face_colour(img), iterations=3) & in_view(d, img.shape)
+                assert face.sum() > 5000, f"the face is not on screen ({name})"
+                for button, display in (("ShowCurvature", "curvature"), ("Zebra", "zebra")):
+                    d.press_button(button, lambda s: s["overlays"] and s["overlays"][0]["display"] == display, display)
+                    time.sleep(0.5)  # (the timer redraws at 60 Hz; a loaded machine draws late)
+                    shown = is_face_colour(d.shot(f"focus_depth_{name}_{display}"))
+                    leaks[f"{name}_{display}"] = int((shown & face).sum())
+                d.press_button("Zebra", lambda s: s["overlays"][0]["display"] == "shading", "the zebra off")
+        assert not any(leaks.values()), leaks
     finally:
         d.close()
