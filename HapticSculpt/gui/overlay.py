@@ -43,6 +43,7 @@ class Overlay:
         self.cursor: tuple[np.ndarray, np.ndarray, bool] | None = None  # position, quaternion (w, x, y, z), grab
         self.contact: np.ndarray | None = None
         self.cursor_shown = False  # whether the last frame drew the cursor
+        self.live = True  # a session is drawn each frame here (the view the pointer is in; see Controller)
         self.frame_ms = 0.0  # cost of the last frame
         self.frames = 0
         self.mode = ""  # what the workbench is doing besides (the airbrush), shown in the HUD
@@ -57,13 +58,17 @@ class Overlay:
         self._root = coin.SoSeparator()
         self._root.setName("HapticSculptOverlay")
         self._timer: Any = None
+        self._lift = coin.SoTranslation()  # see _place_lift
+        self._lift_by = 0.0
+        self._camera_sensor = coin.SoNodeSensor(lambda *_: self._place_lift(), None)
         view.getSceneGraph().addChild(self._root)
 
     # --- life cycle -------------------------------------------------------------------------------
     @property
     def needed(self) -> bool:
         """True while anything is to be drawn each frame."""
-        return bool(self._session() is not None or self.display != "shading" or self.combs or self.panel_visible)
+        return bool((self._session() is not None and self.live) or self.display != "shading" or self.combs
+                    or self.panel_visible)
 
     @property
     def shown(self) -> bool:
@@ -86,6 +91,7 @@ class Overlay:
             self._timer.schedule()
 
     def stop(self) -> None:
+        self._camera_sensor.detach()
         if self._timer is not None:
             self._timer.unschedule()
             self._timer = None
@@ -155,14 +161,18 @@ class Overlay:
         s = self.snapshot()
         mesh = np.array(s.mesh)
         scene = coin.SoSeparator()
+        unpickable = coin.SoPickStyle()  # the mouse finds the face under the displays and the jacks
+        unpickable.style = coin.SoPickStyle.UNPICKABLE
+        scene.addChild(unpickable)
         light = coin.SoLightModel()
         light.model = coin.SoLightModel.BASE_COLOR
         legend = None
         glsl = stripe_shading.shaders_work() if self.per_pixel else False
         if self.display == "zebra" and glsl is None:
             scene.addChild(stripe_shading.probe())  # (per vertex this frame; the answer comes with its render)
-        if self.display != "shading":  # the display covers the face: lifted in front of it, the decor with it
-            scene.addChild(self._lift(mesh))
+        self._lift_by = 2.0 * (face_deflection(self.obj) + mesh_sag(mesh)) + 1e-4 * _size(mesh)
+        self._place_lift()
+        scene.addChild(self._lift)  # the displays and the jacks lie on the surface: in front of the face
         if self.display == "zebra" and glsl:
             scene.addChild(self._stripes(s))
             legend = (self.display, (0.0, 1.0))
@@ -180,6 +190,9 @@ class Overlay:
         decor.addChild(self._jacks(s, mesh))
         self.cursor_shown = self.cursor is not None and self.needed  # (the jacks alone are not redrawn as the mouse moves)
         if self.cursor_shown:
+            pickable = coin.SoPickStyle()  # (as it always was: a mouse grab that picks the cursor, not
+            pickable.style = coin.SoPickStyle.SHAPE  # the face, moves on the focal plane and lifts the face)
+            decor.addChild(pickable)
             decor.addChild(self._cursor(s, mesh))
         if self.panel_visible:
             grab = self.cursor[2] if self.cursor is not None else False
@@ -200,19 +213,20 @@ class Overlay:
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
 
-    def _lift(self, mesh: np.ndarray) -> Any:
-        """A translation toward the camera by more than the displays' meshes and the face's own
-        tessellation can be apart (each within its chordal deviation of the exact surface), so
-        neither the face's shading nor its selection highlight shows through a display at any
-        zoom. Along the view direction: the picture does not move (orthographic; by a negligible
-        scale in perspective), only the depth. Redone each frame, as the camera turns."""
-        from pivy import coin
-        move = coin.SoTranslation()
+    def _place_lift(self) -> None:
+        """Moves everything drawn toward the camera by more than the displays' meshes and the face's
+        own tessellation can be apart (each within its chordal deviation of the exact surface), so
+        neither the face's shading nor its selection highlight shows through a display, nor the
+        face through a jack, at any zoom. Along the view direction the picture does not move
+        (orthographic; by a negligible scale in perspective), only the depth: placed again each
+        time the camera moves (a sensor on it), also between frames."""
+        camera = self.view.getCameraNode()
+        if self._camera_sensor.getAttachedNode() is not camera:
+            self._camera_sensor.detach()
+            self._camera_sensor.attach(camera)
         d = np.array(tuple(self.view.getViewDirection()), float)
         d /= np.linalg.norm(d) or 1.0
-        lift = 2.0 * (face_deflection(self.obj) + mesh_sag(mesh)) + 1e-4 * _size(mesh)
-        move.translation.setValue(*(-lift * d))
-        return move
+        self._lift.translation.setValue(*(-self._lift_by * d))
 
     def _stripes(self, s: core.DynamicSurface) -> Any:
         """Zebra stripes per pixel on the exact surface (sampled again only when the poles moved)."""

@@ -110,6 +110,7 @@ class Controller:
         self._paint_path: list[tuple[float, float]] = []  # where the stroke's dabs went (map coordinates)
         self.tool = "rope"
         self.falloff = "spherical"
+        self._populated: set[int] = set()  # views whose sculpts have their overlays (jacks) since they opened
 
     # --- views ------------------------------------------------------------------------------------
     def activate(self) -> None:
@@ -131,6 +132,7 @@ class Controller:
         for closed in [i for i in self.inputs if not i.alive()]:
             closed.remove()
             self.inputs.remove(closed)
+            self._populated.discard(id(closed.view))
         for key in [k for k, ov in self.overlays.items() if not ov.alive()]:
             self.overlays.pop(key).remove()
         from ..app.sculpt_feature import is_sculpt
@@ -139,6 +141,8 @@ class Controller:
                 self.inputs.append(ViewInput(self, view))
                 if self.mouse is not None:
                     self.mouse.attach_more([view])  # a mouse session follows the pointer into views opened later
+            if id(view) not in self._populated and not doc.Restoring:  # (a sculpt half read is no state)
+                self._populated.add(id(view))
                 for obj in [o for o in doc.Objects if is_sculpt(o)]:
                     self.overlay(obj, view).refresh()  # its jacks (if any) show in the new view at once
         for i in self.inputs:
@@ -265,13 +269,18 @@ class Controller:
         cb.setHandled()
 
     def _follow(self, view: Any) -> None:
-        """The pointer came into ``view``: a running session's sculpt is drawn there too (its cursor
-        and HUD follow the pointer from view to view)."""
+        """The pointer came into ``view``: a running session's sculpt is drawn each frame there, with
+        its cursor and HUD, and no longer in the view it left (one view's frames, not every view's)."""
         obj = self.session.obj if self.session is not None else None
-        if obj is not None and _alive(obj) and (id(view), obj.Document.Name + "/" + obj.Name) not in self.overlays:
-            ov = self.overlay(obj, view)
-            if ov is not None:
-                ov.refresh()
+        if obj is None or not _alive(obj):
+            return
+        if view is None:
+            self.refresh(obj)
+            return
+        self.overlay(obj, view)
+        for ov in self.overlays_of(obj):
+            ov.live = ov.view is view
+            ov.refresh()
 
     # --- the airbrush ------------------------------------------------------------------------------
     def set_painting(self, which: str | None) -> str | None:
@@ -406,7 +415,7 @@ class Controller:
         session = Session()
         session.set_airbrush(self.painting, factor=AIRBRUSH_FACTOR)  # before the first tick can grab
         self.session = session.start(obj, device, tool=obj.Proxy.live.snapshot().tool.name)
-        self.refresh(obj)
+        self._follow(self.view())
         return self.session
 
     @staticmethod
@@ -468,6 +477,7 @@ class Controller:
         for i in self.inputs:
             i.remove()
         self.inputs = []
+        self._populated.clear()
         if self._observer is not None:
             import FreeCAD
             FreeCAD.removeDocumentObserver(self._observer)
