@@ -1,9 +1,10 @@
 """The immediate-mode Coin3D overlay of one sculpt object in one 3D view (GUI only).
 
 Each frame (a Coin timer at up to 60 Hz, scheduled only while a session runs or an analysis display
-is on) the overlay throws its previous scene away and draws a new one from the current state: the
-surface coloured by the active display (shading, a material map, curvature in the paper's green/blue
-channels, mean or Gaussian curvature, zebra stripes), curvature combs, the constraint jacks (point:
+is on; the constraint jacks alone are drawn once per change) the overlay throws its previous scene
+away and draws a new one from the current state: the surface coloured by the active display
+(shading, a material map, curvature in the paper's green/blue channels, mean or Gaussian
+curvature, zebra stripes), curvature combs, the constraint jacks (point:
 red cross, normal: blue line, curvature: white circle), the cursor with its axes, the nearest surface
 point with its axes, the rope and the slider panel's tracks; its screen-space layer (:mod:`hud`)
 shows the legend of the display's range, the sliders' values, the tool and the mode. Nothing is

@@ -16,7 +16,9 @@ workbench listens, and some (OpenInventor) pass none but selection gestures. So 
 workbench is active its views send events to the scene graph first (FreeCAD's redirect, as its
 Esc toggle does), and what nobody there takes goes on to the navigation style: the wheel, the
 middle and right buttons, and a left drag that starts off every object still navigate. While the
-airbrush is on (without a session) or a mouse session runs, the left button belongs to the workbench. Airbrush strokes lay dabs along the whole
+airbrush is on (without a session) or a mouse session runs, the left button belongs to the workbench
+(a mouse session grabs once the held button moved a few pixels: the click that gives the view the
+keyboard is no stroke; the session follows the pointer from view to view, its cursor and HUD too). Airbrush strokes lay dabs along the whole
 mouse path, however fast it moves, and each stroke is one undo step. With a session the device's
 button sprays instead (Session.set_airbrush).
 """
