@@ -199,7 +199,8 @@ class LiveSurface:
         frame = sculpt_state.SculptState({**base.arrays, "Poles": np.asarray(poles, dtype=float).ravel()}, base.settings)
         self.writing = True
         try:
-            self._obj.Shape = face_of(frame)
+            with unsaved_shape(self._obj):
+                self._obj.Shape = face_of(frame)
         finally:
             self.writing = False
         if preview:
@@ -210,7 +211,8 @@ class LiveSurface:
         outside any transaction, before the next one opens, so Undo never restores a frame."""
         self.writing = True
         try:
-            self._obj.Shape = face_of(read_state(self._obj))
+            with unsaved_shape(self._obj):
+                self._obj.Shape = face_of(read_state(self._obj))
         finally:
             self.writing = False
         notify_dependents(self._obj)
@@ -258,6 +260,24 @@ class LiveSurface:
 
 def _maps(surface: core.DynamicSurface) -> dict[str, np.ndarray]:
     return {name: np.array(getattr(surface, name + "_map").values) for name in core.MAPS}
+
+
+class unsaved_shape:
+    """Writes to ``obj.Shape`` inside are no change to save (a session's frames, the stored face put
+    back): FreeCAD's GUI does not mark the document modified for a property with NoModify, so a
+    session that commits nothing leaves it unmodified. The object is not left touched either."""
+
+    def __init__(self, obj: Any) -> None:
+        self.obj = obj
+
+    def __enter__(self) -> None:
+        self.touched = "Touched" in self.obj.State
+        self.obj.setPropertyStatus("Shape", "NoModify")
+
+    def __exit__(self, *exc: Any) -> None:
+        self.obj.setPropertyStatus("Shape", "-NoModify")
+        if not self.touched:
+            self.obj.purgeTouched()
 
 
 def notify_dependents(obj: Any, frame: sculpt_state.SculptState | None = None) -> None:

@@ -6,11 +6,16 @@ from typing import Any, Callable, Sequence
 from ..core import native as _core
 
 
+#: A press grabs once the pointer has moved this many pixels with the button held: a click (to
+#: give the view the keyboard, say) is no stroke.
+GRAB_PIXELS = 4
+
+
 class MouseDevice:
     """The 3D cursor follows the mouse in a FreeCAD 3D view: onto the surface under the pointer, or
-    onto the view's focal plane elsewhere; the left button grabs. Only usable with the GUI up.
-    ``yields(view, pixel)``: True where a press belongs to something else (the slider panel): the
-    device neither grabs nor takes that press, nor its release."""
+    onto the view's focal plane elsewhere; the left button, held and moved, grabs. Only usable
+    with the GUI up. ``yields(view, pixel)``: True where a press belongs to something else (the
+    slider panel): the device neither grabs nor takes that press, nor its release."""
 
     def __init__(self, name: str = "mouse", yields: Callable[[Any, tuple[int, int]], bool] | None = None) -> None:
         self.yields = yields
@@ -18,6 +23,7 @@ class MouseDevice:
         self._callbacks: list[Any] = []
         self._buttons = 0
         self._position = (0.0, 0.0, 0.0)
+        self._pressed: tuple[Any, int, int] | None = None  # view and pixel of a press not yet a grab
 
     def attach(self, view: Any) -> None:
         """Follows the mouse in ``view`` (a FreeCADGui 3D view) until :meth:`detach`."""
@@ -25,10 +31,14 @@ class MouseDevice:
 
     def attach_all(self, views: Sequence[Any]) -> None:
         """Follows the mouse in each of ``views``, wherever it is, until :meth:`detach`."""
+        self.detach()
+        self.attach_more(views)
+
+    def attach_more(self, views: Sequence[Any]) -> None:
+        """Follows the mouse in ``views`` too (views opened during a session)."""
         from pivy import coin
 
         from .coin_events import FrontCallbacks
-        self.detach()
         for view in views:
             self._callbacks.append(FrontCallbacks(view, [
                 (coin.SoLocation2Event, (lambda v: lambda cb: self._on_move(v, cb))(view)),
@@ -60,8 +70,13 @@ class MouseDevice:
 
     def _on_move(self, view: Any, cb: Any) -> None:
         pos = cb.getEvent().getPosition()
+        if self._pressed is not None and self._pressed[0] is view and \
+                max(abs(int(pos[0]) - self._pressed[1]), abs(int(pos[1]) - self._pressed[2])) >= GRAB_PIXELS:
+            self.move_to(view, self._pressed[1:])
+            self.press(True)  # the grab starts where the button went down
+            self._pressed = None
         self.move_to(view, (pos[0], pos[1]))
-        if self._buttons:
+        if self._buttons or self._pressed is not None:
             cb.setHandled()  # a grab: not a selection box or a rotation
 
     def _on_button(self, view: Any, cb: Any) -> None:
@@ -70,8 +85,14 @@ class MouseDevice:
         if event.getButton() == coin.SoMouseButtonEvent.BUTTON1:
             pos = event.getPosition()
             down = event.getState() == coin.SoButtonEvent.DOWN
-            if (down and self.yields is not None and self.yields(view, (pos[0], pos[1]))) or (not down and not self._buttons):
+            if down and self.yields is not None and self.yields(view, (pos[0], pos[1])):
                 return
+            if not down and not self._buttons and self._pressed is None:
+                return  # (the release of a press it did not take)
             self.move_to(view, (pos[0], pos[1]))
-            self.press(down)
+            if event.getState() == coin.SoButtonEvent.DOWN:
+                self._pressed = (view, int(pos[0]), int(pos[1]))  # a grab once it moves (GRAB_PIXELS)
+            else:
+                self._pressed = None
+                self.press(False)
             cb.setHandled()

@@ -1,9 +1,10 @@
 """The immediate-mode Coin3D overlay of one sculpt object in one 3D view (GUI only).
 
 Each frame (a Coin timer at up to 60 Hz, scheduled only while a session runs or an analysis display
-is on) the overlay throws its previous scene away and draws a new one from the current state: the
-surface coloured by the active display (shading, a material map, curvature in the paper's green/blue
-channels, mean or Gaussian curvature, zebra stripes), curvature combs, the constraint jacks (point:
+is on; the constraint jacks alone are drawn once per change) the overlay throws its previous scene
+away and draws a new one from the current state: the surface coloured by the active display
+(shading, a material map, curvature in the paper's green/blue channels, mean or Gaussian
+curvature, zebra stripes), curvature combs, the constraint jacks (point:
 red cross, normal: blue line, curvature: white circle), the cursor with its axes, the nearest surface
 point with its axes and the rope; its screen-space layer (:mod:`hud`) shows the legend of the
 display's range, the slider panel (operated with the mouse there), the tool and the mode. Nothing is
@@ -42,6 +43,8 @@ class Overlay:
         self.panel = SliderPanel()
         self.cursor: tuple[np.ndarray, np.ndarray, bool] | None = None  # position, quaternion (w, x, y, z), grab
         self.contact: np.ndarray | None = None
+        self.cursor_shown = False  # whether the last frame drew the cursor
+        self.live = True  # a session is drawn each frame here (the view the pointer is in; see Controller)
         self.frame_ms = 0.0  # cost of the last frame
         self.frames = 0
         self.mode = ""  # what the workbench is doing besides (the airbrush), shown in the HUD
@@ -56,13 +59,27 @@ class Overlay:
         self._root = coin.SoSeparator()
         self._root.setName("HapticSculptOverlay")
         self._timer: Any = None
+        self._lift = coin.SoTranslation()  # see _place_lift
+        self._lift_by = 0.0
+        self._camera_sensor = coin.SoNodeSensor(lambda *_: self._place_lift(), None)
         view.getSceneGraph().addChild(self._root)
 
     # --- life cycle -------------------------------------------------------------------------------
     @property
     def needed(self) -> bool:
         """True while anything is to be drawn each frame."""
-        return bool(self._session() is not None or self.display != "shading" or self.combs or self.panel_visible)
+        return bool((self._session() is not None and self.live) or self.display != "shading" or self.combs
+                    or self.panel_visible)
+
+    @property
+    def shown(self) -> bool:
+        """True while anything is to be drawn at all: what runs each frame, and the constraint jacks,
+        which show whenever the sculpt does (drawn once per change, no timer)."""
+        return self.needed or bool(self._visible() and self.snapshot().constraints)
+
+    def _visible(self) -> bool:
+        vobj = getattr(self.obj, "ViewObject", None)
+        return bool(vobj is None or vobj.Visibility)
 
     def _session(self) -> Any:
         return self.obj.Proxy.live.session
@@ -75,10 +92,12 @@ class Overlay:
             self._timer.schedule()
 
     def stop(self) -> None:
+        self._camera_sensor.detach()
         if self._timer is not None:
             self._timer.unschedule()
             self._timer = None
         self._root.removeAllChildren()
+        self.cursor_shown = False
         if self.hud is not None:
             self.hud.clear()
 
@@ -107,8 +126,16 @@ class Overlay:
         if self.needed:
             self.start()
             self.frame()
+        elif self.shown:
+            self.stop()
+            self.frame()
         else:
             self.stop()
+
+    def drop_cursor(self) -> None:
+        """The session stopped: no device cursor, no contact (the mouse's own shows when it moves)."""
+        self.cursor = None
+        self.contact = None
 
     # --- state ------------------------------------------------------------------------------------
     def snapshot(self) -> core.DynamicSurface:
@@ -128,19 +155,25 @@ class Overlay:
         """Rebuilds the whole overlay from the current state."""
         from pivy import coin
         t0 = time.perf_counter()
-        if not self.needed:
+        if not self.shown:
             self.stop()
             return
         self._update_cursor()
         s = self.snapshot()
         mesh = np.array(s.mesh)
         scene = coin.SoSeparator()
+        unpickable = coin.SoPickStyle()  # the mouse finds the face under the displays and the jacks
+        unpickable.style = coin.SoPickStyle.UNPICKABLE
+        scene.addChild(unpickable)
         light = coin.SoLightModel()
         light.model = coin.SoLightModel.BASE_COLOR
         legend = None
         glsl = stripe_shading.shaders_work() if self.per_pixel else False
         if self.display == "zebra" and glsl is None:
             scene.addChild(stripe_shading.probe())  # (per vertex this frame; the answer comes with its render)
+        self._lift_by = 2.0 * (face_deflection(self.obj) + mesh_sag(mesh)) + 1e-4 * _size(mesh)
+        self._place_lift()
+        scene.addChild(self._lift)  # the displays and the jacks lie on the surface: in front of the face
         if self.display == "zebra" and glsl:
             scene.addChild(self._stripes(s))
             legend = (self.display, (0.0, 1.0))
@@ -156,13 +189,21 @@ class Overlay:
                                                    every=self.comb_every, gain=self.comb_gain)
             decor.addChild(shapes.lines(segments, (1.0, 0.0, 1.0), 1.0))
         decor.addChild(self._jacks(s, mesh))
-        if self.cursor is not None:
+        self.cursor_shown = self.cursor is not None and self.needed  # (the jacks alone are not redrawn as the mouse moves)
+        if self.cursor_shown:
+            pickable = coin.SoPickStyle()  # (as it always was: a mouse grab that picks the cursor, not
+            pickable.style = coin.SoPickStyle.SHAPE  # the face, moves on the focal plane and lifts the face)
+            decor.addChild(pickable)
             decor.addChild(self._cursor(s, mesh))
         scene.addChild(decor)
         self._root.removeAllChildren()
         self._root.addChild(scene)
         if self.hud is None:
             self.hud = Hud(self.view)
+        if not self.needed:  # the jacks alone: nothing for the HUD to say
+            self.hud.clear()
+            self.frames += 1
+            return
         sliders = self.panel.values(self.obj) if self.panel_visible else []
         self.hud.update(legend, sliders, self._status(s), zebra_bands=int(self.stripes))
         self.frames += 1
@@ -197,6 +238,21 @@ class Overlay:
             return False
         self.frame()
         return True
+
+    def _place_lift(self) -> None:
+        """Moves everything drawn toward the camera by more than the displays' meshes and the face's
+        own tessellation can be apart (each within its chordal deviation of the exact surface), so
+        neither the face's shading nor its selection highlight shows through a display, nor the
+        face through a jack, at any zoom. Along the view direction the picture does not move
+        (orthographic; by a negligible scale in perspective), only the depth: placed again each
+        time the camera moves (a sensor on it), also between frames."""
+        camera = self.view.getCameraNode()
+        if self._camera_sensor.getAttachedNode() is not camera:
+            self._camera_sensor.detach()
+            self._camera_sensor.attach(camera)
+        d = np.array(tuple(self.view.getViewDirection()), float)
+        d /= np.linalg.norm(d) or 1.0
+        self._lift.translation.setValue(*(-self._lift_by * d))
 
     def _stripes(self, s: core.DynamicSurface) -> Any:
         """Zebra stripes per pixel on the exact surface (sampled again only when the poles moved)."""
@@ -292,3 +348,29 @@ class Overlay:
         if self.contact is not None and grab:
             sep.addChild(shapes.lines(np.array([[pos, self.contact]]), (1.0, 0.85, 0.0), 2.0))
         return sep
+
+
+def _size(mesh: np.ndarray) -> float:
+    flat = mesh.reshape(-1, 3)
+    return float(np.linalg.norm(flat.max(0) - flat.min(0))) or 1.0
+
+
+def mesh_sag(mesh: np.ndarray) -> float:
+    """How far a grid of surface points' flat cells can be from the surface (mm): a chord's sag is
+    an eighth of the second difference along it; both directions and the twist, with a margin."""
+    if min(mesh.shape[:2]) < 3:
+        return 0.0
+    du = np.linalg.norm(mesh[2:] - 2 * mesh[1:-1] + mesh[:-2], axis=-1).max()
+    dv = np.linalg.norm(mesh[:, 2:] - 2 * mesh[:, 1:-1] + mesh[:, :-2], axis=-1).max()
+    twist = np.linalg.norm(mesh[1:, 1:] - mesh[1:, :-1] - mesh[:-1, 1:] + mesh[:-1, :-1], axis=-1).max()
+    return float(du + dv + twist) / 4.0
+
+
+def face_deflection(obj: Any) -> float:
+    """The largest distance FreeCAD's tessellation of ``obj``'s face may have from it (mm): Part's
+    view provider meshes with a deflection of Deviation percent of the bounding box's mean side
+    (the sum of its sides / 300 * Deviation)."""
+    vobj = getattr(obj, "ViewObject", None)
+    deviation = float(getattr(vobj, "Deviation", 0.5)) if vobj is not None else 0.5
+    box = obj.Shape.BoundBox
+    return (box.XLength + box.YLength + box.ZLength) / 300.0 * deviation

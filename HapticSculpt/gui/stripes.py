@@ -132,11 +132,11 @@ def stripe_mesh(mesh: np.ndarray, texture: tuple[bytes, bytes], size: int, mode:
     g, h = mesh.shape[:2]
     us, vs = np.linspace(0.0, 1.0, g), np.linspace(0.0, 1.0, h)
     sep = coin.SoSeparator()
-    # Pulled toward the viewer by more than the gap between this mesh and the Part face's coarser
-    # tessellation (a fraction of a millimetre), so the face never shows through the stripes.
+    # A hair toward the viewer where the surface is steep on screen; the overlay lifts the whole
+    # display in front of the face by its tessellation's deviation (Overlay._lift).
     offset = coin.SoPolygonOffset()
-    offset.factor = -2.0
-    offset.units = -20000.0
+    offset.factor = -1.0
+    offset.units = -1.0
     sep.addChild(offset)
     complexity = coin.SoComplexity()
     complexity.textureQuality = 0.1  # nearest texels, no mipmaps (0 would switch texturing off): the shader

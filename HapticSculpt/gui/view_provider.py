@@ -37,6 +37,13 @@ class SculptViewProvider(_Stateless):
     def attach(self, vobj: Any) -> None:
         self.Object = vobj.Object
 
+    def onChanged(self, vobj: Any, prop: str) -> None:
+        if prop == "Visibility":  # the constraint jacks show and hide with the sculpt
+            from .workbench import controller
+            ctl = controller()
+            for ov in ctl.overlays_of(vobj.Object) if ctl.inputs else []:
+                ov.refresh()
+
     def getIcon(self) -> str:
         return icon("HapticSculpt")
 

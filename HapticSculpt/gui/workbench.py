@@ -16,7 +16,9 @@ workbench listens, and some (OpenInventor) pass none but selection gestures. So 
 workbench is active its views send events to the scene graph first (FreeCAD's redirect, as its
 Esc toggle does), and what nobody there takes goes on to the navigation style: the wheel, the
 middle and right buttons, and a left drag that starts off every object still navigate. While the
-airbrush is on (without a session) or a mouse session runs, the left button belongs to the workbench. Airbrush strokes lay dabs along the whole
+airbrush is on (without a session) or a mouse session runs, the left button belongs to the workbench
+(a mouse session grabs once the held button moved a few pixels: the click that gives the view the
+keyboard is no stroke; the session follows the pointer from view to view, its cursor and HUD too). Airbrush strokes lay dabs along the whole
 mouse path, however fast it moves, and each stroke is one undo step. With a session the device's
 button sprays instead (Session.set_airbrush).
 """
@@ -75,18 +77,18 @@ class ViewInput:
         self._callbacks.remove()
 
 
-def all_3d_views() -> list[Any]:
-    """Every open 3D view of every document."""
+def all_3d_views() -> list[tuple[Any, Any]]:
+    """Every open 3D view of every document, with its document."""
     import FreeCAD
     import FreeCADGui as Gui
     views = []
-    for name in FreeCAD.listDocuments():
+    for name, doc in FreeCAD.listDocuments().items():
         gdoc = Gui.getDocument(name)
         if gdoc is None:
             continue
         for view in gdoc.mdiViewsOfType("Gui::View3DInventor"):
             if hasattr(view, "addEventCallbackPivy"):
-                views.append(view)
+                views.append((doc, view))
     return views
 
 
@@ -110,6 +112,7 @@ class Controller:
         self._paint_path: list[tuple[float, float]] = []  # where the stroke's dabs went (map coordinates)
         self.tool = "rope"
         self.falloff = "spherical"
+        self._populated: set[int] = set()  # views whose sculpts have their overlays (jacks) since they opened
 
     # --- views ------------------------------------------------------------------------------------
     def activate(self) -> None:
@@ -131,11 +134,19 @@ class Controller:
         for closed in [i for i in self.inputs if not i.alive()]:
             closed.remove()
             self.inputs.remove(closed)
+            self._populated.discard(id(closed.view))
         for key in [k for k, ov in self.overlays.items() if not ov.alive()]:
             self.overlays.pop(key).remove()
-        for view in all_3d_views():
+        from ..app.sculpt_feature import is_sculpt
+        for doc, view in all_3d_views():
             if not any(i.view is view for i in self.inputs):
                 self.inputs.append(ViewInput(self, view))
+                if self.mouse is not None:
+                    self.mouse.attach_more([view])  # a mouse session follows the pointer into views opened later
+            if id(view) not in self._populated and not doc.Restoring:  # (a sculpt half read is no state)
+                self._populated.add(id(view))
+                for obj in [o for o in doc.Objects if is_sculpt(o)]:
+                    self.overlay(obj, view).refresh()  # its jacks (if any) show in the new view at once
         for i in self.inputs:
             i.events_first(True)  # (each time: FreeCAD's Esc toggles it)
 
@@ -212,6 +223,8 @@ class Controller:
         if any(ov.panel_drag(float(pos[0])) for ov in self.overlays.values()):
             cb.setHandled()  # a slider drag: neither a stroke nor a rotation
             return
+        if view is not self.mouse_view:
+            self._follow(view)
         self.mouse_view = view
         self.mouse_point = self.point_at(view, int(pos[0]), int(pos[1]))
         if self._paint_stroke is not None:
@@ -276,6 +289,20 @@ class Controller:
             import FreeCAD
             FreeCAD.Console.PrintWarning(f"HapticSculpt: {exc}\n")
         cb.setHandled()
+
+    def _follow(self, view: Any) -> None:
+        """The pointer came into ``view``: a running session's sculpt is drawn each frame there, with
+        its cursor and HUD, and no longer in the view it left (one view's frames, not every view's)."""
+        obj = self.session.obj if self.session is not None else None
+        if obj is None or not _alive(obj):
+            return
+        if view is None:
+            self.refresh(obj)
+            return
+        self.overlay(obj, view)
+        for ov in self.overlays_of(obj):
+            ov.live = ov.view is view
+            ov.refresh()
 
     # --- the airbrush ------------------------------------------------------------------------------
     def set_painting(self, which: str | None) -> str | None:
@@ -410,7 +437,7 @@ class Controller:
         session = Session()
         session.set_airbrush(self.painting, factor=AIRBRUSH_FACTOR)  # before the first tick can grab
         self.session = session.start(obj, device, tool=obj.Proxy.live.snapshot().tool.name)
-        self.refresh(obj)
+        self._follow(self.view())
         return self.session
 
     @staticmethod
@@ -432,7 +459,9 @@ class Controller:
             obj = self.session.obj
             self.session.stop()
             self.session = None
-            if obj is not None:
+            if obj is not None and _alive(obj):
+                for ov in self.overlays_of(obj):
+                    ov.drop_cursor()
                 self.refresh(obj)
         if self.mouse is not None:
             self.mouse.detach()
@@ -470,6 +499,7 @@ class Controller:
         for i in self.inputs:
             i.remove()
         self.inputs = []
+        self._populated.clear()
         if self._observer is not None:
             import FreeCAD
             FreeCAD.removeDocumentObserver(self._observer)

@@ -151,7 +151,7 @@ def _views():
                 out.append({"doc": name, "size": list(v.getSize()), "cursor": list(v.getCursorPos()),
                             "pixel": _pixel(v),
                             "camera": v.getCamera(),
-                            "active": v is getattr(Gui.ActiveDocument, "ActiveView", None),
+                            "active": v is getattr(Gui.ActiveDocument, "ActiveView", None), "id": id(v),
                             "redirect": bool(v.getViewer().isRedirectedToSceneGraph())})
             except Exception:  # noqa: BLE001 - a view closing
                 pass
@@ -250,6 +250,7 @@ def write(*_):
     for name, doc in FreeCAD.listDocuments().items():
         state["docs"][name] = {"undo": list(doc.UndoNames), "redo": list(doc.RedoNames), "file": doc.FileName,
                                "modified": bool(getattr(doc, "isTouched", lambda: False)()),
+                               "gui_modified": bool(getattr(Gui.getDocument(name), "Modified", False)),
                                "sculpts": _sculpts(doc), "objects": [o.Name for o in doc.Objects],
                                "solids": _solids(doc), "features": _features(doc),
                                "screen": {o.Name: _on_screen(o) for o in doc.Objects if hasattr(o, "Shape")}}
@@ -262,7 +263,9 @@ def write(*_):
         state["overlays"] = [{"display": ov.display, "frames": ov.frames, "view_size": list(ov.view.getSize()),
                               "hud": ov.hud.boxes() if ov.hud is not None else {},
                               "sliders": ov.panel.values(ov.obj) if ov.panel_visible else [],
-                              "stripes": ov.stripes, "active_view": ov.view is getattr(Gui.ActiveDocument, "ActiveView", None)}
+                              "stripes": ov.stripes, "active_view": ov.view is getattr(Gui.ActiveDocument, "ActiveView", None),
+                              "view": id(ov.view), "object": ov.obj.Name, "cursor": ov.cursor_shown,
+                              "drawn": ov._root.getNumChildren() > 0}
                              for ov in ctl.overlays.values()]
     except Exception as exc:  # noqa: BLE001 - the workbench not loaded yet
         state["controller_error"] = str(exc)
