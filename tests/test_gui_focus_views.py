@@ -124,6 +124,9 @@ def in_view(d: Desktop, shape: tuple[int, ...]) -> np.ndarray:
     inside = np.zeros(shape[:2], bool)
     inside[min(y0, y1):max(y0, y1) + 1, min(x0, x1):max(x0, x1) + 1] = True
     inside[min(y0, y1):min(y0, y1) + 170, max(x0, x1) - 170:] = False
+    for bar in d.state()["toolbars"]["bars"].values():  # (the calibration is only as good as the view's
+        x, y, bw, bh = bar["rect"]                      # reported mouse; a toolbar's red record button
+        inside[max(y, 0):y + bh, max(x, 0):x + bw] = False  # is no face)
     return inside
 
 

@@ -241,12 +241,30 @@ def _toolbars():
             "commands": [c for c in Gui.listCommands() if c.startswith("HapticSculpt_")]}
 
 
+def _widget_rect(class_name):
+    """[x, y, width, height] on the screen of the first shown widget of that class, else None."""
+    stack = [Gui.getMainWindow()]
+    while stack:
+        w = stack.pop()
+        if w.metaObject().className() == class_name and w.isVisible():
+            return _rect(w)
+        stack.extend(c for c in w.children() if c.isWidgetType())
+    return None
+
+
+def _focus():
+    """The class of the widget that has the main window's keyboard focus."""
+    w = Gui.getMainWindow().focusWidget()
+    return w.metaObject().className() if w is not None else None
+
+
 def write(*_):
     state = {"version": [int(x) for x in FreeCAD.Version()[:2]],
              "workbench": Gui.activeWorkbench().name() if Gui.activeWorkbench() else "",
              "active": FreeCAD.ActiveDocument.Name if FreeCAD.ActiveDocument else None, "docs": {}, "views": _views(),
              "task_dialog": bool(Gui.Control.activeDialog()), "tree": _tree_items(),
-             "task_buttons": _task_buttons(), "toolbars": _toolbars()}
+             "task_buttons": _task_buttons(), "toolbars": _toolbars(), "console": _widget_rect("Gui::PythonConsole"),
+             "focus": _focus()}
     for name, doc in FreeCAD.listDocuments().items():
         state["docs"][name] = {"undo": list(doc.UndoNames), "redo": list(doc.RedoNames), "file": doc.FileName,
                                "modified": bool(getattr(doc, "isTouched", lambda: False)()),

@@ -1,0 +1,45 @@
+"""The workbench's keys and ctrl+z in the 3D view whatever widget had the keyboard last: after
+typing in the Python console, the pointer over the view is enough (real X events through xdotool;
+the observer reads which widget has the focus)."""
+from __future__ import annotations
+
+import pytest
+from test_gui_real_input import NEEDS, Desktop, sculpt, undo
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD's GUI")
+def test_keys_and_undo_reach_the_view_under_the_pointer_after_the_console_had_them(tmp_path):
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        s = d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        d.calibrate()
+        centre, east, west, _, _ = [d.to_screen(p) for p in sculpt(s)["screen"]]
+        for at, key, kind in ((east, "p", "point"), (west, "n", "normal")):
+            # the console takes the keyboard: a click in it and a line typed there
+            x, y, w, h = d.state()["console"]
+            d.xdo("mousemove", str(x + w // 2), str(y + h // 2), "click", "1")
+            d.wait(lambda s: s["focus"] == "Gui::PythonConsole", "the console to have the keyboard")
+            d.xdo("type", "--delay", "20", "hs_typed = 1")
+            d.xdo("key", "Return")
+            before = len(sculpt(d.state())["constraints"])
+            # the pointer into the view, then the key: a constraint, not a letter in the console
+            d.xdo("mousemove", str(at[0]), str(at[1]))
+            d.wait(lambda s: s["focus"] != "Gui::PythonConsole" and s["mouse_point"] is not None,
+                   "the view to take the keyboard under the pointer")
+            d.xdo("key", key)
+            s = d.wait(lambda s: len(sculpt(s)["constraints"]) == before + 1, f"{key.upper()}: a {kind} constraint")
+            assert sculpt(s)["constraints"][-1][0] == kind
+        d.shot("focus_keys_constraints")
+        # ctrl+z after the console had the keyboard again: FreeCAD's Undo, not the console's
+        x, y, w, h = d.state()["console"]
+        d.xdo("mousemove", str(x + w // 2), str(y + h // 2), "click", "1")
+        d.wait(lambda s: s["focus"] == "Gui::PythonConsole", "the console to have the keyboard")
+        names = undo(d.state())
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.wait(lambda s: s["focus"] != "Gui::PythonConsole", "the view to take the keyboard")
+        d.xdo("key", "ctrl+z")
+        s = d.wait(lambda s: undo(s) == names[1:], "ctrl+z: the last constraint undone")
+        assert len(sculpt(s)["constraints"]) == 1
+        d.shot("focus_keys_undone")
+    finally:
+        d.close()
