@@ -19,7 +19,7 @@ TOOLBAR = ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "HapticSculpt_Ses
            "HapticSculpt_Panel", "HapticSculpt_CombDensity", "HapticSculpt_CombScale", "HapticSculpt_Thicken",
            "HapticSculpt_ExportStep"]
 #: The menu: the toolbar's commands and the ones that are only in the menu.
-MENU = TOOLBAR[:5] + ["HapticSculpt_HoldEdges"] + TOOLBAR[5:]
+MENU = TOOLBAR[:5] + ["HapticSculpt_HoldEdges", "HapticSculpt_Fair"] + TOOLBAR[5:]
 
 
 def _selected_sculpts() -> list[Any]:
@@ -210,6 +210,16 @@ class KeepShape(_SculptCommand):
     def Activated(self) -> None:
         from .echo import ref, run_echoed
         run_echoed(f"HapticSculpt.keep_shape({ref(_ctl().active_sculpt())})")
+
+
+class Fair(_SculptCommand):
+    icon_name, menu = "Session", "Fair"
+    tip = ("Relax the curvature variation of the active sculpt (waves, tents, creases) while its held and "
+           "linked poles and its symmetry hold; one undo step")
+
+    def Activated(self) -> None:
+        from .echo import ref, run_echoed
+        run_echoed(f"HapticSculpt.fair({ref(_ctl().active_sculpt())})")
 
 
 class HoldEdges(_SculptCommand):
@@ -440,7 +450,7 @@ class Panel(_SculptCommand):
 
 COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_SculptFace": SculptFace, "HapticSculpt_Session": Session,
             "HapticSculpt_Material": Material, "HapticSculpt_KeepShape": KeepShape,
-            "HapticSculpt_HoldEdges": HoldEdges,
+            "HapticSculpt_HoldEdges": HoldEdges, "HapticSculpt_Fair": Fair,
             "HapticSculpt_ToolRope": ToolRope, "HapticSculpt_ToolMagnet": ToolMagnet,
             "HapticSculpt_MagnetFalloff": MagnetFalloff, "HapticSculpt_ToolOrientation": ToolOrientation,
             "HapticSculpt_ToolSmooth": ToolSmooth, "HapticSculpt_PointConstraint": PointConstraint,
