@@ -152,6 +152,27 @@ TEST_P(AllocationFree, SteppingWithToolConstraintsAndLawsDoesNotAllocate) {
     EXPECT_EQ(allocationsWhileSculpting(s, 1e4, 1e-3, [](const StepReport& r) { ASSERT_FALSE(r.refused); }), 0);
 }
 
+TEST_P(AllocationFree, SteppingWithBendingDoesNotAllocate) {
+    // The bending energy (a painted map, clay's reference following the plastic flow) in every scheme.
+    DynamicSurface s(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 30, 30);
+    { SolverSettings solver = s.solver(); solver.kind = GetParam(); s.setSolver(solver); }
+    s.bendingMap().setUniform(10.0);
+    s.bendingMap().dab(0.3, 0.6, 0.2, 40.0, Falloff::Spherical, 1.0);
+    EXPECT_EQ(allocationsWhileSculpting(s, 1e4, 1e-3, [](const StepReport& r) { ASSERT_FALSE(r.refused); }), 0);
+    EXPECT_GT(s.bending().energy(s.mesh()), 0.0);
+}
+
+TEST(Verlet, SteppingWithBendingDoesNotAllocate) {
+    DynamicSurface s(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 30, 30);
+    s.bendingMap().setUniform(10.0);
+    const double dt = 0.5 * s.verletStepLimit();
+    ASSERT_GT(dt, 0.0);
+    EXPECT_EQ(allocationsWhileSculpting(s, 1.0, dt, [](const StepReport& r) {
+                  ASSERT_TRUE(r.verlet);
+                  ASSERT_FALSE(r.refused);
+              }), 0);
+}
+
 TEST(Verlet, SteppingWithToolConstraintsForcesAndPlasticityDoesNotAllocate) {
     // Local/global's explicit branch on a soft patch (linear laws: the only ones it takes).
     DynamicSurface s(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 30, 30);
