@@ -3,6 +3,7 @@ errors), make_sculpt's held edges, and the bending weight saved and reopened wit
 from __future__ import annotations
 
 import os
+import time
 
 import FreeCAD
 import numpy as np
@@ -38,6 +39,30 @@ class TestFair(DocumentTestCase):
         self.assertEqual(obj.Shape.Faces[0].Surface.getPoles()[3][3].z, after[3 * 8 + 3][2])  # shown at once
         self.doc.undo()
         np.testing.assert_array_equal(np.array(obj.Poles).reshape(-1, 3), poles)
+
+    def test_fair_during_a_session_is_taken_at_once_and_committed(self):
+        obj = hs.make_sculpt(self.doc, material="clay", mesh=(24, 24), edges="G0")
+        stroke(obj)
+        held = obj.Proxy.live.snapshot().held_poles
+        before = np.array(obj.Proxy.surface.poles).reshape(-1, 3)
+        idle = hs.ReplayDevice([0.0, 30.0], [(0.0, 0.0, 60.0)] * 2, buttons=[0, 0])  # no grab: no stroke
+        session = hs.Session().start(obj, idle)
+        try:
+            end = time.monotonic() + 30
+            while session.status()["elapsed"] < 0.2:
+                self.assertLess(time.monotonic(), end, "the session never ran")
+                time.sleep(0.01)
+            hs.fair(obj)
+            while not session.applied_edits:
+                self.assertLess(time.monotonic(), end, "the fair never applied")
+                session.poll()
+                time.sleep(0.01)
+        finally:
+            session.stop()
+        self.assertIn("Fair", self.doc.UndoNames)
+        after = np.array(obj.Proxy.surface.poles).reshape(-1, 3)
+        np.testing.assert_array_equal(after[held], before[held])
+        self.assertGreater(np.abs(after - before).max(), 1e-3)
 
     def test_fair_in_a_region_leaves_the_rest(self):
         obj = hs.make_sculpt(self.doc, material="clay")
