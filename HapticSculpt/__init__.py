@@ -14,6 +14,7 @@ from .app.api import (
                       export_step,
                       held_boundary,
                       hold_boundary,
+                      fair,
                       keep_shape,
                       make_sculpt,
                       make_thickness,
@@ -38,7 +39,7 @@ from .version import __version__
 
 legacy_paths.install()
 
-__all__ = ["make_sculpt", "sculpt_solid", "set_boundary", "boundary_of", "seam_report_of", "run", "add_constraint", "remove_constraint", "hold_boundary", "held_boundary",
+__all__ = ["make_sculpt", "fair", "sculpt_solid", "set_boundary", "boundary_of", "seam_report_of", "run", "add_constraint", "remove_constraint", "hold_boundary", "held_boundary",
            "set_material", "material_of", "keep_shape",
            "set_tool", "set_uniform", "set_curvature_target", "paint", "record_state", "replay_stroke",
            "export_step", "thicken", "make_thickness",

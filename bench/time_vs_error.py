@@ -34,6 +34,11 @@ seconds_per_sim_second, error) and time_vs_error.png, prints each solver's faste
 level 1e-2 .. 1e-6 and the default's speed-up over the paper's schemes. Finished runs are kept if
 interrupted (Ctrl-C writes what is done). ``--scenes rope,two_faces`` runs only those scenes and
 replaces their records in the JSON (every scene's solvers are compared within one run).
+
+``--fairness`` runs only the fair-stroke measure (issue 26): curvature sign changes and total
+variation along sections of a rope stroke, free and pinned, clay and elastic, with and without the
+bending energy, and the per-step time of each integrator with and without it
+(bench/results/fairness.json; see fairness_table).
 """
 from __future__ import annotations
 
@@ -47,7 +52,7 @@ import numpy as np
 from scipy import optimize
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path[:0] = [ROOT, os.path.dirname(os.path.abspath(__file__))]
+sys.path[:0] = [ROOT, os.path.dirname(os.path.abspath(__file__)), os.path.join(ROOT, "tests")]
 from HapticSculpt import core  # noqa: E402
 from progress import progress  # noqa: E402
 
@@ -287,9 +292,57 @@ def plot(records: list[dict], path: str) -> None:
     fig.savefig(path, dpi=110)
 
 
+def fairness_table(out_dir: str) -> None:
+    """Issue 26's fair strokes: the rope scene of tests/fairness_scene.py (a flat 100 mm patch
+    whose centre the rope pulls up 20 mm and holds for 4 s), free and corners pinned, elastic and
+    clay, with today's springs alone (bending 0) and with the default bending weight: curvature
+    sign changes and total variation along the central sections (and the diagonals when pinned),
+    the lift, and the wall time per step of each integrator on that scene at a session's 1 ms."""
+    import fairness_scene as fs
+    from HapticSculpt.app.api import FAIR_BENDING as default
+    rows = []
+    print(f"\nfairness (default bending {default:g}; sign changes per section, variation = sum of "
+          "total variation / largest |curvature|)")
+    print(f"{'scene':<16}{'bending':>8}{'lift mm':>9}{'signs':>7}{'worst':>7}{'variation':>11}")
+    for material in ("elastic", "clay"):
+        for pinned in (False, True):
+            for bending in (0.0, default):
+                s = fs.build(material, pinned, bending)
+                report = fs.pull(s)
+                m = fs.measure(s, pinned)
+                rows.append({"material": material, "pinned": pinned, "bending": bending, "lift": report["lift"],
+                             "sign_changes": m.sign_changes, "worst_section": max(c for c, _ in m.per_section),
+                             "variation": m.variation})
+                r = rows[-1]
+                print(f"{material + (' pinned' if pinned else ' free'):<16}{bending:>8g}{r['lift']:>9.2f}"
+                      f"{r['sign_changes']:>7}{r['worst_section']:>7}{r['variation']:>11.1f}")
+    before = sum(r["variation"] for r in rows if r["bending"] == 0)
+    after = sum(r["variation"] for r in rows if r["bending"] != 0)
+    print(f"variation over the four scenes: {before:.1f} -> {after:.1f} ({100 * (1 - after / before):.0f} % less)")
+    timing = []
+    print(f"\nper-step wall time on the pinned elastic rope scene, dt 1 ms (median of 3 pulls)")
+    print(f"{'solver':<22}{'bending 0 us':>14}{'bending on us':>15}")
+    for label, integ, settings in [("explicit", "explicit", {}), ("implicit (5 CG)", "implicit", {"cg_iterations": 5}),
+                                   ("local_global (default)", "local_global", {})]:
+        cells = {}
+        for bending in (0.0, default):
+            runs = []
+            for _ in range(3):
+                s = configure(fs.build("elastic", True, bending), integ, settings)
+                runs.append(fs.pull(s, hold=1.0)["step_seconds"])
+            cells[bending] = float(np.median(runs))
+        timing.append({"solver": label, "off": cells[0.0], "on": cells[default]})
+        print(f"{label:<22}{1e6 * cells[0.0]:>14.0f}{1e6 * cells[default]:>15.0f}")
+    with open(os.path.join(out_dir, "fairness.json"), "w") as f:
+        json.dump({"default_bending": default, "scenes": rows, "step_seconds": timing}, f, indent=1)
+
+
 def main() -> None:
     out_dir = os.path.join(ROOT, "bench", "results")
     os.makedirs(out_dir, exist_ok=True)
+    if "--fairness" in sys.argv:
+        fairness_table(out_dir)
+        return
     chosen = list(SCENES)
     if "--scenes" in sys.argv:
         chosen = sys.argv[sys.argv.index("--scenes") + 1].split(",")

@@ -2,7 +2,8 @@
 (`make stress`, tests/stress_campaign.py).
 
 One seed fully decides a scene: shape (including collapsed rows and zero-area patches), material
-(stiffness 1e-3..1e7, mass 1e-6..1e3, damping 0..1e4), integrator and time step (1e-6..1e-1 s),
+(stiffness 1e-3..1e7, mass 1e-6..1e3, damping 0..1e4, bending 0, the default or 1e-3..1e4 times the
+stiffness), integrator and time step (1e-6..1e-1 s),
 tool, conflicting constraints, non-linear laws and plasticity, and a script of random forces,
 cursor teleports, grabs and releases and non-finite inputs. `run_scene(seed)` plays it and returns
 what it found; a failure names the seed, so `run_scene(seed)` replays it exactly.
@@ -40,6 +41,7 @@ class SceneResult:
     mass: float
     damping: float
     shape: str
+    bending: float = -1.0  # the bending weight; -1: the core's default
     steps: int = 0
     refused_steps: int = 0
     energy_limited_steps: int = 0
@@ -185,6 +187,25 @@ def run_scene(seed: int, steps: int = STEPS) -> SceneResult:
             held = sorted(int(i) for i in held_rng.choice(n_poles, int(held_rng.integers(1, n_poles + 1)), replace=False))
             s.hold_poles(held)
         held_at = np.array(s.poles).reshape(-1, 3)[held].copy()
+        # The bending weight, from a stream of its own: off, huge, anything between, or the default;
+        # a negative or NaN weight is refused naming the map.
+        bend_rng = np.random.default_rng([seed, 3])
+        pick = bend_rng.random()
+        if pick < 0.75:
+            # (a ratio to the stiffness: 1e4 is 1000x the materials' 10; past it, as for stiffness,
+            # a long step's system no longer factors and the step is refused naming dt)
+            res.bending = 0.0 if pick < 0.2 else 1e4 if pick < 0.35 else _log_uniform(bend_rng, 1e-3, 1e4)
+            s.bending_map.set_uniform(res.bending)
+        for bad in (-1.0, math.nan):
+            before = _snapshot(s), np.array(s.bending_map.values).tobytes()
+            try:
+                s.bending_map.set_uniform(bad)
+                res.failure = f"bending weight {bad} accepted"
+                return res
+            except ValueError as exc:
+                if "bending" not in str(exc) or (_snapshot(s), np.array(s.bending_map.values).tobytes()) != before:
+                    res.failure = f"bending weight {bad} refused without naming the map or changed the state: {exc}"
+                    return res
         # Linked poles (a G1 seam: a row kept between its neighbours) or mirror symmetry (x = 0) in
         # a quarter each of the scenes with nothing held, from a stream of their own.
         extra_rng = np.random.default_rng([seed, 2])

@@ -35,8 +35,9 @@ def test_a_recorded_change_gives_the_state_after_bit_for_bit(clay):
     for name in sculpt_state.ARRAY_NAMES:
         np.testing.assert_array_equal(got.arrays[name], after.arrays[name], err_msg=name)
     assert got.settings_json() == after.settings_json()  # (the painted map's grid size is a setting)
-    # Only what changed is recorded: the knots and weights are not, plastic rest lengths sparsely.
-    assert len(text) < 30000, len(text)
+    # Only what changed is recorded: the knots and weights are not, plastic rest lengths sparsely;
+    # clay's bending reference follows its plastic flow, so it changed everywhere (5.6 kB more).
+    assert len(text) < (40000 if clay else 30000), len(text)
     assert recorded_state.unpack(recorded_state.pack(before, before), before).arrays["Poles"].tobytes() == \
         before.arrays["Poles"].tobytes()
 

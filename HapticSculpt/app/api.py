@@ -70,7 +70,8 @@ def _sculpt(obj: Any, name: str = "obj", solids: bool = False) -> Any:
 
 def make_sculpt(doc: Any = None, source: Any = None, controls: tuple[int, int] = (8, 8),
                 degree: tuple[int, int] = (3, 3), mesh: tuple[int, int] = (40, 40),
-                size: tuple[float, float] = (100.0, 100.0), name: str = "Sculpt", material: str = "elastic") -> Any:
+                size: tuple[float, float] = (100.0, 100.0), name: str = "Sculpt", material: str = "elastic",
+                edges: Any = "free") -> Any:
     """A new Sculpt object in ``doc`` (the active or a new document when None).
 
     ``source``: None (a flat ``size`` patch in XY, centred at the origin), a ``Part.Face``, a
@@ -80,11 +81,17 @@ def make_sculpt(doc: Any = None, source: Any = None, controls: tuple[int, int] =
     ``obj.ConversionError``. ``mesh`` is the g x h mass-point sampling (at least the control count).
     ``material``: "elastic" (what a stroke pulls springs back unless held by constraints: the
     scripting default) or "clay" (plastic: what a stroke pulls stays, the GUI's default); see
-    :func:`set_material`. Undo is switched on for the document if it was off, so each stroke can be
-    undone.
+    :func:`set_material`. ``edges``: "free" (a free sheet), "held" (a clamped sheet: every edge
+    and its tangent plane held, as :func:`hold_boundary` "G1"), or what :func:`hold_boundary` takes.
+    Undo is switched on for the document if it was off, so each stroke can be undone.
     """
-    doc = _document(doc)
     controls, degree, mesh = _checked_resolution(controls, degree, mesh)
+    edges = _edges(edges)
+    try:  # validated (names, rows left free) before the document changes
+        boundary_poles(controls, edges)
+    except (TypeError, ValueError) as exc:
+        raise type(exc)(f"edges: 'free', 'held' or as hold_boundary takes it ({exc})") from None
+    doc = _document(doc)
     try:
         sx, sy = size
     except (TypeError, ValueError):
@@ -94,7 +101,7 @@ def make_sculpt(doc: Any = None, source: Any = None, controls: tuple[int, int] =
         raise TypeError("name: expected a non-empty string")
     _material(material)
     made = source_surface(source, controls, degree, size, doc)
-    state = _sculpt_state(made, mesh, material)
+    state = _sculpt_state(made, mesh, material, held=boundary_poles(tuple(made.surface.controls), edges))
     if doc.UndoMode == 0:
         doc.UndoMode = 1
     with transaction(doc, "Create sculpt"):
@@ -144,6 +151,11 @@ def _add_sculpt(doc: Any, name: str, made: Any, state: sculpt_state.SculptState)
 CLAY = (True, 0.01, 5.0)
 CLAY_DAMPING = 10.0
 ELASTIC_DAMPING = 1.0  # the core's default
+#: The bending (thin-plate) weight, a ratio to the stiffness (docs/solver.md), at which a rope
+#: stroke leaves a fair bump, no tents or creases (tests/test_fairness.py):
+#: ``set_uniform(obj, "bending", FAIR_BENDING)``. Not the materials' default yet: strokes on it lift
+#: less (held edges, faces of solids: docs/benchmarks.md), so the default stays 0 (springs alone).
+FAIR_BENDING = 10.0
 MATERIALS = ("elastic", "clay")
 
 
@@ -264,12 +276,59 @@ def set_tool(obj: Any, tool: str, falloff: str | None = None) -> None:
 
 
 def set_uniform(obj: Any, map: str, value: float) -> None:
-    """Sets material map ``map`` ("mass", "damping", "stiffness") to ``value`` everywhere (the
-    slider panel's edit). One undo step; a running session takes it at once."""
+    """Sets material map ``map`` ("mass", "damping", "stiffness", "bending") to ``value`` everywhere
+    (the slider panel's edit; damping and bending may be 0: off; bending is a ratio to the
+    stiffness, FAIR_BENDING for fair strokes). One undo step; a running session
+    takes it at once."""
     obj = _sculpt(obj, solids=True)
     sculpt_state.map_property(map)  # validates the name
-    value = _finite(value, "value", nonnegative=map == "damping", positive=map != "damping")
+    off = map in ("damping", "bending")
+    value = _finite(value, "value", nonnegative=off, positive=not off)
     obj.Proxy.live.edit(lambda s: getattr(s, map + "_map").set_uniform(value), f"Set {map}")
+
+
+def fair_weights(mesh: np.ndarray, region: Any = None) -> np.ndarray:
+    """Per mesh point weights in [0, 1] for :func:`fair`: all ones without a region, else
+    (1 - (r / radius)^2)^2 at distance r < radius from the centre (smooth to zero at the rim)."""
+    points = np.asarray(mesh, dtype=float).reshape(-1, 3)
+    if region is None:
+        return np.ones(len(points))
+    try:
+        centre, radius = region
+        centre = [_finite(x, "region centre") for x in centre]
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"region: expected None or (centre (x, y, z), radius), got {region!r}") from exc
+    if len(centre) != 3:
+        raise TypeError(f"region: expected None or (centre (x, y, z), radius), got {region!r}")
+    radius = _finite(radius, "region radius", positive=True)
+    r2 = np.sum((points - np.array(centre)) ** 2, axis=1) / radius ** 2
+    weights = np.where(r2 < 1, (1 - r2) ** 2, 0.0)
+    if not weights.any():
+        raise ValueError(f"region: no point of the surface lies within {radius} of {centre}")
+    return weights
+
+
+def fair(obj: Any, region: Any = None, strength: float = 10.0) -> None:
+    """Relaxes the curvature variation of the sculpt's shape (Fair): where ``region`` (None: the
+    whole surface; else ``(centre, radius)`` in the sculpt's coordinates, weighted smoothly to
+    zero at the rim) the poles balance the change of curvature (third differences of the mesh,
+    which leave planes, cylinders and spheres alone) against staying put, by ``strength`` (1 weighs
+    both alike for the control net's own waves; the default 10 takes a rope stroke's creases out
+    and keeps 96 % of its lift, tests/test_fairness.py; larger fairs more). Held and linked poles and the mirror
+    symmetry hold exactly (penalty constraints are not part of it: they act again at the next step).
+    A clay sculpt keeps the faired shape (it becomes its rest shape); an elastic one springs back
+    toward its rest shape when it is next stepped, as after a stroke. One undo step; a running
+    session takes the faired shape at once, at rest."""
+    obj = _sculpt(obj, solids=True)
+    strength = _finite(strength, "strength", nonnegative=True)
+    weights = fair_weights(obj.Proxy.live.snapshot().mesh, region)  # validated before the document changes
+
+    def change(s: core.DynamicSurface) -> None:
+        s.fair(weights, strength)
+        if s.plasticity[0]:
+            s.relax()
+
+    obj.Proxy.live.edit(change, "Fair", new_shape=True)
 
 
 def set_curvature_target(obj: Any, u: float | None = None, v: float | None = None) -> None:
@@ -471,6 +530,11 @@ def boundary_poles(controls: tuple[int, int], boundary: Any) -> list[int]:
             else:
                 held.update(i * nv + line for i in range(nu))
     return sorted(held)
+
+
+def _edges(edges: Any) -> Any:
+    """make_sculpt's ``edges``: "held" is a clamped sheet (G1), the rest as boundary_poles takes it."""
+    return "G1" if isinstance(edges, str) and edges == "held" else edges
 
 
 def hold_boundary(obj: Any, boundary: Any = "G0") -> list[int]:

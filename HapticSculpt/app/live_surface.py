@@ -135,13 +135,16 @@ class LiveSurface:
         return np.array(getattr(self.snapshot(), name + "_map").values)
 
     # --- writes -----------------------------------------------------------------------------------
-    def edit(self, change: Callable[[core.DynamicSurface], T], title: str, keep_shape: bool = False) -> T:
+    def edit(self, change: Callable[[core.DynamicSurface], T], title: str, keep_shape: bool = False,
+             new_shape: bool = False) -> T:
         """Applies ``change(surface)`` as one undo transaction named ``title`` and returns its result.
 
         Without a session it changes the surface and commits at once. During one ``change`` runs on
         a copy configured from the document with the newest shape, which the session swaps in
         between two steps without letting go of the device (the transaction follows when the
-        simulation has applied it). ``keep_shape`` then makes the current shape the rest shape."""
+        simulation has applied it). ``keep_shape`` then makes the current shape the rest shape.
+        ``new_shape``: ``change`` moves the poles (Fair), so the session takes the copy as it is, at
+        rest, as it takes an Undo, instead of carrying its own shape over."""
         if self._session is not None and not self._session.running:
             self._session.stop()  # its loops ended by themselves: commit its strokes, take the surface back
         if self._session is None:
@@ -160,7 +163,7 @@ class LiveSurface:
         after = _maps(prepared)
         keep_maps = all(np.array_equal(before[k], after[k]) for k in before)
         head = sculpt_state.capture(prepared)  # (before the simulation thread owns it)
-        self._session.post_edit(prepared, head, title, restore=False, keep_maps=keep_maps, keep_shape=keep_shape)
+        self._session.post_edit(prepared, head, title, restore=new_shape, keep_maps=keep_maps, keep_shape=keep_shape)
         self._head = head
         self._shadow_stale = True
         return result

@@ -2,7 +2,7 @@
 
 This is what a FreeCAD document stores (float lists are saved as binary doubles, JSON floats are
 written with ``repr``), so ``restore(capture(s))`` reproduces ``s`` bit for bit: poles, velocities,
-knots, weights, sampling, rest lengths, material maps, constraints (with their ids), held and
+knots, weights, sampling, rest lengths, the bending reference, material maps, constraints (with their ids), held and
 linked poles, mirror symmetry, laws, plasticity, tool and integrator settings. No FreeCAD import here.
 """
 from __future__ import annotations
@@ -19,16 +19,19 @@ from .. import core
 FORMAT_VERSION = 1
 #: The float arrays of a state, by the name of the document property that holds each.
 ARRAY_NAMES = ("Poles", "Velocities", "KnotsU", "KnotsV", "Weights", "RestLengths",
-               "MassMap", "DampingMap", "StiffnessMap")
-_MAPS = {"MassMap": "mass_map", "DampingMap": "damping_map", "StiffnessMap": "stiffness_map"}
+               "MassMap", "DampingMap", "StiffnessMap", "BendingMap", "BendingReference")
+_MAPS = {"MassMap": "mass_map", "DampingMap": "damping_map", "StiffnessMap": "stiffness_map",
+         "BendingMap": "bending_map"}
+#: Arrays documents from before the bending energy do not have (empty there: the core's default).
+_OPTIONAL = ("BendingMap", "BendingReference")
 
 
 def map_property(name: str) -> str:
-    """The document property of material map ``name`` ("mass", "damping" or "stiffness")."""
+    """The document property of material map ``name`` ("mass", "damping", "stiffness" or "bending")."""
     for prop, attr in _MAPS.items():
         if attr == name + "_map":
             return prop
-    raise ValueError(f"map: one of mass, damping, stiffness, not {name!r}")
+    raise ValueError(f"map: one of mass, damping, stiffness, bending, not {name!r}")
 
 
 _TOOL_PARAMS = {
@@ -85,6 +88,7 @@ def capture(surface: core.DynamicSurface) -> SculptState:
         "KnotsV": np.array(bs.knots_v, dtype=float),
         "Weights": np.zeros(0) if weights is None else np.array(weights, dtype=float).ravel(),
         "RestLengths": np.array(surface.rest_lengths, dtype=float),
+        "BendingReference": np.array(surface.bending_reference, dtype=float).ravel(),
     }
     maps = {}
     for prop, attr in _MAPS.items():
@@ -189,9 +193,14 @@ def restore(state: SculptState) -> core.DynamicSurface:
         raise ValueError(f"SculptSettings: the stored surface is invalid: {exc}") from exc
     surface.set_velocities(_array(arrays, "Velocities", nu * nv * 3).reshape(nu, nv, 3))
     surface.set_rest_lengths(list(_array(arrays, "RestLengths", surface.spring_count)))
+    if np.asarray(arrays.get("BendingReference", ())).size:
+        g, h = mesh
+        surface.set_bending_reference(_array(arrays, "BendingReference", g * h * 3).reshape(g * h, 3))
     surface.reference = tuple(_float_list(s, "reference", 3))
     maps = s.get("maps", {})
     for prop, attr in _MAPS.items():
+        if prop in _OPTIONAL and not np.asarray(arrays.get(prop, ())).size:
+            continue
         rows, cols = _pair(maps, prop) if prop in maps else (1, 1)
         values = _array(arrays, prop, rows * cols).reshape(rows, cols)
         getattr(surface, attr).set_values(values)

@@ -17,9 +17,10 @@ GROUPS = {
                                "smooth",
                                ["HapticSculpt_ToolRope", "HapticSculpt_ToolMagnet", "HapticSculpt_MagnetFalloff",
                                 "HapticSculpt_ToolOrientation", "HapticSculpt_ToolSmooth"], 0),
-    "HapticSculpt_MaterialGroup": ("Material", "The material: elastic or clay, keep the shape, airbrush the mass, "
-                                   "damping or stiffness map, the slider panel",
-                                   ["HapticSculpt_Material", "HapticSculpt_KeepShape", "HapticSculpt_PaintMass",
+    "HapticSculpt_MaterialGroup": ("Material", "The material: elastic or clay, keep the shape, fair it, airbrush "
+                                   "the mass, damping or stiffness map, the slider panel",
+                                   ["HapticSculpt_Material", "HapticSculpt_KeepShape", "HapticSculpt_Fair",
+                                    "HapticSculpt_PaintMass",
                                     "HapticSculpt_PaintDamping", "HapticSculpt_PaintStiffness", "HapticSculpt_Panel"],
                                    0),
     "HapticSculpt_ConstraintGroup": ("Constraints and edges", "Hold the edges (free / G0 / G1), or toggle a point, "
@@ -237,6 +238,16 @@ class KeepShape(_SculptCommand):
     def Activated(self) -> None:
         from .echo import ref, run_echoed
         run_echoed(f"HapticSculpt.keep_shape({ref(_ctl().active_sculpt())})")
+
+
+class Fair(_SculptCommand):
+    icon_name, menu = "Fair", "Fair"
+    tip = ("Relax the curvature variation of the active sculpt (waves, tents, creases) while its held and "
+           "linked poles and its symmetry hold; one undo step")
+
+    def Activated(self) -> None:
+        from .echo import ref, run_echoed
+        run_echoed(f"HapticSculpt.fair({ref(_ctl().active_sculpt())})")
 
 
 class HoldEdges(_SculptCommand):
@@ -488,7 +499,7 @@ class Group:
 
 COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_SculptFace": SculptFace, "HapticSculpt_Session": Session,
             "HapticSculpt_Material": Material, "HapticSculpt_KeepShape": KeepShape,
-            "HapticSculpt_HoldEdges": HoldEdges,
+            "HapticSculpt_HoldEdges": HoldEdges, "HapticSculpt_Fair": Fair,
             "HapticSculpt_ToolRope": ToolRope, "HapticSculpt_ToolMagnet": ToolMagnet,
             "HapticSculpt_MagnetFalloff": MagnetFalloff, "HapticSculpt_ToolOrientation": ToolOrientation,
             "HapticSculpt_ToolSmooth": ToolSmooth, "HapticSculpt_PointConstraint": PointConstraint,

@@ -429,12 +429,13 @@ class _Observer:
 
 
 def _with_event(state: sculpt_state.SculptState, event: dict[str, Any]) -> sculpt_state.SculptState:
-    """``state`` with the poles, velocities, rest lengths and maps a runtime event carries."""
+    """``state`` with the poles, velocities, rest lengths, bending reference and maps a runtime event carries."""
     arrays = dict(state.arrays)
     settings = dict(state.settings, maps=dict(state.settings.get("maps", {})))
     arrays["Poles"] = np.asarray(event["poles"], dtype=float).ravel()
     arrays["Velocities"] = np.asarray(event["velocities"], dtype=float).ravel()
     arrays["RestLengths"] = np.asarray(event["rest_lengths"], dtype=float).ravel()
+    arrays["BendingReference"] = np.asarray(event["bending_reference"], dtype=float).ravel()
     for name, values in event["maps"].items():
         prop = sculpt_state.map_property(name)
         arrays[prop] = np.asarray(values, dtype=float).ravel()

@@ -143,11 +143,26 @@ void bindDynamicSurface(py::module_& m) {
         .def_property_readonly("mass_map", py::overload_cast<>(&DynamicSurface::massMap), py::return_value_policy::reference_internal)
         .def_property_readonly("damping_map", py::overload_cast<>(&DynamicSurface::dampingMap), py::return_value_policy::reference_internal)
         .def_property_readonly("stiffness_map", py::overload_cast<>(&DynamicSurface::stiffnessMap), py::return_value_policy::reference_internal)
+        .def_property_readonly("bending_map", py::overload_cast<>(&DynamicSurface::bendingMap), py::return_value_policy::reference_internal,
+                               "Bending (thin-plate) weight beta per mesh cell, in the springs' units; 0 switches it off")
+        .def_property_readonly("bending_reference", [](py::object self) {
+            auto& s = self.cast<DynamicSurface&>();
+            return view(s.bending().reference().data(), {s.g(), s.h(), 3}, self).attr("copy")();
+        }, "(g, h, 3) copy of the shape the bending energy measures from")
+        .def("set_bending_reference", [](DynamicSurface& s, DoubleArray r) {
+            s.setBendingReference(pointsFrom(r, static_cast<Eigen::Index>(s.g()) * s.h(), "reference"));
+        }, py::arg("reference"), "Replace the bending energy's reference shape ((g, h, 3) or (g*h, 3)).")
+        .def("fair", [](DynamicSurface& s, const Eigen::VectorXd& weights, double strength) { s.fair(weights, strength); },
+             py::arg("weights"), py::arg("strength") = 10.0,
+             "Relax the curvature variation where weights (one per mesh point, row a*h + b, in [0, 1]) ask, "
+             "by strength against staying put; held and linked poles and symmetry hold.")
+        .def_property_readonly("bending_energy", &DynamicSurface::bendingEnergy,
+                               "The bending energy at the current mesh")
         .def_property_readonly("spring_count", [](const DynamicSurface& s) { return s.springs().size(); })
         .def_property_readonly("rest_lengths", [](const DynamicSurface& s) { return s.springs().rest(); })
         .def("set_rest_lengths", [](DynamicSurface& s, const std::vector<double>& r) { s.springs().setRest(r); }, py::arg("rest"))
-        .def("relax", [](DynamicSurface& s) { s.springs().resetRest(s.mesh()); s.wake(); },
-             "Make the current shape the rest shape (rest lengths from the current mesh).")
+        .def("relax", &DynamicSurface::relax,
+             "Make the current shape the rest shape (rest lengths and bending reference from the current mesh).")
         .def("set_stiffness_law", [](DynamicSurface& s, const std::string& kind, double scale) {
             s.setStiffnessLaw({fromName(kLawNames, kind, "law"), scale});
         },
@@ -319,14 +334,14 @@ void bindDynamicSurface(py::module_& m) {
         .def_property_readonly("step_count", &DynamicSurface::stepCount)
         .def_property_readonly("work_done", &DynamicSurface::workDone, "work of external and tool forces so far")
         .def("kinetic_energy", &DynamicSurface::kineticEnergy)
-        .def("potential_energy", &DynamicSurface::potentialEnergy, "springs plus penalty terms")
+        .def("potential_energy", &DynamicSurface::potentialEnergy, "springs, bending and penalty terms")
         .def("potential_gradient", [](DynamicSurface& s) {
             const Points& g = s.potentialGradient();
             const auto [nu, nv] = std::make_pair(s.surface().nu(), s.surface().nv());
             py::array_t<double> out({nu, nv, 3});
             std::copy(g.data(), g.data() + g.size(), out.mutable_data());
             return out;
-        }, "Gradient of potential_energy() with respect to the poles (nu, nv, 3): -A^T f(d), springs and constraints")
+        }, "Gradient of potential_energy() with respect to the poles (nu, nv, 3): -A^T f(d), springs, bending and constraints")
         .def("point_masses", [](DynamicSurface& s) { return Eigen::VectorXd(s.pointMasses()); })
         .def("curvature_grid", [](const DynamicSurface& s) {
             Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> c;

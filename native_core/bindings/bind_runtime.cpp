@@ -185,6 +185,7 @@ void bindRuntime(py::module_& m) {
             d["poles"] = py::cast(s.poles);
             d["velocities"] = py::cast(s.velocities);
             d["rest_lengths"] = py::cast(s.restLengths);
+            d["bending_reference"] = py::cast(Eigen::MatrixXd(s.bendingReference));
             d["painted"] = s.painted == AirbrushSettings::Map::Off ? py::object(py::none()) : py::str(mapName(s.painted));
             d["edit"] = s.edit == 0 ? py::object(py::none()) : py::int_(s.edit);
             py::dict maps;

@@ -8,7 +8,7 @@ namespace hs {
 
 DynamicSurface::DynamicSurface(BSplineSurface surface, int g, int h)
     : surface_(std::move(surface)), A_(surface_, g, h), mass_(1.0, "mass"), damping_(1.0, "damping"),
-      stiffness_(100.0, "stiffness") {
+      stiffness_(100.0, "stiffness"), bendingMap_(1.0, "bending") {
     const Eigen::Index S = static_cast<Eigen::Index>(g) * h, N = surface_.poles().rows();
     for (Points* m : {&d_, &dd_, &fext_, &ftool_, &force_, &meshTmp_, &meshTmp2_, &base_, &dPrev_, &av_, &history_.d, &history_.av, &history_.dHat, &yMesh_})
         m->setZero(S, 3);
@@ -19,6 +19,8 @@ DynamicSurface::DynamicSurface(BSplineSurface surface, int g, int h)
     verlet_.appliedPoles.reserve(static_cast<size_t>(N));
     verlet_.poleMark.assign(static_cast<size_t>(N), 0);
     damping_.allowZero(true);
+    bendingMap_.allowZero(true);
+    bendingMap_.setUniform(kDefaultBending);
     A_.apply(surface_.poles(), d_);
     springs_ = SpringMesh(g, h, d_);
     constraints_ = ConstraintSet(g, h);
@@ -33,6 +35,7 @@ DynamicSurface::DynamicSurface(BSplineSurface surface, int g, int h)
         }
     spacingU_ = su / ((g - 1) * h);
     spacingV_ = sv / (g * (h - 1));
+    bending_ = BendingEnergy(g, h, spacingU_, spacingV_, d_);
     setTool("rope");
     terms_.reserve(64);
     refreshMaterials();
@@ -44,6 +47,8 @@ void DynamicSurface::setReference(const std::array<double, 3>& r) {
     size_ = r[0];
     spacingU_ = r[1];
     spacingV_ = r[2];
+    bending_ = BendingEnergy(g(), h(), spacingU_, spacingV_, bending_.reference());
+    materialKey_[3] = ~0ull;  // the operator's scaling changed: its weights again
     touch();
 }
 
@@ -96,8 +101,10 @@ void DynamicSurface::continueFrom(DynamicSurface& live, bool keepMaps) {
     setPoles(live.poles());
     setVelocities(live.velocities());
     springs_.setRest(live.springs_.rest());
+    bending_.setReference(live.bending_.reference());
     if (keepMaps) {
-        for (auto [mine, theirs] : {std::pair{&mass_, &live.mass_}, {&damping_, &live.damping_}, {&stiffness_, &live.stiffness_}})
+        for (auto [mine, theirs] : {std::pair{&mass_, &live.mass_}, {&damping_, &live.damping_}, {&stiffness_, &live.stiffness_},
+                                    {&bendingMap_, &live.bendingMap_}})
             if (mine->rows() != theirs->rows() || mine->cols() != theirs->cols() || mine->values() != theirs->values())
                 mine->setValues(theirs->rows(), theirs->cols(), theirs->values());
     }
@@ -174,8 +181,8 @@ std::pair<double, double> DynamicSurface::meshParameters(int index) const {
 }
 
 void DynamicSurface::refreshMaterials() {
-    const std::uint64_t key[3] = {mass_.version(), damping_.version(), stiffness_.version()};
-    if (key[0] == materialKey_[0] && key[1] == materialKey_[1] && key[2] == materialKey_[2]) return;
+    const std::uint64_t key[4] = {mass_.version(), damping_.version(), stiffness_.version(), bendingMap_.version()};
+    if (key[0] == materialKey_[0] && key[1] == materialKey_[1] && key[2] == materialKey_[2] && key[3] == materialKey_[3]) return;
     // Densities per unit parameter area, lumped with trapezoid weights that sum to one.
     const int G = g(), H = h();
     for (int a = 0; a < G; ++a)
@@ -186,10 +193,12 @@ void DynamicSurface::refreshMaterials() {
             gamma_[a * H + b] = damping_.at(u, v) * w;
         }
     springs_.setStiffness(stiffness_, A_.us(), A_.vs());
+    if (key[2] != materialKey_[2] || key[3] != materialKey_[3]) bending_.setWeights(bendingMap_, stiffness_);
     minMass_ = m_.minCoeff();
     maxDampingRate_ = (gamma_.array() / m_.array()).maxCoeff();
-    maxStiffness_ = stiffness_.values().maxCoeff();
-    for (int i = 0; i < 3; ++i) materialKey_[i] = key[i];
+    // The stiffest spring, with bending as the spring stiffness of the same Laplacian row sum (16 k).
+    maxStiffness_ = stiffness_.values().maxCoeff() + bending_.maxRowSum() / 16;
+    for (int i = 0; i < 4; ++i) materialKey_[i] = key[i];
     accelerationValid_ = verlet_.valid = false;
 }
 
@@ -204,10 +213,11 @@ void DynamicSurface::ensureMassFactor() {
 }
 
 void DynamicSurface::ensureSystem(double dt, bool factor) {
-    const std::uint64_t key[4] = {mass_.version(), damping_.version(), stiffness_.version(), structureKey()};
+    const std::uint64_t key[5] = {mass_.version(), damping_.version(), stiffness_.version(), structureKey(),
+                                  bendingMap_.version()};
     auto current = [&](const SystemSlot& slot) {
         bool same = dt == slot.dt && (slot.factored || !factor);
-        for (int i = 0; i < 4; ++i) same = same && key[i] == slot.key[i];
+        for (int i = 0; i < 5; ++i) same = same && key[i] == slot.key[i];
         return same;
     };
     for (std::size_t k = 0; k < systems_.size(); ++k)
@@ -217,7 +227,7 @@ void DynamicSurface::ensureSystem(double dt, bool factor) {
             return;
         }
     // Rebuild the slot used least recently. S = A^T (M + dt D + dt^2 L) A with L the Laplacian of
-    // springs and penalty terms.
+    // springs and penalty terms and the bending matrix K_b.
     system_ = systems_[0].used <= systems_[1].used ? 0 : 1;
     SystemSlot& slot = systems_[system_];
     slot.used = ++systemUses_;
@@ -241,13 +251,14 @@ void DynamicSurface::ensureSystem(double dt, bool factor) {
     }
     slot.factored = factor;
     slot.dt = dt;
-    for (int i = 0; i < 4; ++i) slot.key[i] = key[i];
+    for (int i = 0; i < 5; ++i) slot.key[i] = key[i];
 }
 
 Eigen::SparseMatrix<double> DynamicSurface::laplacian() const {
     std::vector<Eigen::Triplet<double>> t;
     springs_.addLaplacian(t);
     constraints_.addLaplacian(t);
+    bending_.addMatrix(t);
     Eigen::SparseMatrix<double> L(d_.rows(), d_.rows());
     L.setFromTriplets(t.begin(), t.end());
     return L;
@@ -291,6 +302,8 @@ void DynamicSurface::setCursor(const Cursor& c) {
         touch();
     } else if (!n.grab && tool_->grabbed()) {
         tool_->release();
+        // Clay keeps what it is given: the stroke's shape becomes what bending measures from.
+        if (springs_.plasticity.enabled) bending_.setReference(d_);
         history_.valid = false;
         touch();
     }
@@ -317,6 +330,7 @@ double DynamicSurface::meshForces(const Points& d, const Points& dd, double) {
     const bool nonlinearDamping = dampingLaw_.kind != LawKind::Linear;
     if (nonlinearDamping)
         for (Eigen::Index i = 0; i < d.rows(); ++i) meshTmp2_(i, 0) = dampingLaw_.dampingFactor(force_.row(i).norm());
+    const double bend = bending_.addForces(d, force_);  // (after the damping law: it reads spring forces)
     if (hasExternal_) force_ += fext_;
     if (toolForces_) force_ += ftool_;
     double penalty = 0;
@@ -325,14 +339,15 @@ double DynamicSurface::meshForces(const Points& d, const Points& dd, double) {
         for (Eigen::Index i = 0; i < d.rows(); ++i) force_.row(i) -= gamma_[i] * meshTmp2_(i, 0) * dd.row(i);
     else
         force_ -= gamma_.asDiagonal() * dd;
-    return energy + penalty;
+    return energy + bend + penalty;
 }
 
 StepReport DynamicSurface::step(double dt) {
     if (!(dt >= kMinDt) || !std::isfinite(dt)) throw std::invalid_argument("dt: must be finite and >= 1e-9 s");
     refreshMaterials();
-    const std::uint64_t key[4] = {mass_.version(), damping_.version(), stiffness_.version(), constraints_.version()};
-    for (int i = 0; i < 4; ++i)
+    const std::uint64_t key[5] = {mass_.version(), damping_.version(), stiffness_.version(), constraints_.version(),
+                                  bendingMap_.version()};
+    for (int i = 0; i < 5; ++i)
         if (key[i] != wakeKey_[i]) { touch(); resetEnergyCeiling(); wakeKey_[i] = key[i]; }
     // A held tool keeps the surface awake; its forces are refreshed by applyToolForces each step.
     if (tool_->grabbed()) sleep_.wake();
@@ -382,6 +397,9 @@ StepReport DynamicSurface::step(double dt) {
     work_ += work;
     if (springs_.plasticity.enabled) {
         springs_.applyPlasticity(d_, dt);
+        // Between strokes the reference follows plastic flow (under a stroke it holds, so the
+        // stroke's shape is fair; the release commits it).
+        if (!tool_->grabbed()) bending_.follow(d_, std::min(1.0, springs_.plasticity.rate * dt));
         verlet_.valid = false;  // the rest lengths moved under the forces Verlet carries over
     }
     time_ += dt;
@@ -468,7 +486,8 @@ void DynamicSurface::restoreStepStart(bool keepVelocity) {
 }
 
 double DynamicSurface::potentialEnergy() {
-    double e = springs_.energy(d_);
+    refreshMaterials();
+    double e = springs_.energy(d_) + bending_.energy(d_);
     if (!constraints_.empty()) {
         force_.setZero();
         e += constraints_.addForces(d_, force_, terms_);
@@ -480,6 +499,7 @@ const Points& DynamicSurface::potentialGradient() {
     refreshMaterials();
     force_.setZero();
     springs_.addForces(d_, force_);
+    bending_.addForces(d_, force_);
     if (!constraints_.empty()) constraints_.addForces(d_, force_, terms_);
     A_.applyTransposed(force_, fp_);
     fp_ = -fp_;

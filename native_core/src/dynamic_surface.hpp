@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "bending_energy.hpp"
 #include "bspline_surface.hpp"
 #include "constraints.hpp"
 #include "energy_guard.hpp"
@@ -38,6 +39,10 @@ enum class IntegratorKind {
 /// (integrator_verlet.cpp): omega_max dt below this, omega_max bounded by the springs' and penalty
 /// terms' Laplacian (which bounds their Hessian for linear laws) and the tool's slope.
 constexpr double kVerletStability = 1.8;
+
+/// The bending map's default: off (springs alone, as before it existed). 10 (beta per mesh cell 10 x
+/// the stiffness there, api.FAIR_BENDING) makes rope strokes fair (tests/test_fairness.py).
+constexpr double kDefaultBending = 0.0;
 
 struct SolverSettings {
     IntegratorKind kind = IntegratorKind::LocalGlobal;
@@ -126,6 +131,16 @@ public:
     MaterialMap& massMap() { return mass_; }
     MaterialMap& dampingMap() { return damping_; }
     MaterialMap& stiffnessMap() { return stiffness_; }
+    /// Bending (thin-plate) weight per mesh cell as a ratio to the stiffness there (bending_energy.hpp); 0: off.
+    MaterialMap& bendingMap() { return bendingMap_; }
+    const MaterialMap& bendingMap() const { return bendingMap_; }
+    /// The bending energy; its reference is the shape the bending measures from: the initial mesh;
+    /// with plasticity the shape a stroke leaves at its release, and between strokes it follows
+    /// the shape at the plastic rate.
+    const BendingEnergy& bending() const { return bending_; }
+    void setBendingReference(const Points& reference) { bending_.setReference(reference); wake(); }
+    /// Makes the current shape the rest shape: rest lengths and the bending reference from the mesh.
+    void relax() { springs_.resetRest(d_); bending_.setReference(d_); wake(); }
     const MaterialMap& massMap() const { return mass_; }
     const MaterialMap& dampingMap() const { return damping_; }
     const MaterialMap& stiffnessMap() const { return stiffness_; }
@@ -191,9 +206,16 @@ public:
     /// (0 where it never does: switched off, non-linear laws, curvature constraints, smooth tool).
     double verletStepLimit();
 
+    /// Fair (fairing.cpp): relaxes the curvature variation where `weights` (one per mesh point, in
+    /// [0, 1]) ask for it, by `strength` (>= 0) against staying put; held and linked poles and
+    /// the mirror symmetry hold exactly. Zeroes velocities (as setPoles). Allocates (an edit).
+    void fair(const Eigen::VectorXd& weights, double strength);
+
     // --- measures -----------------------------------------------------------------------------
     double kineticEnergy();
     double potentialEnergy();
+    /// Its bending part, 1/2 (d - r)^T K_b (d - r).
+    double bendingEnergy() { refreshMaterials(); return bending_.energy(d_); }
     /// Gradient of potentialEnergy() with respect to the poles, -A^T f(d) (springs and constraints).
     const Points& potentialGradient();
     /// Curvature of the circle through interior mesh point `index` and its two neighbours along
@@ -285,8 +307,9 @@ private:
     MirrorSymmetry mirror_;
     // Material: per mesh point masses and damping rates, the maps, springs, constraints, tool.
     Eigen::VectorXd m_, gamma_;
-    MaterialMap mass_, damping_, stiffness_;
+    MaterialMap mass_, damping_, stiffness_, bendingMap_;
     SpringMesh springs_;
+    BendingEnergy bending_;
     ResponseLaw dampingLaw_;
     ConstraintSet constraints_;
     std::vector<ConstraintTerm> terms_;
@@ -296,13 +319,13 @@ private:
     PrefactoredSolver massSolver_;
     Eigen::SparseMatrix<double> massMatrix_;  // A^T M A, as last factored by ensureMassFactor()
     std::uint64_t massVersion_ = ~0ull, materialKey_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
-    std::uint64_t wakeKey_[4] = {0, 0, 0, 0};
+    std::uint64_t wakeKey_[5] = {0, 0, 0, 0, 0};
     // The system matrix for the two step lengths used last (a session steps at its dt, and at
     // twice it while catching up with real time), each with its factors and Jacobi diagonal.
     struct SystemSlot {
         PrefactoredSolver solver;
         Eigen::VectorXd invDiag;
-        std::uint64_t key[4] = {~0ull, ~0ull, ~0ull, ~0ull};
+        std::uint64_t key[5] = {~0ull, ~0ull, ~0ull, ~0ull, ~0ull};
         double dt = -1;
         bool factored = false;
         std::uint64_t used = 0;

@@ -99,7 +99,8 @@ const char* mapName(AirbrushSettings::Map map) { return nameOf(kMapNames, map); 
 
 MaterialMap& HapticRuntime::mapOf(AirbrushSettings::Map map) {
     return map == AirbrushSettings::Map::Mass ? surface_->massMap()
-         : map == AirbrushSettings::Map::Damping ? surface_->dampingMap() : surface_->stiffnessMap();
+         : map == AirbrushSettings::Map::Damping ? surface_->dampingMap()
+         : map == AirbrushSettings::Map::Bending ? surface_->bendingMap() : surface_->stiffnessMap();
 }
 
 bool HapticRuntime::takePaintedMap(PaintedMap& out) {
@@ -155,7 +156,7 @@ bool HapticRuntime::takeEdits(double simTime) {
             liveSurface_.store(surface_.get(), std::memory_order_release);
         }
         if (e.keepShape) {
-            surface_->springs().resetRest(surface_->mesh());
+            surface_->relax();
             surface_->wake();
         }
         pushStroke(simTime, AirbrushSettings::Map::Off, e.id);
@@ -182,7 +183,7 @@ void HapticRuntime::airbrush(bool spraying, double simTime) {
     if (sprayMap_ == Map::Off) {
         sprayMap_ = want;
         // One target for the whole spray, so dabs saturate at it instead of compounding.
-        sprayTarget_ = std::clamp(airbrush_.factor * m.mean(), want == Map::Damping ? 0.0 : kMinMaterial, kMaxMaterial);
+        sprayTarget_ = std::clamp(airbrush_.factor * m.mean(), want == Map::Damping || want == Map::Bending ? 0.0 : kMinMaterial, kMaxMaterial);
         nextDab_ = simTime;
     }
     if (simTime < nextDab_) return;
@@ -210,6 +211,7 @@ void HapticRuntime::pushStroke(double simTime, AirbrushSettings::Map painted, st
         s.velocities = surface_->velocities();
         const auto& rest = static_cast<const DynamicSurface&>(*surface_).springs().rest();
         std::copy(rest.begin(), rest.end(), s.restLengths.begin());
+        s.bendingReference = surface_->bending().reference();  // (same size: no allocation)
         s.painted = painted;
         s.edit = edit;
         // (copying a map allocates only when its size changed: at a spray's end or an edit, not a step)
@@ -241,6 +243,7 @@ void HapticRuntime::start() {
         s.poles = p;
         s.velocities = surface_->velocities();
         s.restLengths = static_cast<const DynamicSurface&>(*surface_).springs().rest();
+        s.bendingReference = surface_->bending().reference();
     }
     if (settings_.logSeconds > 0) {
         ticks_.resize(static_cast<size_t>(settings_.logSeconds * settings_.hapticRate) + 16);

@@ -84,7 +84,7 @@ struct HapticTick {
 /// instead of grabbing (the tool lets go and renders no force): a dab every 1/rate seconds at the
 /// mass point nearest the cursor moves the map toward `factor` times its mean at the spray's start.
 struct AirbrushSettings {
-    enum class Map { Off, Mass, Damping, Stiffness };
+    enum class Map { Off, Mass, Damping, Stiffness, Bending };
     Map map = Map::Off;
     double radius = 0.08;    ///< in map coordinates (the unit square)
     double factor = 3.0;     ///< target = factor * the map's mean when the spray started
@@ -93,10 +93,10 @@ struct AirbrushSettings {
     /// Throws std::invalid_argument naming the first bad field.
     void validate() const;
 };
-const char* mapName(AirbrushSettings::Map map);  ///< "mass", "damping", "stiffness" ("" when off)
-/// The three maps, in the order of StrokeSnapshot::maps.
-constexpr std::array<AirbrushSettings::Map, 3> kMaps = {AirbrushSettings::Map::Mass, AirbrushSettings::Map::Damping,
-                                                        AirbrushSettings::Map::Stiffness};
+const char* mapName(AirbrushSettings::Map map);  ///< "mass", "damping", "stiffness", "bending" ("" when off)
+/// The four maps, in the order of StrokeSnapshot::maps.
+constexpr std::array<AirbrushSettings::Map, 4> kMaps = {AirbrushSettings::Map::Mass, AirbrushSettings::Map::Damping,
+                                                        AirbrushSettings::Map::Stiffness, AirbrushSettings::Map::Bending};
 
 /// A material map's values as a snapshot carries them.
 struct MapSnapshot {
@@ -127,9 +127,10 @@ struct StrokeSnapshot {
     std::uint64_t step = 0;  ///< simulation steps taken when it happened
     Points poles, velocities;
     std::vector<double> restLengths;
+    Points bendingReference;  ///< the bending energy's reference (clay's follows plastic flow)
     AirbrushSettings::Map painted = AirbrushSettings::Map::Off;
     std::uint64_t edit = 0;
-    std::array<MapSnapshot, 3> maps;  ///< in kMaps order (those carried)
+    std::array<MapSnapshot, 4> maps;  ///< in kMaps order (those carried)
 };
 
 /// The map a spray is painting, as the GUI shows it while the spray goes on.

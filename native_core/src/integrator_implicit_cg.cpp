@@ -16,6 +16,7 @@ StepReport DynamicSurface::stepImplicitCG(double dt) {
     auto stiffnessTimes = [&](const Points& y, Points& out) {
         out.setZero();
         springs_.addTangentStiffness(y, out);
+        bending_.addStiffness(y, out);
         if (!constraints_.empty()) constraints_.addStiffness(y, out);
     };
     stiffnessTimes(dd_, meshTmp2_);

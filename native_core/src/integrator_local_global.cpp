@@ -132,6 +132,7 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
         if (iterate == &yMesh_) meshTmp2_ = base_;  // d = y
         else meshTmp2_ = base_ + (m_ + h * gamma_).asDiagonal() * (yMesh_ - *iterate);
         springs_.addProjections(*iterate, meshTmp2_, 0.25 * minMass_ / (h * h), h * h);
+        bending_.addForces(*iterate, meshTmp2_, h * h);  // quadratic: its force is J t - L d's part
         if (!constraints_.empty()) constraints_.addProjections(*iterate, meshTmp2_, terms_, h * h);
         A_.applyTransposed(meshTmp2_, fp_);
         held_.reduce(fp_);

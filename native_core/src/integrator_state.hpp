@@ -52,10 +52,10 @@ struct VerletState {
 /// configuration), and the snapshot they were computed at (stiffnesses, masses, constraint
 /// structure, bounds), which map changes rescale (verlet_stability_bound.cpp).
 struct OmegaBounds {
-    std::uint64_t key[3] = {~0ull, ~0ull, ~0ull};
+    std::uint64_t key[4] = {~0ull, ~0ull, ~0ull, ~0ull};
     double upper = std::numeric_limits<double>::infinity(), lower = 0;
     bool tight = false;
-    Eigen::VectorXd snapK, snapM;
+    Eigen::VectorXd snapK, snapM, snapBending;  // (bending: the bending energy's row weights)
     std::uint64_t snapStructure = 0;
     double snapUpper = 0, snapLower = 0;
 };

@@ -26,6 +26,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 double DynamicSurface::verletForces(const Points& d, const Points& dd) {
     force_.setZero();
     double energy = springs_.addProjections(d, force_, 0.0, 1.0, true);  // the spring forces, for a linear law
+    energy += bending_.addForces(d, force_);
     if (!constraints_.empty()) energy += constraints_.addForces(d, force_, terms_);
     if (maxDampingRate_ > 0) force_ -= gamma_.asDiagonal() * dd;
     return energy;

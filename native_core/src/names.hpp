@@ -31,9 +31,9 @@ inline constexpr std::array<Named<Falloff>, 4> kFalloffNames{{
     {"conical", Falloff::Conical}}};
 inline constexpr std::array<Named<LawKind>, 3> kLawNames{{
     {"linear", LawKind::Linear}, {"cubic", LawKind::CubicHardening}, {"saturating", LawKind::Saturating}}};
-inline constexpr std::array<Named<AirbrushSettings::Map>, 3> kMapNames{{
+inline constexpr std::array<Named<AirbrushSettings::Map>, 4> kMapNames{{
     {"mass", AirbrushSettings::Map::Mass}, {"damping", AirbrushSettings::Map::Damping},
-    {"stiffness", AirbrushSettings::Map::Stiffness}}};
+    {"stiffness", AirbrushSettings::Map::Stiffness}, {"bending", AirbrushSettings::Map::Bending}}};
 /// The tools makeTool() builds (tools.cpp).
 inline constexpr std::array<const char*, 4> kToolNames{{"rope", "magnet", "orientation", "smooth"}};
 

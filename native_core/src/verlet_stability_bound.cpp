@@ -19,10 +19,10 @@
 namespace hs {
 
 bool DynamicSurface::omegaSquaredBelow(double limit, bool tight) {
-    const std::uint64_t key[3] = {mass_.version(), stiffness_.version(), structureKey()};
-    if (key[0] != omega_.key[0] || key[1] != omega_.key[1] || key[2] != omega_.key[2]) {
+    const std::uint64_t key[4] = {mass_.version(), stiffness_.version(), structureKey(), bendingMap_.version()};
+    if (key[0] != omega_.key[0] || key[1] != omega_.key[1] || key[2] != omega_.key[2] || key[3] != omega_.key[3]) {
         rescaleOmegaBounds();
-        for (int i = 0; i < 3; ++i) omega_.key[i] = key[i];
+        for (int i = 0; i < 4; ++i) omega_.key[i] = key[i];
     }
     if (!tight) {
         if (omega_.upper <= limit) return true;
@@ -45,6 +45,14 @@ void DynamicSurface::rescaleOmegaBounds() {
         kUp = std::max(kUp, r);
         kDown = std::min(kDown, r);
     }
+    // K_b = B^T W B grows by at most the largest ratio of its row weights (0 stays 0; from 0, unbounded).
+    const Eigen::VectorXd& w = bending_.weights();
+    for (Eigen::Index s = 0; s < w.size(); ++s) {
+        const double was = omega_.snapBending[s];
+        const double r = was > 0 ? w[s] / was : w[s] > 0 ? std::numeric_limits<double>::infinity() : 1.0;
+        kUp = std::max(kUp, r);
+        kDown = std::min(kDown, r);
+    }
     for (Eigen::Index i = 0; i < m_.size(); ++i) {
         const double r = m_[i] / omega_.snapM[i];
         mUp = std::max(mUp, r);
@@ -64,6 +72,7 @@ void DynamicSurface::computeOmegaBounds(double limit) {
     for (Eigen::Index s = 0; s < omega_.snapK.size(); ++s) omega_.snapK[s] = springs_.stiffness(static_cast<int>(s));
     omega_.snapM = m_;
     omega_.snapStructure = structureKey();
+    omega_.snapBending = bending_.weights();
     // max K_ii / M_ii is a Rayleigh quotient, so a lower bound: it rules out long steps cheaply.
     const double lower = (K.diagonal().array() / M.diagonal().array()).maxCoeff();
     if (lower > limit) {

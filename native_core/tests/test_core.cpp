@@ -152,6 +152,51 @@ TEST_P(AllocationFree, SteppingWithToolConstraintsAndLawsDoesNotAllocate) {
     EXPECT_EQ(allocationsWhileSculpting(s, 1e4, 1e-3, [](const StepReport& r) { ASSERT_FALSE(r.refused); }), 0);
 }
 
+TEST_P(AllocationFree, SteppingWithBendingDoesNotAllocate) {
+    // The bending energy (a painted map, clay's reference following the plastic flow) in every scheme.
+    DynamicSurface s(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 30, 30);
+    { SolverSettings solver = s.solver(); solver.kind = GetParam(); s.setSolver(solver); }
+    s.bendingMap().setUniform(10.0);
+    s.bendingMap().dab(0.3, 0.6, 0.2, 40.0, Falloff::Spherical, 1.0);
+    EXPECT_EQ(allocationsWhileSculpting(s, 1e4, 1e-3, [](const StepReport& r) { ASSERT_FALSE(r.refused); }), 0);
+    EXPECT_GT(s.bending().energy(s.mesh()), 0.0);
+}
+
+TEST(Fair, RelaxesWavesAndKeepsHeldPolesExactly) {
+    DynamicSurface s(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 24, 24);
+    Points p = s.poles();
+    for (int i = 1; i < 7; ++i)
+        for (int j = 1; j < 7; ++j) p(i * 8 + j, 2) = ((i + j) % 2 ? 2.0 : -2.0) + 0.5 * i;  // waves on a slope
+    s.setPoles(p);
+    s.holdPoles({0, 7, 56, 63, 27});
+    auto variation = [&] {  // squared third differences of the mesh along u
+        double e = 0;
+        for (int a = 0; a + 3 < s.g(); ++a)
+            for (int b = 0; b < s.h(); ++b)
+                e += (s.mesh().row((a + 3) * s.h() + b) - 3 * s.mesh().row((a + 2) * s.h() + b) +
+                      3 * s.mesh().row((a + 1) * s.h() + b) - s.mesh().row(a * s.h() + b)).squaredNorm();
+        return e;
+    };
+    const double before = variation();
+    const Points held = s.poles();
+    s.fair(Eigen::VectorXd::Ones(24 * 24), 10.0);
+    EXPECT_LT(variation(), 0.5 * before);
+    for (int i : {0, 7, 56, 63, 27}) EXPECT_EQ(s.poles().row(i), held.row(i)) << i;
+    EXPECT_THROW(s.fair(Eigen::VectorXd::Ones(3), 1.0), std::invalid_argument);
+    EXPECT_THROW(s.fair(Eigen::VectorXd::Ones(24 * 24), -1.0), std::invalid_argument);
+}
+
+TEST(Verlet, SteppingWithBendingDoesNotAllocate) {
+    DynamicSurface s(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 30, 30);
+    s.bendingMap().setUniform(10.0);
+    const double dt = 0.5 * s.verletStepLimit();
+    ASSERT_GT(dt, 0.0);
+    EXPECT_EQ(allocationsWhileSculpting(s, 1.0, dt, [](const StepReport& r) {
+                  ASSERT_TRUE(r.verlet);
+                  ASSERT_FALSE(r.refused);
+              }), 0);
+}
+
 TEST(Verlet, SteppingWithToolConstraintsForcesAndPlasticityDoesNotAllocate) {
     // Local/global's explicit branch on a soft patch (linear laws: the only ones it takes).
     DynamicSurface s(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 30, 30);

@@ -1,0 +1,66 @@
+"""The fair-stroke scene (issue 26): a flat 100 mm patch (8 x 8 cubic poles, 40 x 40 mesh, as
+make_sculpt makes it) whose centre the rope pulls up until it stands LIFT mm high, then holds for
+HOLD seconds; free or with its corner poles held, elastic or clay (the materials of
+HapticSculpt.app.api), with the bending weight that makes strokes fair or with none. Shared by
+tests/test_fairness.py and bench/time_vs_error.py."""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from HapticSculpt import core
+from HapticSculpt.app import api, fairness
+
+LIFT = 20.0   # mm the centre stands above the sheet
+HOLD = 4.0    # s the rope holds it there
+RISE = 10.0   # mm/s the cursor rises
+DT = 1e-3     # a session's default step
+CENTRE = (20, 20)
+
+
+def build(material: str, pinned: bool, bending: float = api.FAIR_BENDING) -> core.DynamicSurface:
+    """The patch as make_sculpt makes it, with bending weight ``bending`` (0: springs alone)."""
+    s = core.patch((8, 8), (3, 3), (40, 40))
+    api._apply_material(s, material)
+    s.bending_map.set_uniform(bending)
+    if pinned:
+        nu, nv = s.controls
+        s.hold_poles([0, nv - 1, (nu - 1) * nv, nu * nv - 1])
+    return s
+
+
+def pull(s: core.DynamicSurface, lift: float = LIFT, hold: float = HOLD, max_time: float = 10.0) -> dict:
+    """Grabs the centre with the rope and raises the cursor until the centre stands ``lift`` above
+    where it started, then holds the cursor still for ``hold`` s (long enough for the elastic sheet
+    to stop ringing). Returns the lift at the end, the kinetic energy left and the wall seconds per
+    step."""
+    z0 = float(s.mesh[CENTRE][2])
+    cursor = np.array(s.mesh[CENTRE], dtype=float)
+    t, steps, wall = 0.0, 0, 0.0
+
+    def step() -> None:
+        nonlocal steps, wall
+        s.set_cursor(list(cursor), grab=True)
+        start = time.perf_counter()
+        s.step(DT)
+        wall += time.perf_counter() - start
+        steps += 1
+
+    while float(s.mesh[CENTRE][2]) - z0 < lift:
+        if t > max_time:
+            raise RuntimeError(f"the rope did not lift the centre {lift} mm in {max_time} s")
+        cursor[2] += RISE * DT
+        step()
+        t += DT
+    for _ in range(round(hold / DT)):
+        step()
+    return {"lift": float(s.mesh[CENTRE][2]) - z0, "kinetic_energy": s.kinetic_energy(),
+            "step_seconds": wall / steps}
+
+
+def measure(s: core.DynamicSurface, pinned: bool) -> fairness.Fairness:
+    """The six central sections (and with held corners the two diagonals, where a crease to a
+    corner would run)."""
+    g, h = s.mesh_shape
+    return fairness.measure(np.array(s.mesh), fairness.central_sections(g, h, CENTRE, diagonals=pinned))
