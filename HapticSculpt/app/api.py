@@ -10,7 +10,7 @@ import math
 import os
 import time
 from dataclasses import dataclass
-from typing import Any, Iterable, Protocol, Sequence
+from typing import Any, Callable, Iterable, Protocol, Sequence
 
 import numpy as np
 
@@ -362,6 +362,14 @@ def paint(obj: Any, map: str, path: Sequence[Sequence[float]], radius: float = 0
     the unit square): dabs half a radius apart move the map toward ``factor`` times its mean at the
     stroke's start. One undo step ("Paint <map>"); the GUI's airbrush records its strokes so."""
     obj = _sculpt(obj, solids=True)
+    obj.Proxy.live.edit(paint_change(map, path, radius, factor, strength), f"Paint {map}")
+
+
+def paint_change(map: str, path: Sequence[Sequence[float]], radius: float = 0.08, factor: float = 3.0,
+                 strength: float = 0.25) -> Callable[[core.DynamicSurface], None]:
+    """The change :func:`paint` makes, its arguments checked (``ValueError`` naming the first bad
+    one): for a caller that commits it itself (the GUI's airbrush keeps its long strokes in the
+    StrokeLog in the same undo step)."""
     sculpt_state.map_property(map)
     points = np.asarray(path, dtype=float)
     if points.ndim != 2 or points.shape[1] != 2 or len(points) == 0:
@@ -379,7 +387,7 @@ def paint(obj: Any, map: str, path: Sequence[Sequence[float]], radius: float = 0
         for p in points:
             paint_dabs(material, previous, (p[0], p[1]), radius, target, strength)
             previous = (p[0], p[1])
-    obj.Proxy.live.edit(change, f"Paint {map}")
+    return change
 
 
 class CursorSource(Protocol):

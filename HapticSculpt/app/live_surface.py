@@ -136,7 +136,7 @@ class LiveSurface:
 
     # --- writes -----------------------------------------------------------------------------------
     def edit(self, change: Callable[[core.DynamicSurface], T], title: str, keep_shape: bool = False,
-             new_shape: bool = False) -> T:
+             new_shape: bool = False, inside: Callable[[], None] | None = None) -> T:
         """Applies ``change(surface)`` as one undo transaction named ``title`` and returns its result.
 
         Without a session it changes the surface and commits at once. During one ``change`` runs on
@@ -144,7 +144,9 @@ class LiveSurface:
         between two steps without letting go of the device (the transaction follows when the
         simulation has applied it). ``keep_shape`` then makes the current shape the rest shape.
         ``new_shape``: ``change`` moves the poles (Fair), so the session takes the copy as it is, at
-        rest, as it takes an Undo, instead of carrying its own shape over."""
+        rest, as it takes an Undo, instead of carrying its own shape over. ``inside`` (no session
+        only) runs inside the transaction, after the state is written: the GUI keeps and echoes the
+        change there, in the same undo step."""
         if self._session is not None and not self._session.running:
             self._session.stop()  # its loops ended by themselves: commit its strokes, take the surface back
         if self._session is None:
@@ -152,7 +154,7 @@ class LiveSurface:
             result = change(surface)
             if keep_shape:
                 surface.relax()
-            self.commit(title)
+            self.commit(title, inside=inside)
             return result
         prepared = self._configured()
         poles = self._session.latest_poles()
@@ -168,13 +170,16 @@ class LiveSurface:
         self._shadow_stale = True
         return result
 
-    def commit(self, title: str, strokes: int = 0) -> None:
-        """Writes the surface's state to the document as one undo transaction (no session)."""
+    def commit(self, title: str, strokes: int = 0, inside: Callable[[], None] | None = None) -> None:
+        """Writes the surface's state to the document as one undo transaction (no session);
+        ``inside`` runs in it after the write."""
         obj = self._obj
         with transaction(obj.Document, title):
             self.write(sculpt_state.capture(self.surface))
             if strokes:
                 obj.Strokes = obj.Strokes + strokes
+            if inside is not None:
+                inside()
             obj.purgeTouched()
 
     def write(self, state: sculpt_state.SculptState) -> None:

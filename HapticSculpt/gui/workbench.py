@@ -39,6 +39,7 @@ KEYS = {"p": "point", "n": "normal", "c": "curvature"}
 AIRBRUSH_FACTOR = 3.0  # a stroke moves the map toward this times its mean when the stroke began
 AIRBRUSH_RADIUS = 0.08  # map coordinates (the unit square)
 AIRBRUSH_STRENGTH = 0.25  # per dab, at its centre
+ECHO_MAX = 200  # an echoed call longer than this goes into the StrokeLog (a person reads the console)
 VIEW_SCAN_SECONDS = 0.25  # how often new and closed 3D views are looked for
 #: Shown in the status bar when the workbench is chosen (the workbench selector keeps the keys).
 HELLO = ("HapticSculpt: click in the 3D view, then P / N / C toggle point, normal, curvature constraints at the "
@@ -340,8 +341,12 @@ class Controller:
         obj, self._paint_stroke = self._paint_stroke, None
         if obj is not None and _alive(obj) and self._paint_path:
             obj.Proxy.live.revert_map(self.painting)  # (the call below lays the same dabs again)
-            run_echoed(f"HapticSculpt.paint({ref(obj)}, {self.painting!r}, {self._paint_path!r}, radius={AIRBRUSH_RADIUS!r}, "
-                       f"factor={AIRBRUSH_FACTOR!r}, strength={AIRBRUSH_STRENGTH!r})")
+            call = (f"HapticSculpt.paint({ref(obj)}, {self.painting!r}, {self._paint_path!r}, radius={AIRBRUSH_RADIUS!r}, "
+                    f"factor={AIRBRUSH_FACTOR!r}, strength={AIRBRUSH_STRENGTH!r})")
+            if len(call) <= ECHO_MAX:
+                run_echoed(call)
+            else:  # a long path: kept in the sculpt's StrokeLog, echoed as one short line
+                paint_long_stroke(obj, self.painting, self._paint_path)
             self.refresh(obj)
 
     def _dab_to(self, obj: Any, at: np.ndarray) -> None:
@@ -537,3 +542,15 @@ def controller() -> Controller:
     if not _CONTROLLER:
         _CONTROLLER.append(Controller())
     return _CONTROLLER[0]
+
+
+def paint_long_stroke(obj: Any, map: str, path: list[tuple[float, float]]) -> None:
+    """An airbrush stroke whose ``paint`` call would be longer than a line: painted, kept in the
+    sculpt's StrokeLog and echoed as ``HapticSculpt.replay_stroke``, in one undo step."""
+    from ..app import api
+    from ..app.sculpt_properties import read_state
+    from .echo import echo_stroke
+    title = f"Paint {map}"
+    before = read_state(obj)
+    change = api.paint_change(map, path, radius=AIRBRUSH_RADIUS, factor=AIRBRUSH_FACTOR, strength=AIRBRUSH_STRENGTH)
+    obj.Proxy.live.edit(change, title, inside=lambda: echo_stroke(obj, before, title, 0))
