@@ -45,14 +45,15 @@ def test_new_patch_without_a_document_then_thicken_choosing_the_thickness(tmp_pa
         centre = d.to_screen(sculpt(s)["screen"][0])
         d.xdo("mousemove", str(centre[0]), str(centre[1]))
         d.wait(lambda s: s["mouse_point"] is not None, "the mouse over the patch")
-        d.xdo("click", "1")  # select the patch
-        d.wait(lambda s: sculpt(s)["selected"], "the patch selected")
+        # nothing selected: Thicken takes the document's only sculpt
         d.press_button("Thicken", lambda s: s["task_dialog"], "the thickness panel")
         d.shot("thick_panel")
+        d.xdo("key", "--delay", "100", "ctrl+a", "0", "Return")  # 0 mm is refused: the panel stays, says why
         d.xdo("key", "--delay", "100", "ctrl+a", "5", "Return")  # the value is selected: typing replaces it
         s = d.wait(lambda s: not s["task_dialog"] and any(f["thickness"] for f in doc(s)["features"].values()),
                    "the Thickness made", timeout=30)
         made = thickness(s)
+        assert [f["thickness"] for f in doc(s)["features"].values() if f["thickness"]] == [5.0], doc(s)["features"]
         assert made["thickness"] == 5.0 and made["valid"] and made["solids"] == 1, made
         assert made["state"] == ["Up-to-date"] and made["visible"], made
         assert 0.85 * 5e4 < made["volume"] < 1.15 * 5e4, made  # 100 x 100 mm by 5 mm (a flat patch)

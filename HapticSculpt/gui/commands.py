@@ -138,20 +138,38 @@ class SculptFace:
                                      f"{obj.ConversionMethod}, error {obj.ConversionError:.3g} mm\n")
 
 
+def _sculpt_to_thicken() -> Any:
+    """The selected sculpt, else the active document's only sculpt that is no face of a solid."""
+    from ..app.sculpt_feature import is_sculpt
+    from ..app.sculpted_solid import is_sculpted_solid
+    picked = _selected_sculpts()
+    if picked:
+        return picked[0] if len(picked) == 1 else None
+    doc = FreeCAD.ActiveDocument
+    if doc is None:
+        return None
+    in_solids = {id(s) for o in doc.Objects if is_sculpted_solid(o) for s in o.OutList}
+    free = [o for o in doc.Objects if is_sculpt(o) and id(o) not in in_solids]
+    return free[0] if len(free) == 1 else None
+
+
 class Thicken:
-    """Thicken the selected sculpt into a parametric solid: a task panel asks the thickness."""
+    """Thicken the selected sculpt (else the document's only one) into a parametric solid: a task
+    panel asks the thickness."""
 
     def GetResources(self) -> dict[str, str]:
         return {"Pixmap": icon("Thicken"), "MenuText": "Thicken",
-                "ToolTip": "Offset the selected sculpt surface into a solid that follows it (asks the thickness; "
-                           "double-click the Thickness to change it)"}
+                "ToolTip": "Offset the selected sculpt surface (else the only one) into a solid that follows it "
+                           "(asks the thickness; double-click the Thickness to change it)"}
 
     def IsActive(self) -> bool:
-        return len(_selected_sculpts()) == 1 and not Gui.Control.activeDialog()
+        return _sculpt_to_thicken() is not None and not Gui.Control.activeDialog()
 
     def Activated(self) -> None:
         from .thickness_panel import ThicknessPanel
-        Gui.Control.showDialog(ThicknessPanel(sculpt=_selected_sculpts()[0]))
+        sculpt = _sculpt_to_thicken()
+        if sculpt is not None:
+            Gui.Control.showDialog(ThicknessPanel(sculpt=sculpt))
 
 
 class ExportStep:

@@ -286,7 +286,7 @@ class Overlay:
         if session is not None:
             parts.append(f"sculpting with the {session.device_name or 'mouse'}")
         if self.display == "zebra":
-            turn = (f"strips at {self.stripe_angle:g} deg" if self.stripe_mode == "reflection"
+            turn = (f"stripes at {self.stripe_angle:g} deg" if self.stripe_mode == "reflection"
                     else "to ({:.2g}, {:.2g}, {:.2g})".format(*self.stripe_direction))
             parts.append(f"zebra: {self.stripe_mode}, {self.stripes:g} stripes, {turn}")
         if self.combs:

@@ -51,6 +51,10 @@ class SliderPanel:
             run_echoed(f"HapticSculpt.set_uniform({ref(obj)}, {name!r}, {float(value)!r})")
         elif [c for c in obj.Proxy.live.snapshot().constraints if c["kind"] == "curvature"]:
             run_echoed(f"HapticSculpt.set_curvature_target({ref(obj)}, {name[-1]}={float(value)!r})")
+        else:  # (the targets belong to curvature constraints: nothing to set yet)
+            import FreeCAD
+            FreeCAD.Console.PrintWarning("HapticSculpt: the curvature sliders set the targets of curvature "
+                                         "constraints, and this sculpt has none: press C over the surface to add one\n")
 
     @staticmethod
     def fraction(name: str, value: float) -> float:

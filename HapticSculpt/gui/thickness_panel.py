@@ -42,8 +42,9 @@ class ThicknessPanel:
                 run_echoed(f"HapticSculpt.make_thickness({ref(self.sculpt)}, {t!r})")
             else:
                 self._edit(t)
-        except (ValueError, TypeError) as exc:
+        except (ValueError, TypeError) as exc:  # (0 mm, say: the spin box lets it through to be refused)
             FreeCAD.Console.PrintError(f"HapticSculpt: Thicken: {exc}\n")
+            self.form.message.setText(str(exc))
             return False  # (the panel stays open for another value)
         self._close()
         return True
