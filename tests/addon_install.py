@@ -13,6 +13,7 @@ PYTHON is an interpreter with pip for FreeCAD's Python version (a virtual enviro
 from __future__ import annotations
 
 import argparse
+import glob
 import os
 import shutil
 import subprocess
@@ -69,10 +70,9 @@ def main(argv: list[str]) -> int:
 
     run("freecadcmd -t TestHapticSculpt (from the installed addon)", ["freecadcmd", "-t", "TestHapticSculpt"],
         env=env, cwd=out)
+    gui_tests = sorted(os.path.relpath(p, addon) for p in glob.glob(os.path.join(addon, "tests", "test_gui_*.py")))
     run("GUI tests (from the installed addon)",
-        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-rfE", *args.pytest_args.split(),
-         "tests/test_gui_workbench.py", "tests/test_gui_undo.py", "tests/test_gui_overlay.py",
-         "tests/test_gui_real_input.py", "tests/test_gui_sculpted_solid.py", "tests/test_gui_force_device.py"],
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-rfE", *args.pytest_args.split(), *gui_tests],
         env=env, cwd=addon)
     return 0
 
