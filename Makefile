@@ -98,9 +98,11 @@ wheel: deps $(WHEEL_VENV)/.installed
 # The Addon Manager's install without a compiler: a copy of the repository without build output in
 # a private FreeCAD home's Mod folder, the wheel in its AdditionalPythonPackages; then, from there,
 # the FreeCAD-layer tests through FreeCAD's runner and the GUI tests (tests/addon_install.py).
+GUI_TESTS ?=
 test-addon: build wheel ocp-venv
 	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) tests/addon_install.py \
-	  --wheel $$(ls $(BUILD)/wheel/dist/*.whl) --pip-python $(WHEEL_VENV)/bin/python --out $(BUILD)/addon-install
+	  --wheel $$(ls $(BUILD)/wheel/dist/*.whl) --pip-python $(WHEEL_VENV)/bin/python --out $(BUILD)/addon-install \
+	  --gui-tests "$(GUI_TESTS)"
 
 # The FreeCAD-layer tests through FreeCAD's own runner, with this checkout linked as the addon (make
 # test runs them from the installed addon instead: test-addon).
@@ -119,11 +121,16 @@ HOST_SUITE  := $(shell . /etc/os-release 2>/dev/null; echo $$VERSION_CODENAME)
 OTHER_SUITE := $(if $(filter trixie,$(HOST_SUITE)),bookworm,trixie)
 OTHER_PACKAGES := $(APT_PACKAGES) make ca-certificates
 OTHER := tools/debian-root $(OTHER_SUITE) run make BUILD=build/$(OTHER_SUITE) DEMO_OUT=build/$(OTHER_SUITE)/demo
+# The GUI tests the other Debian runs: those written before this round's (the panel, toolbar, focus,
+# thickness, solid-session, export and fair ones have run on FreeCAD 0.20 only so far; on 1.0 the
+# observer found no toolbars, fixed, but the rest is untried).
+OTHER_GUI_TESTS := tests/test_gui_workbench.py tests/test_gui_undo.py tests/test_gui_overlay.py \
+                   tests/test_gui_real_input.py tests/test_gui_sculpted_solid.py tests/test_gui_force_device.py
 # Where no root can be made (no mount namespace: tools/debian-root exits 77 with one line saying what
 # is missing), the rest of make test still counts.
 test-other-debian: deps
 	@set +e; tools/debian-root $(OTHER_SUITE) ensure $(OTHER_PACKAGES) && \
-	  $(OTHER) test-cpp test-asan test-python test-addon demo; rc=$$?; \
+	  $(OTHER) test-cpp test-asan test-python test-addon demo "GUI_TESTS='$(OTHER_GUI_TESTS)'"; rc=$$?; \
 	  if [ $$rc = 77 ]; then echo "make test: the other Debian's FreeCAD was not tested (see the line above)"; exit 0; fi; \
 	  exit $$rc
 

@@ -43,6 +43,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--pip-python", required=True)
     parser.add_argument("--out", required=True)
     parser.add_argument("--pytest-args", default="", help="more arguments for the GUI tests' pytest")
+    parser.add_argument("--gui-tests", default="", help="the GUI test files to run (default: every tests/test_gui_*.py)")
     args = parser.parse_args(argv)
     out = os.path.abspath(args.out)
     shutil.rmtree(out, ignore_errors=True)
@@ -70,7 +71,8 @@ def main(argv: list[str]) -> int:
 
     run("freecadcmd -t TestHapticSculpt (from the installed addon)", ["freecadcmd", "-t", "TestHapticSculpt"],
         env=env, cwd=out)
-    gui_tests = sorted(os.path.relpath(p, addon) for p in glob.glob(os.path.join(addon, "tests", "test_gui_*.py")))
+    gui_tests = args.gui_tests.split() or sorted(
+        os.path.relpath(p, addon) for p in glob.glob(os.path.join(addon, "tests", "test_gui_*.py")))
     run("GUI tests (from the installed addon)",
         [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-rfE", *args.pytest_args.split(), *gui_tests],
         env=env, cwd=addon)

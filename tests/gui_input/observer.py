@@ -211,13 +211,13 @@ def _toolbars():
     mw = Gui.getMainWindow()
     bars, buttons, groups, open_menus = {}, {}, {}, {}
     for bar in mw.children():
-        if bar.metaObject().className() != "QToolBar" or not bar.isVisible():
+        if not bar.inherits("QToolBar") or not bar.isVisible():  # (FreeCAD 1.0's are Gui::ToolBar)
             continue
         shown, hidden, extension = [], [], None
         for tb in bar.children():
             if tb.objectName() == "qt_toolbar_ext_button":  # (a QToolBarExtension)
                 extension = _rect(tb) if tb.isVisible() else None
-            elif tb.metaObject().className() == "QToolButton" and tb.defaultAction() is not None:
+            elif tb.inherits("QToolButton") and tb.defaultAction() is not None:
                 name = _command_name(tb.defaultAction())
                 if tb.isVisible():
                     buttons[name] = _rect(tb) + [tb.isEnabled()]
