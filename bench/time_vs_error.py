@@ -352,7 +352,7 @@ def main() -> None:
     path = os.path.join(out_dir, "time_vs_error.json")
     kept: dict = {"references": {}, "records": []}
     if chosen != list(SCENES) and os.path.exists(path):
-        with open(path) as f:
+        with open(path, encoding="utf-8") as f:
             kept = json.load(f)
     refs, notes = {}, {k: v for k, v in kept["references"].items() if k not in chosen}
     for scene in progress(chosen, "references"):

@@ -83,7 +83,7 @@ def run_freecadcmd(script: str, tmp: str, timeout: float = 300) -> dict:
     proc = subprocess.run([FREECADCMD, path], env=env, capture_output=True, text=True, timeout=timeout)
     if not os.path.exists(out):
         raise AssertionError(f"freecadcmd gave no answer (rc {proc.returncode}):\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
-    with open(out) as f:
+    with open(out, encoding="utf-8") as f:
         return json.load(f)
 
 
@@ -108,7 +108,7 @@ def run_freecad_gui(script: str, tmp: str, timeout: float = 300) -> dict:
                           env=env, capture_output=True, text=True, timeout=timeout)
     if not os.path.exists(out):
         raise AssertionError(f"the FreeCAD GUI gave no answer (rc {proc.returncode}):\n{proc.stdout[-2000:]}\n{proc.stderr[-2000:]}")
-    with open(out) as f:
+    with open(out, encoding="utf-8") as f:
         result = json.load(f)
     assert "error" not in result, result["error"]
     return result

@@ -315,7 +315,7 @@ class TestReadme(DocumentTestCase):
         import os
         import re
         from freecad_support import ROOT
-        with open(os.path.join(ROOT, "README.md")) as f:
+        with open(os.path.join(ROOT, "README.md"), encoding="utf-8") as f:
             block = re.search(r"## Scripting.*?```python\n(.*?)```", f.read(), re.S).group(1)
         block = block.replace('"/tmp/sculpt.step"', repr(os.path.join(self.tmp, "sculpt.step")))
         scope = {}
@@ -341,5 +341,5 @@ class TestPackage(DocumentTestCase):
         self.assertEqual(bench.FreeCADMin, "0.20.0")  # higher makes 0.20 skip the addon
         self.assertTrue(os.path.isfile(os.path.join(ROOT, bench.Icon)))
         self.assertIn("numpy", [d["package"] for d in bench.Depend])
-        with open(os.path.join(ROOT, "InitGui.py")) as f:
+        with open(os.path.join(ROOT, "InitGui.py"), encoding="utf-8") as f:
             self.assertIn(f"class {bench.Classname}(", f.read())

@@ -35,7 +35,7 @@ def stop_macro(d: Desktop, name: str) -> str:
     end, text = time.monotonic() + 30, ""
     while "# Macro End" not in text and time.monotonic() < end:  # (written when the recording stops)
         time.sleep(0.05)
-        text = open(path).read() if os.path.exists(path) else ""
+        text = open(path, encoding="utf-8").read() if os.path.exists(path) else ""
     return text
 
 

@@ -106,7 +106,7 @@ class Desktop:
 
     def state(self) -> dict:
         try:
-            with open(self.state_file) as f:
+            with open(self.state_file, encoding="utf-8") as f:
                 return json.load(f)
         except (OSError, ValueError):
             return {}
@@ -379,7 +379,7 @@ def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
         end, text = time.monotonic() + 20, ""
         while "# Macro End" not in text and time.monotonic() < end:  # (written when the recording stops)
             time.sleep(0.05)
-            text = open(macro).read() if os.path.exists(macro) else ""
+            text = open(macro, encoding="utf-8").read() if os.path.exists(macro) else ""
         saved = str(tmp_path / "strokes.FCStd")
         d.xdo("key", "ctrl+s")  # (after the recording: the macro must not save over it)
         d.wait_window("Save FreeCAD Document")

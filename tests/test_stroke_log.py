@@ -149,7 +149,7 @@ def test_an_old_macro_with_record_state_replays_in_console_mode(tmp_path):
     out = run_freecadcmd(f"""
         import FreeCAD
         App = FreeCAD
-        exec(open({str(macro)!r}).read())
+        exec(open({str(macro)!r}, encoding="utf-8").read())
         obj = FreeCAD.getDocument("Unnamed").getObject("Sculpt")
         answer({{"poles": list(obj.Poles), "strokes": obj.Strokes, "undo": FreeCAD.getDocument("Unnamed").UndoNames}})
         """, str(tmp_path / "replay"))

@@ -109,7 +109,7 @@ def _usb_vendors() -> set[str]:
     found = set()
     for path in glob.glob("/sys/bus/usb/devices/*/idVendor"):
         try:
-            with open(path) as f:
+            with open(path, encoding="utf-8") as f:
                 found.add(f.read().strip().lower())
         except OSError:
             pass
@@ -224,7 +224,7 @@ def _sysfs_has(vendor: str, product: str) -> builtins.list[bool]:
     hits = []
     for path in glob.glob("/sys/bus/usb/devices/*/idVendor"):
         try:
-            with open(path) as f, open(os.path.join(os.path.dirname(path), "idProduct")) as g:
+            with open(path, encoding="utf-8") as f, open(os.path.join(os.path.dirname(path), "idProduct"), encoding="utf-8") as g:
                 hits.append(f.read().strip() == vendor and g.read().strip() == product)
         except OSError:
             pass
