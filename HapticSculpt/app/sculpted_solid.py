@@ -17,6 +17,7 @@ from typing import Any
 from . import face_in_solid
 from .face_chain import FaceChain, single
 from .sculpt_properties import read_state, surface_of
+from .tagged_proxy import TaggedProxy
 from .view_provider_hook import ViewProviderHook
 
 TYPE = "HapticSculpt::SculptedSolid"
@@ -49,8 +50,10 @@ def ensure_properties(obj: Any) -> None:
         obj.setEditorMode(name, mode)
 
 
-class SculptedSolidFeature:
+class SculptedSolidFeature(TaggedProxy):
     """Proxy of a SculptedSolid object; no state of its own (see the module docstring)."""
+
+    TYPE = TYPE
 
     def __init__(self, obj: Any) -> None:
         self.Type = TYPE
@@ -105,19 +108,6 @@ class SculptedSolidFeature:
             except (RuntimeError, ValueError) as exc:
                 import FreeCAD
                 FreeCAD.Console.PrintError(f"HapticSculpt: {obj.Label}: {exc}\n")
-
-    def dumps(self) -> dict[str, Any]:
-        """Proxy state for the file: only the type tag (everything else is in the properties)."""
-        return {"Type": TYPE}
-
-    def loads(self, state: Any) -> None:
-        self.Type = TYPE
-
-    def __getstate__(self) -> dict[str, Any]:
-        return self.dumps()
-
-    def __setstate__(self, state: Any) -> None:
-        self.loads(state)
 
 
 def is_sculpted_solid(obj: Any) -> bool:

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from .tagged_proxy import TaggedProxy
 from .view_provider_hook import ViewProviderHook
 
 TYPE = "HapticSculpt::Thickness"
@@ -47,8 +48,10 @@ def thickened(face: Any, thickness: float, tolerance: float = TOLERANCE) -> Any:
     return solids[0]
 
 
-class ThicknessFeature:
+class ThicknessFeature(TaggedProxy):
     """Proxy of a Thickness object; no state of its own (see the module docstring)."""
+
+    TYPE = TYPE
 
     def __init__(self, obj: Any) -> None:
         self.Type = TYPE
@@ -64,19 +67,6 @@ class ThicknessFeature:
 
     def onDocumentRestored(self, obj: Any) -> None:
         ensure_properties(obj)
-
-    def dumps(self) -> dict[str, Any]:
-        """Proxy state for the file: only the type tag (everything else is in the properties)."""
-        return {"Type": TYPE}
-
-    def loads(self, state: Any) -> None:
-        self.Type = TYPE
-
-    def __getstate__(self) -> dict[str, Any]:
-        return self.dumps()
-
-    def __setstate__(self, state: Any) -> None:
-        self.loads(state)
 
 
 def is_thickness(obj: Any) -> bool:
