@@ -226,3 +226,39 @@ class TestEditsDuringASession(DocumentTestCase):
         self.assertEqual(self.doc.UndoNames[0], "Add point constraint")
         self.assertIn("Sculpt stroke", self.doc.UndoNames)
         self.assertIn(cid, [c["id"] for c in obj.Proxy.surface.constraints])
+
+
+class TestStop(DocumentTestCase):
+    def test_stop_adds_no_undo_step_and_keeps_the_shape_the_surface_ended_in(self):
+        """An elastic patch springs back after a stroke; Stop right after the stroke's commit makes
+        no step of its own ("Sculpt session end"): what moved joins the stroke's step, the face is
+        the surface the session ended with, and Undo and Redo go to before the stroke and back."""
+        from HapticSculpt.app import sculpt_state
+        from HapticSculpt.app.sculpt_properties import read_state
+        obj = hs.make_sculpt(self.doc, material="elastic")
+        flat = read_state(obj)
+        up = hs.ReplayDevice(t=[0.0, 0.4, 0.5, 30.0], xyz=[[0, 0, 0], [0, 0, 30], [0, 0, 30], [0, 0, 30]],
+                             buttons=[1, 1, 0, 0])
+        session = hs.Session().start(obj, up)
+        end = time.monotonic() + 60
+        while session.poll() == 0:  # (the stroke's commit; the patch springs back from its release on)
+            self.assertLess(time.monotonic(), end, "no stroke")
+            time.sleep(0.002)
+        steps, released = list(self.doc.UndoNames), read_state(obj)
+        self.assertEqual(steps[0], "Sculpt stroke")
+        session.stop()
+        ended = sculpt_state.capture(obj.Proxy.live.surface)
+        self.assertEqual(list(self.doc.UndoNames), steps)
+        self.assertEqual(obj.Strokes, 1)
+        kept = read_state(obj)
+        self.assertGreater(np.abs(kept.arrays["Poles"] - released.arrays["Poles"]).max(), 1e-6,
+                           "the patch had stopped moving: this test shows nothing")
+        for name in sculpt_state.ARRAY_NAMES:
+            np.testing.assert_array_equal(kept.arrays[name], ended.arrays[name], err_msg=name)
+        face = np.array([[p.x, p.y, p.z] for row in obj.Shape.Faces[0].Surface.getPoles() for p in row])
+        np.testing.assert_array_equal(face.ravel(), kept.arrays["Poles"])
+        self.doc.undo()
+        np.testing.assert_array_equal(read_state(obj).arrays["Poles"], flat.arrays["Poles"])
+        self.doc.redo()
+        np.testing.assert_array_equal(read_state(obj).arrays["Poles"], kept.arrays["Poles"])
+        self.assertEqual(obj.Strokes, 1)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import time
 
 import FreeCAD
 import numpy as np
@@ -18,7 +19,7 @@ from HapticSculpt.app.sculpt_properties import read_state
 from HapticSculpt.runtime import session as session_module
 
 
-def keep(obj, before, title, strokes):
+def keep(obj, before, title, strokes, echo=True):
     stroke_log.record(obj, before, title, strokes)
 
 
@@ -182,3 +183,77 @@ class TestAFailingListener(DocumentTestCase):
             session_module.set_commit_listener(None)
         self.assertEqual(obj.Strokes, 1)
         self.assertIn("Sculpt stroke", self.doc.UndoNames)
+
+
+def test_a_macro_with_strokes_and_edits_interleaved_in_a_session_replays_in_console_mode(tmp_path):
+    """The GUI's code path without the GUI: each call runs as FreeCADGui.doCommand runs it (the line
+    into the macro, then executed), and each commit the session makes is kept and echoed as the GUI's
+    listener does. Edits made while the session's surface moves (an elastic patch springing back, a
+    held stroke) act there on the moving poles, and in the macro on the state the lines before gave:
+    the macro, replayed by freecadcmd with the saved document open, ends in the same state."""
+    doc = FreeCAD.newDocument("Edits")
+    lines: list[str] = []
+    ref = "App.getDocument('Edits').getObject('Sculpt')"
+    space = {"HapticSculpt": hs, "App": FreeCAD}
+
+    def run(line: str) -> None:
+        lines.append(line)
+        exec(line, space)
+
+    def echo(obj, before, title, strokes, echo=True):
+        name = stroke_log.record(obj, before, title, strokes)
+        if echo:
+            run(f"HapticSculpt.replay_stroke({ref}, {name!r})")
+
+    session_module.set_commit_listener(echo)
+    try:
+        run("HapticSculpt.make_sculpt(App.getDocument('Edits'), material='elastic')")
+        obj = doc.getObject("Sculpt")
+        # two strokes: up (released at 0.5 s), then down while the patch still springs back
+        device = hs.ReplayDevice(t=[0.0, 0.4, 0.5, 1.2, 1.6, 1.7, 3.0],
+                                 xyz=[[0, 0, 0], [0, 0, 30], [0, 0, 30], [20, 20, 0], [20, 20, -20], [20, 20, -20],
+                                      [20, 20, -20]], buttons=[1, 1, 0, 1, 1, 0, 0])
+        s = hs.Session().start(obj, device, stop_when_finished=True)
+
+        def until(condition, what):
+            end = time.monotonic() + 60
+            while not condition():
+                assert time.monotonic() < end, what
+                s.poll()
+                time.sleep(0.005)
+
+        until(lambda: obj.Strokes >= 1, "the first stroke")  # (the patch springs back from here)
+        run(f"HapticSculpt.add_constraint({ref}, 'normal', near=(10.0, -10.0, 0.0))")
+        run(f"HapticSculpt.set_uniform({ref}, 'stiffness', 250.0)")
+        until(lambda: s.status()["elapsed"] > 1.4, "the second stroke under way")
+        run(f"HapticSculpt.set_material({ref}, 'clay')")  # (on a held stroke)
+        run(f"HapticSculpt.add_constraint({ref}, 'point', near=(-30.0, 30.0, 0.0))")
+        until(lambda: obj.Strokes >= 2, "the second stroke")
+        run(f"HapticSculpt.keep_shape({ref})")
+        until(lambda: not s.running, "the replay to end")
+        s.stop()
+        titles = list(doc.UndoNames)
+        assert "Sculpt session end" not in titles
+        assert titles.count("Sculpt stroke") == 2 and "Material: clay" in titles and "Keep shape" in titles, titles
+        expected = read_state(obj)
+        saved = str(tmp_path / "saved.FCStd")
+        doc.saveAs(saved)
+    finally:
+        session_module.set_commit_listener(None)
+        FreeCAD.closeDocument(doc.Name)
+    macro = tmp_path / "edits.FCMacro"
+    macro.write_text("import FreeCAD\nApp = FreeCAD\nimport HapticSculpt\nApp.newDocument('Edits')\n"
+                     + "\n".join(lines) + "\n", encoding="utf-8")
+    out = run_freecadcmd(f"""
+        import FreeCAD
+        FreeCAD.openDocument({saved!r})
+        exec(open({str(macro)!r}, encoding="utf-8").read())
+        obj = FreeCAD.getDocument("Edits").getObject("Sculpt")
+        from HapticSculpt.app import sculpt_state
+        answer({{name: list(map(float, getattr(obj, name))) for name in sculpt_state.ARRAY_NAMES}}
+               | {{"settings": obj.SculptSettings, "strokes": obj.Strokes}})
+        """, str(tmp_path / "replay"))
+    for name in sculpt_state.ARRAY_NAMES:
+        np.testing.assert_allclose(out[name], expected.arrays[name], rtol=0, atol=1e-9, err_msg=name)
+    assert json.loads(out["settings"]) == json.loads(expected.settings_json())
+    assert out["strokes"] == 2

@@ -42,9 +42,12 @@ class SessionLink(Protocol):
         """Ends the session and hands the surface back (see LiveSurface.detach)."""
 
     def post_edit(self, prepared: core.DynamicSurface, state: sculpt_state.SculptState | None, title: str,
-                  restore: bool, keep_maps: bool, keep_shape: bool) -> None:
+                  restore: bool, keep_maps: bool, keep_shape: bool,
+                  replay: Callable[[core.DynamicSurface], None] | None = None) -> None:
         """Queues an edit for the simulation thread; when it applied, commits ``state`` (the
-        configuration it leaves) as ``title`` with the motion it took over (not if ``state`` is None)."""
+        configuration it leaves) as ``title`` with the motion it took over (not if ``state`` is None:
+        the document's own state restored). ``replay`` applies the edit to a surface as the same
+        scripting call does without a session (in a macro replayed in console mode)."""
 
     def latest_poles(self) -> np.ndarray | None:
         """The newest pole snapshot ((nu*nv, 3)) the session published, None before the first."""
@@ -165,7 +168,13 @@ class LiveSurface:
         after = _maps(prepared)
         keep_maps = all(np.array_equal(before[k], after[k]) for k in before)
         head = sculpt_state.capture(prepared)  # (before the simulation thread owns it)
-        self._session.post_edit(prepared, head, title, restore=new_shape, keep_maps=keep_maps, keep_shape=keep_shape)
+
+        def replay(surface: core.DynamicSurface) -> None:  # (what this call does without a session)
+            change(surface)
+            if keep_shape:
+                surface.relax()
+        self._session.post_edit(prepared, head, title, restore=new_shape, keep_maps=keep_maps, keep_shape=keep_shape,
+                                replay=replay)
         self._head = head
         self._shadow_stale = True
         return result

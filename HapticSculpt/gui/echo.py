@@ -22,11 +22,14 @@ def ref(obj: Any) -> str:
     return f"App.getDocument({obj.Document.Name!r}).getObject({obj.Name!r})"
 
 
-def echo_stroke(obj: Any, before: Any, title: str, strokes: int) -> None:
-    """Keeps a stroke, spray or session end that a threaded session committed in the sculpt's
-    StrokeLog and echoes the one short ``HapticSculpt.replay_stroke`` line that names it: run here
-    it changes nothing (the object holds that state), and in a recorded macro it replays the stroke
-    exactly. Called inside the commit's transaction (see runtime.session.set_commit_listener)."""
+def echo_stroke(obj: Any, before: Any, title: str, strokes: int, echo: bool = True) -> None:
+    """Keeps a stroke, spray or edit that a threaded session committed in the sculpt's StrokeLog
+    and echoes the one short ``HapticSculpt.replay_stroke`` line that names it: run here it changes
+    nothing (the object holds that state), and in a recorded macro it replays the commit exactly
+    (``before`` is the state the macro holds there). ``echo=False``: kept only (a commit made again
+    at the session's stop, with what moved after it, under the name its line gave already). Called
+    inside the commit's transaction (see runtime.session.set_commit_listener)."""
     from ..app import stroke_log
     name = stroke_log.record(obj, before, title, strokes)
-    run_echoed(f"HapticSculpt.replay_stroke({ref(obj)}, {name!r})")
+    if echo:
+        run_echoed(f"HapticSculpt.replay_stroke({ref(obj)}, {name!r})")

@@ -7,6 +7,14 @@ timer while FreeCAD's GUI runs, by :meth:`Session.poll` / :meth:`Session.wait` i
 always at :meth:`Session.stop`. Edits made meanwhile (``obj.Proxy.live.edit``) reach the running
 simulation through the runtime's edit queue without stopping it, and are committed the same way
 when the simulation has applied them; Undo and Redo restore the session's surface in place.
+
+Macros: every commit a session makes (a stroke, a spray, an edit with the motion it took over) is
+told to the commit listener (the GUI keeps it in the sculpt's StrokeLog and echoes one
+``replay_stroke`` line) with, as its state before, the state a macro replayed in console mode holds
+at that line: the session follows what each echoed line does there (an edit's own scripting call
+acts on the document's state, not on the session's moving poles), so a macro with strokes and
+edits interleaved replays to the same surface. :meth:`Session.stop` makes no undo step of its own:
+what moved after the last commit (an elastic patch springing back) joins that commit's step.
 """
 from __future__ import annotations
 
@@ -35,17 +43,19 @@ FrameClock = Callable[[Callable[[], None]], Callable[[], None]]
 _frame_clocks: list[FrameClock] = []
 
 
-#: Called inside the transaction of each commit a session makes that no scripting call made (a
-#: stroke, a spray, the session's end) with the object, its state before, the undo step's title and
-#: the strokes it counts: the GUI layer installs one that keeps the stroke in the sculpt and echoes
-#: HapticSculpt.replay_stroke, so a macro records it (and Undo forgets it with the stroke).
-CommitListener = Callable[[Any, sculpt_state.SculptState, str, int], None]
+#: Called inside the transaction of each commit a session makes (a stroke, a spray, an applied edit
+#: with the motion it took over) with the object, the state a macro replayed in console mode holds
+#: before it (see the module docstring), the undo step's title and the strokes it counts: the GUI
+#: layer installs one that keeps the change in the sculpt and echoes HapticSculpt.replay_stroke, so
+#: a macro records it (and Undo forgets it with the commit). ``echo=False`` (a keyword, only when
+#: False): the last commit's record amended at the stop, already echoed under the same name.
+CommitListener = Callable[..., None]
 _commit_listeners: list[CommitListener] = []
 
 
 def set_commit_listener(listener: CommitListener | None) -> None:
-    """Installs the listener told of every stroke, spray and session end a session commits (None:
-    none, as in console mode)."""
+    """Installs the listener told of every stroke, spray and edit a session commits (None: none, as
+    in console mode)."""
     _commit_listeners[:] = [listener] if listener is not None else []
 
 
@@ -71,6 +81,13 @@ class Session:
         self._next_edit = 1
         self._committed = False
         self._edits: dict[int, tuple[str, sculpt_state.SculptState | None, int]] = {}  # posted, not yet applied
+        #: the state a macro replayed in console mode holds after the lines echoed so far (None: not
+        #: known, an edit's own call failed on it; the document's state stands in then)
+        self._console: sculpt_state.SculptState | None = None
+        #: the last commit: (undo steps after it, title, strokes, console state before it, in this stop())
+        #: the last commit: undo steps after it, its title and strokes, the console's state before it,
+        #: whether the listener was told of it, whether it was made by stop()
+        self._last_commit: tuple[int, str, int, sculpt_state.SculptState, bool, bool] | None = None
         #: each edit the simulation applied this run: its title, the simulation steps taken when it
         #: was posted and when it applied (it applies between two steps, so these differ by 0 to 2),
         #: and the simulated time it applied at (s since the start)
@@ -109,6 +126,7 @@ class Session:
         self._latest_poles, self._latest_maps, self._edits, self.applied_edits = None, {}, {}, []
         self._previewed = False
         self._committed = False  # a stroke, spray or edit this run (else its end commits nothing)
+        self._console, self._last_commit = read_state(obj), None
         runtime.set_airbrush(**self._airbrush)
         runtime.start()
         _ACTIVE.add(self)
@@ -139,7 +157,7 @@ class Session:
         if obj is not None and _alive(obj):
             obj.Proxy.live.detach(runtime.surface)
             if commit:
-                self._commit_strokes(runtime, obj)
+                self._commit_strokes(runtime, obj, final=sculpt_state.capture(obj.Proxy.live.surface))
                 self._commit_final(obj)
             obj.Proxy.live.reset_shape()
         self._last_runtime = runtime  # logs stay readable (recording, force errors)
@@ -147,12 +165,15 @@ class Session:
 
     # --- the live surface's link (see live_surface.SessionLink) -------------------------------------
     def post_edit(self, prepared: Any, state: sculpt_state.SculptState | None, title: str, restore: bool,
-                  keep_maps: bool, keep_shape: bool) -> None:
+                  keep_maps: bool, keep_shape: bool, replay: Callable[[Any], None] | None = None) -> None:
         """Queues an edit for the simulation thread (called by ``obj.Proxy.live``); when it has
         applied, :meth:`poll` commits ``state`` as ``title`` with the motion it took over (not for
-        None: an Undo or Redo restoring the document's own state)."""
+        None: an Undo or Redo restoring the document's own state). ``replay`` does to a surface what
+        the edit's scripting call does without a session: the session follows the state a macro
+        replayed in console mode holds (see the module docstring)."""
         if self._runtime is None:
             raise RuntimeError("session: not running")
+        self._follow_console(title, state, replay)
         edit_id = self._next_edit
         self._next_edit += 1
         self._edits[edit_id] = (title, state, 0)
@@ -272,12 +293,39 @@ class Session:
             pass
 
     # --- strokes -> undo transactions -------------------------------------------------------------
-    def _commit_strokes(self, runtime: Any, obj: Any) -> int:
+    def _follow_console(self, title: str, state: sculpt_state.SculptState | None,
+                        replay: Callable[[Any], None] | None) -> None:
+        """An edit's call was just echoed (it runs before its commit, in the macro too): the state a
+        console replaying the macro holds after it. A restore (Undo, Redo, a replayed record: state
+        None) leaves the console with what the document holds now."""
+        obj = self._obj
+        if state is None or replay is None:
+            self._console = read_state(obj)
+            return
+        if self._console is None:
+            return
+        try:
+            surface = sculpt_state.restore(self._console)
+            replay(surface)
+            self._console = sculpt_state.capture(surface)
+        except Exception as exc:  # noqa: BLE001 - the call itself would fail there: said, not raised
+            import FreeCAD
+            FreeCAD.Console.PrintWarning(f"HapticSculpt: {title} does not replay on the macro's state "
+                                         f"({exc}); a macro recorded now may not replay\n")
+            self._console = None
+
+    def _commit_strokes(self, runtime: Any, obj: Any, final: sculpt_state.SculptState | None = None) -> int:
         """Commits the runtime's events in order: strokes, sprays and applied edits, one undo
-        transaction each. Returns the number of strokes and sprays."""
+        transaction each. At the stop, ``final`` is the state the surface ended in: the last of
+        them commits that (what moved after it is part of it). Returns the number of strokes and sprays."""
         n = 0
         live = obj.Proxy.live
+        events = []
         while (event := runtime.take_stroke()) is not None:
+            events.append(event)
+        last = max((k for k, e in enumerate(events) if e["edit"] is None or self._edits.get(e["edit"], ("", None))[1]
+                    is not None), default=-1)
+        for k, event in enumerate(events):
             if event["edit"] is not None:
                 title, state, posted = self._edits.pop(event["edit"], ("", None, 0))
                 self.applied_edits.append({"title": title or "restore", "posted_step": posted,
@@ -288,25 +336,35 @@ class Session:
             else:
                 title = f"Paint {event['painted']}" if event["painted"] else "Sculpt stroke"
                 state, strokes = read_state(obj), 1
+            before = self._console if self._console is not None else read_state(obj)
             live.reset_shape()  # (so the transaction records the stored face as what Undo goes back to)
-            with transaction(obj.Document, title):
-                live.write(_with_event(state, event))
+            doc = obj.Document
+            with transaction(doc, title):
+                live.write(final if final is not None and k == last else _with_event(state, event))
                 if strokes:
                     obj.Strokes = obj.Strokes + strokes
-                    _tell_commit(obj, state, title, strokes)
+                told = bool(strokes) or _differs(before, read_state(obj))  # (else the edit's own call gives it)
+                if told:
+                    _tell_commit(obj, before, title, strokes)
                 obj.purgeTouched()
+            self._console = read_state(obj)  # (the replay_stroke line just echoed gives it)
+            self._last_commit = (len(doc.UndoNames), title, strokes, before, told, final is not None)
             self._committed = True
             n += strokes
         return n
 
     def _commit_final(self, obj: Any) -> None:
-        """The state after the last stroke as its own transaction, if the surface moved on after it
-        (an elastic patch springing back, a swing settling). A session without a stroke, spray or
-        edit changed nothing (whatever its constraints made the surface do meanwhile), and
-        round-off drift of a resting patch (below a nanometre), and a clay patch's rest lengths
-        relaxed at the start, are no edit: the document keeps its state and the surface is reloaded."""
+        """What moved after the last commit (an elastic patch springing back, a swing settling)
+        joins that commit's undo step: Stop is no user action of its own and adds no step. A
+        session without a stroke, spray or edit changed nothing (whatever its constraints made the
+        surface do meanwhile), and round-off drift of a resting patch (below a nanometre), and a
+        clay patch's rest lengths relaxed at the start, are no change: the document keeps its state
+        and the surface is reloaded from it. So is the motion when the document changed after the
+        last commit (a step of another object's on top): the face and the surface then show the
+        last commit's state, which is what the document keeps."""
         live = obj.Proxy.live
-        if not self._committed:
+        last = self._last_commit
+        if not self._committed or last is None:
             live.document_changed()
             return
         current = sculpt_state.capture(live.surface)
@@ -318,11 +376,20 @@ class Session:
         if same and drift <= 1e-9:
             live.document_changed()  # the stored state stays the truth
             return
+        steps, title, strokes, before, told, in_stop = last
+        doc = obj.Document
+        if in_stop or len(doc.UndoNames) != steps or doc.UndoNames[0] != title:
+            live.document_changed()  # (committed with this stop: it holds the end state already)
+            return
+        doc.undo()  # (that step is taken back and made again with the motion after it)
         live.reset_shape()
-        with transaction(obj.Document, "Sculpt session end"):
+        with transaction(doc, title):
             live.write(current)
-            _tell_commit(obj, stored, "Sculpt session end", 0)
+            if strokes:
+                obj.Strokes = obj.Strokes + strokes
+            _tell_commit(obj, before, title, strokes, echo=not told)  # (told: its line names it already)
             obj.purgeTouched()
+        live.document_changed()
 
     # --- GUI: shape at graphics rate, strokes as they end ----------------------------------------
     def _start_timer(self) -> None:
@@ -358,12 +425,18 @@ class Session:
                 obj.Proxy.live.reset_shape()
 
 
-def _tell_commit(obj: Any, before: sculpt_state.SculptState, title: str, strokes: int) -> None:
+def _differs(a: sculpt_state.SculptState, b: sculpt_state.SculptState) -> bool:
+    """True unless the two states are equal, bit for bit."""
+    return a.settings_json() != b.settings_json() or any(
+        not np.array_equal(a.arrays[k], b.arrays[k]) for k in sculpt_state.ARRAY_NAMES)
+
+
+def _tell_commit(obj: Any, before: sculpt_state.SculptState, title: str, strokes: int, echo: bool = True) -> None:
     """Tells the listeners, inside the commit's transaction; one that fails is reported and the
     stroke is committed all the same (an echo must not cost the stroke)."""
     for listener in _commit_listeners:
         try:
-            listener(obj, before, title, strokes)
+            listener(obj, before, title, strokes) if echo else listener(obj, before, title, strokes, echo=False)
         except Exception as exc:  # noqa: BLE001 - reported, not raised: see the docstring
             import FreeCAD
             FreeCAD.Console.PrintError(f"HapticSculpt: {title} committed, but not echoed: {exc}\n")
