@@ -9,7 +9,10 @@ red cross, normal: blue line, curvature: white circle), the cursor with its axes
 point with its axes and the rope; its screen-space layer (:mod:`hud`) shows the legend of the
 display's range, the slider panel (operated with the mouse there), the tool and the mode. Nothing is
 retained between frames but the Coin roots it draws into; nothing is computed for a display that is
-off. No Qt: everything is pivy.
+off. The displays and the jacks lie on the surface, so they show only while it does: the sculpt
+shown, or the SculptedSolid it is a face of shown (a Thickness made from the sculpt, a Part Cut of
+its solid hide it, and its displays with it); the cursor and the HUD of a running session stay.
+No Qt: everything is pivy.
 """
 from __future__ import annotations
 
@@ -44,6 +47,7 @@ class Overlay:
         self.cursor: tuple[np.ndarray, np.ndarray, bool] | None = None  # position, quaternion (w, x, y, z), grab
         self.contact: np.ndarray | None = None
         self.cursor_shown = False  # whether the last frame drew the cursor
+        self.surface_drawn = False  # whether the last frame drew anything on the surface (a display, jacks)
         self.live = True  # a session is drawn each frame here (the view the pointer is in; see Controller)
         self.frame_ms = 0.0  # cost of the last frame
         self.frames = 0
@@ -68,8 +72,8 @@ class Overlay:
     @property
     def needed(self) -> bool:
         """True while anything is to be drawn each frame."""
-        return bool((self._session() is not None and self.live) or self.display != "shading" or self.combs
-                    or self.panel_visible)
+        return bool((self._session() is not None and self.live) or self.panel_visible
+                    or ((self.display != "shading" or self.combs) and self._visible()))
 
     @property
     def shown(self) -> bool:
@@ -78,8 +82,14 @@ class Overlay:
         return self.needed or bool(self._visible() and self.snapshot().constraints)
 
     def _visible(self) -> bool:
+        """The surface shows: the sculpt itself, or a shown SculptedSolid it is a face of."""
+        from ..app.sculpted_solid import solid_of
         vobj = getattr(self.obj, "ViewObject", None)
-        return bool(vobj is None or vobj.Visibility)
+        if vobj is None or vobj.Visibility:
+            return True
+        solid = solid_of(self.obj)
+        svobj = getattr(solid, "ViewObject", None) if solid is not None else None
+        return bool(svobj is not None and svobj.Visibility)
 
     def _session(self) -> Any:
         return self.obj.Proxy.live.session
@@ -98,6 +108,7 @@ class Overlay:
             self._timer = None
         self._root.removeAllChildren()
         self.cursor_shown = False
+        self.surface_drawn = False
         if self.hud is not None:
             self.hud.clear()
 
@@ -168,27 +179,31 @@ class Overlay:
         light = coin.SoLightModel()
         light.model = coin.SoLightModel.BASE_COLOR
         legend = None
+        seen = self._visible()
+        display = self.display if seen else "shading"
         glsl = stripe_shading.shaders_work() if self.per_pixel else False
-        if self.display == "zebra" and glsl is None:
+        if display == "zebra" and glsl is None:
             scene.addChild(stripe_shading.probe())  # (per vertex this frame; the answer comes with its render)
         self._lift_by = 2.0 * (face_deflection(self.obj) + mesh_sag(mesh)) + 1e-4 * _size(mesh)
         self._place_lift()
         scene.addChild(self._lift)  # the displays and the jacks lie on the surface: in front of the face
-        if self.display == "zebra" and glsl:
+        if display == "zebra" and glsl:
             scene.addChild(self._stripes(s))
             legend = (self.display, (0.0, 1.0))
-        elif self.display != "shading":
+        elif display != "shading":
             colours, rng = self._colours(s, mesh)
             scene.addChild(shapes.coloured_mesh(mesh, colours, self._cells(mesh.shape[:2], s.mesh_parameters_u,
                                                                            s.mesh_parameters_v)))
             legend = (self.display, rng)
         decor = coin.SoSeparator()
         decor.addChild(light)
-        if self.combs:
+        if self.combs and seen:
             segments, _ = analysis.curvature_combs(mesh, s.curvature_grid().reshape(mesh.shape[:2] + (6,)),
                                                    every=self.comb_every, gain=self.comb_gain)
             decor.addChild(shapes.lines(segments, (1.0, 0.0, 1.0), 1.0))
-        decor.addChild(self._jacks(s, mesh))
+        if seen:
+            decor.addChild(self._jacks(s, mesh))
+        self.surface_drawn = seen and (display != "shading" or (self.combs or bool(s.constraints)))
         self.cursor_shown = self.cursor is not None and self.needed  # (the jacks alone are not redrawn as the mouse moves)
         if self.cursor_shown:
             pickable = coin.SoPickStyle()  # (as it always was: a mouse grab that picks the cursor, not

@@ -65,6 +65,14 @@ class SolidViewProvider(_Stateless):
     def getIcon(self) -> str:
         return icon("HapticSculpt")
 
+    def onChanged(self, vobj: Any, prop: str) -> None:
+        if prop == "Visibility":  # its sculpt's displays lie on its face: they show and hide with it
+            from .workbench import controller
+            ctl = controller()
+            for sculpt in getattr(vobj.Object, "Sculpts", []) if ctl.inputs else []:
+                for ov in ctl.overlays_of(sculpt):
+                    ov.refresh()
+
     def claimChildren(self) -> list[Any]:
         obj = self.Object
         return [o for o in [getattr(obj, "Base", None), *getattr(obj, "Sculpts", [])] if o is not None]

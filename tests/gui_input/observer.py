@@ -33,8 +33,20 @@ def _sculpts(doc):
                     "session": o.Proxy.live.session is not None if getattr(o.Proxy, "live", None) else False,
                     "device": o.Proxy.live.session.device_name
                     if getattr(o.Proxy, "live", None) and o.Proxy.live.session else "",
-                    "selected": o in Gui.Selection.getSelection(), "screen": _on_screen(o), "digest": digest(o)})
+                    "selected": o in Gui.Selection.getSelection(), "screen": _on_screen(o), "digest": digest(o),
+                    "drawn_poles": _drawn_poles(o)})
     return out
+
+
+def _drawn_poles(o):
+    """The poles the overlays draw the sculpt from (its live surface's newest state), as a flat list."""
+    live = getattr(getattr(o, "Proxy", None), "live", None)
+    if live is None:
+        return []
+    try:
+        return [float(x) for x in __import__("numpy").asarray(live.snapshot().poles).ravel()]
+    except Exception:  # noqa: BLE001 - a stored state being read
+        return []
 
 
 def _solids(doc):
@@ -264,7 +276,8 @@ def write(*_):
              "active": FreeCAD.ActiveDocument.Name if FreeCAD.ActiveDocument else None, "docs": {}, "views": _views(),
              "task_dialog": bool(Gui.Control.activeDialog()), "tree": _tree_items(),
              "task_buttons": _task_buttons(), "toolbars": _toolbars(), "console": _widget_rect("Gui::PythonConsole"),
-             "focus": _focus()}
+             "focus": _focus(), "selection": [[o.ObjectName, list(o.SubElementNames)]
+                                              for o in Gui.Selection.getSelectionEx()]}
     for name, doc in FreeCAD.listDocuments().items():
         state["docs"][name] = {"undo": list(doc.UndoNames), "redo": list(doc.RedoNames), "file": doc.FileName,
                                "modified": bool(getattr(doc, "isTouched", lambda: False)()),
@@ -283,6 +296,7 @@ def write(*_):
                               "sliders": ov.panel.values(ov.obj) if ov.panel_visible else [],
                               "stripes": ov.stripes, "active_view": ov.view is getattr(Gui.ActiveDocument, "ActiveView", None),
                               "view": id(ov.view), "object": ov.obj.Name, "cursor": ov.cursor_shown,
+                              "surface_drawn": ov.surface_drawn,
                               "drawn": ov._root.getNumChildren() > 0}
                              for ov in ctl.overlays.values()]
     except Exception as exc:  # noqa: BLE001 - the workbench not loaded yet
