@@ -128,12 +128,15 @@ class SculptFace:
                 f"HapticSculpt: {obj.Label}: {', '.join(faces)} of {base.Label} sculpted in place, edges held G0"
                 + (f", mirrored in {plane.Label}" if plane is not None else "")
                 + (f", seams {', '.join(seams)}" if seams else "") + "\n")
+            # The picked faces are gone with the base, hidden under the new solid: nothing stays
+            # selected (as after FreeCAD's own features); the commands take the sculpt under the
+            # mouse, else the document's only one.
             Gui.Selection.clearSelection()
-            Gui.Selection.addSelection(obj)
             return
         run_echoed(f"HapticSculpt.make_sculpt(App.getDocument({doc.Name!r}), source=({ref(base)}, {faces[0]!r}), "
                    "material='clay')")
         obj = doc.Objects[-1]
+        Gui.Selection.clearSelection()
         FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label} from {obj.SourceDescription}, "
                                      f"{obj.ConversionMethod}, error {obj.ConversionError:.3g} mm\n")
 
