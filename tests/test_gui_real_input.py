@@ -341,7 +341,9 @@ def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
     """Every command and key echoes its scripting call (FreeCADGui.doCommand): FreeCAD's own macro
     recorder, started from its menu with real keys, records a session that freecadcmd replays, with
     the saved document (which keeps the strokes) open, to the bit-identical sculpt state. A stroke
-    is one short replay_stroke line; a session without a stroke echoes nothing."""
+    is one short replay_stroke line; a session without a stroke echoes nothing. Edits during the
+    session (N, Material while the elastic patch still springs back) replay too, and Stop adds no
+    undo step of its own."""
     d = Desktop(str(tmp_path), "CAD")
     try:
         d.xdo("key", "alt+m")  # Macro > Macro recording...
@@ -368,8 +370,18 @@ def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
         d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
         d.drag([south] + [(south[0], south[1] - 10 * k) for k in range(1, 12)], seconds=0.6)
         d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the session's stroke")
+        # edits while the elastic patch springs back: N at the mouse, the material switched
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.wait(lambda s: s["mouse_point"] is not None, "the mouse over the patch")
+        d.xdo("key", "n")
+        d.wait(lambda s: undo(s)[0] == "Add normal constraint", "N during the session")
+        d.press_button("Material", lambda s: undo(s)[0] == "Material: clay", "Material: clay during the session")
+        d.drag([south] + [(south[0], south[1] - 8 * k) for k in range(1, 10)], seconds=0.5)
+        d.wait(lambda s: sculpt(s)["strokes"] == 2, "the session's second stroke")
+        steps = len(undo(d.state()))
         s = d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
-        assert sculpt(s)["strokes"] == 1
+        assert sculpt(s)["strokes"] == 2
+        assert len(undo(s)) == steps and "Sculpt session end" not in undo(s), undo(s)[:6]  # (Stop: no step)
         d.shot("stroke_echo")  # (the Python console: one replay_stroke line a commit)
         gui_digest = sculpt(s)["digest"]
         d.xdo("mousemove", "640", "500")
@@ -393,8 +405,10 @@ def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
         assert f"HapticSculpt.{call}(" in text, text
     # one short line a stroke or paint stroke (a paint call whose path makes it long: a replay_stroke
     # line too); none for the quiet session
+    # (and the two edits made during the session: each has its own call and a replay_stroke line
+    # taking the macro from what that call does on the document to what the session committed)
     strokes = [line for line in text.splitlines() if "replay_stroke" in line]
-    assert len(strokes) + text.count("HapticSculpt.paint(") == len(commits), (commits, text)
+    assert len(strokes) + text.count("HapticSculpt.paint(") == len(commits) + 2, (commits, text)
     assert all(len(line) <= 200 for line in text.splitlines() if "HapticSculpt." in line), text
     out = run_freecadcmd(f"""
         import sys
@@ -592,5 +606,40 @@ def test_a_second_view_of_the_same_document_takes_keys_and_strokes_and_closes_cl
         time.sleep(0.3)
         d.xdo("key", "m")
         d.wait(lambda s: all(o["display"] == "shading" for o in s["overlays"]), "M in the first view after the close")
+    finally:
+        d.close()
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_stop_right_after_a_stroke_on_an_elastic_patch_keeps_what_was_shown_in_the_stroke_step(tmp_path):
+    """New patch, Elastic, a session with zebra stripes on, one stroke, Stop as soon as the stroke is
+    committed (the patch still springs back): Stop adds no undo step, and the face, the stored
+    state and what the overlay draws are one surface, the one the session ended with."""
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        d.xdo("mousemove", "640", "500")
+        d.xdo("key", "ctrl+n")
+        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view")
+        d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        d.press_button("Material", lambda s: undo(s)[0] == "Material: elastic", "Material: elastic")
+        d.press_button("Zebra", lambda s: any(o["display"] == "zebra" for o in s["overlays"]), "the zebra stripes")
+        s = d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
+        d.calibrate()
+        south = d.to_screen(sculpt(s)["screen"][4])
+        d.drag([south] + [(south[0], south[1] - 10 * k) for k in range(1, 16)], seconds=0.8)
+        s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke's undo step")
+        released = np.array(sculpt(s)["poles"])
+        d.click_button("Session")
+        s = d.wait(lambda s: not sculpt(s)["session"], "the session to stop")
+        assert undo(s) == ["Sculpt stroke", "Material: elastic", "Create sculpt"], undo(s)
+        kept = np.array(sculpt(s)["poles"]).reshape(-1, 3)
+        assert np.abs(kept[:, 2]).max() > 3.0, "the rope did not pull"
+        assert np.abs(np.array(sculpt(s)["shape_poles"]) - kept).max() == 0.0, "the face is not the stored surface"
+        assert np.abs(np.array(sculpt(s)["drawn_poles"]).reshape(-1, 3) - kept).max() == 0.0, \
+            "the overlay draws another surface than the face"
+        print("moved after the stroke's commit:", np.abs(kept.ravel() - released).max(), "mm")
+        frames = sum(o["frames"] for o in s["overlays"])
+        d.wait(lambda s: sum(o["frames"] for o in s["overlays"]) > frames + 5, "frames drawn after the stop")
+        d.shot("elastic_stop")  # (the stripes on the face: no part of the face shows through them)
     finally:
         d.close()
