@@ -193,10 +193,12 @@ class TestEditsDuringASession(DocumentTestCase):
         self.assertEqual(surface.tool.name, "magnet")
         self.assertIn(cid, [c["id"] for c in surface.constraints])
         self.assertGreater(float(np.max(surface.stiffness_map.values)), 150.0)
-        # the rendered force never dropped out over the material, constraint, paint and keep-shape edits:
+        # the rope's force never dropped out over the material, constraint, paint and keep-shape edits:
         # no step down where one applied (the stiffer material and the kept shape ease the pull
-        # over the following second, as the surface follows the rope)
-        t, force = session.rendered_forces()
+        # over the following second, as the surface follows the rope). Measured before the safety
+        # layer: on a loaded machine the simulation thread can fall 20 ms behind, and the safety
+        # layer then fades the force on purpose (native_core/tests/test_runtime.cpp covers that): no edit's doing.
+        t, force = session.rendered_forces(before_safety=True)
         magnitude = np.linalg.norm(force, axis=1)
         held = magnitude[(t > t_first - 0.2) & (t < t_first)].mean()
         self.assertGreater(magnitude[(t >= t_first) & (t <= t_last)].min(), 0.2 * held)

@@ -269,14 +269,16 @@ class Session:
             raise RuntimeError("session: nothing recorded (start it with record_seconds > 0)")
         return ReplayDevice(ticks["t"], ticks["position"], ticks["orientation"], ticks["buttons"].astype(np.int64))
 
-    def rendered_forces(self) -> tuple[np.ndarray, np.ndarray]:
+    def rendered_forces(self, before_safety: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Each logged haptic tick's time (s since the start) and the force sent to the device
-        ((n, 3)); needs ``record_seconds``."""
+        ((n, 3)); needs ``record_seconds``. With ``before_safety``, the estimate's force before the
+        safety layer, which fades the force while the simulation has fallen behind (a loaded
+        machine) and clamps it to the device's limits."""
         runtime = self._runtime or getattr(self, "_last_runtime", None)
         if runtime is None or runtime.running:
             raise RuntimeError("session: stop it before analysing it")
         ticks = runtime.ticks()
-        return np.asarray(ticks["t"]), np.asarray(ticks["rendered_force"])
+        return np.asarray(ticks["t"]), np.asarray(ticks["estimated_force" if before_safety else "rendered_force"])
 
     def force_errors(self, floor: float = 0.05) -> np.ndarray:
         """Relative error of each logged haptic force against the exact surface (see the core)."""
