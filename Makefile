@@ -5,7 +5,8 @@ BUILD       := build
 JOBS        ?= 2
 APT_PACKAGES := build-essential cmake ninja-build pkg-config libeigen3-dev pybind11-dev libgtest-dev \
                 python3-dev python3-numpy python3-scipy python3-pytest python3-hypothesis python3-matplotlib \
-                python3-venv freecad-python3 freecad libhidapi-dev libusb-1.0-0 libwebsockets-dev libsimdjson-dev python3-websockets xvfb xauth xdotool imagemagick debootstrap
+                python3-venv freecad-python3 freecad libhidapi-dev libusb-1.0-0 libwebsockets-dev libsimdjson-dev python3-websockets xvfb xauth xdotool imagemagick debootstrap \
+                ccache
 SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
@@ -13,6 +14,19 @@ PHONY_LONG := stress fuzz bench-peers
 .PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-gui-repeat test-cpp test-asan test-python \
         test-gui test-freecad test-addon wheel ocp-venv demo bench install install-udev install-realtime uninstall clean test-other-debian \
         test-gui-repeat-other-debian
+# A compiler cache outside the checkout, as the Debian roots are: a clean clone then compiles only
+# what changed since the last build on this machine (in a root, the cache lives in the root). Paths
+# are taken relative to the checkout and the build folder is not hashed, so that clones in other
+# folders and the wheel's build share it. CMake (3.17+) reads the launcher from the environment.
+# (On a fresh machine make deps installs it: from the next make on.)
+CCACHE := $(shell command -v ccache)
+ifneq ($(CCACHE),)
+export CCACHE_DIR ?= $(HOME)/.cache/hapticsculpt/ccache
+export CCACHE_BASEDIR := $(CURDIR)
+export CCACHE_NOHASHDIR := 1
+export CMAKE_CXX_COMPILER_LAUNCHER := $(CCACHE)
+export CMAKE_C_COMPILER_LAUNCHER := $(CCACHE)
+endif
 # The fake vendor libraries (libusb with an emulated Falcon, OpenHaptics, DHD) the device tests
 # load instead of the system's: built with the C++ tests.
 export HS_FAKE_VENDOR := $(CURDIR)/$(BUILD)/release/fake_vendor
