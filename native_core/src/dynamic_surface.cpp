@@ -303,7 +303,9 @@ void DynamicSurface::setCursor(const Cursor& c) {
     } else if (!n.grab && tool_->grabbed()) {
         tool_->release();
         // Clay keeps what it is given: the stroke's shape becomes what bending measures from.
-        if (springs_.plasticity.enabled) bending_.setReference(d_);
+        // (follow, not setReference: the state is the core's own, finite by its guards, and may lie
+        // past the +-1e9 a caller's reference is held to after extreme forces)
+        if (springs_.plasticity.enabled) bending_.follow(d_, 1.0);
         history_.valid = false;
         touch();
     }
