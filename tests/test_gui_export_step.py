@@ -112,6 +112,13 @@ try:
     Gui.Selection.addSelection(box)  # (any part selected goes: a thickened sculpt is a plain Part feature)
     res["part"] = [o.Name for o in export_panel.exportable(Gui.Selection.getSelection(), doc)]
     Gui.Selection.clearSelection()
+    thick_doc = FreeCAD.newDocument("Thick")  # a patch thickened: the solid the user sees, not its hidden face
+    thick = hs.make_thickness(hs.make_sculpt(thick_doc), 3.0)
+    thick_doc.recompute()
+    res["thickened"] = [o.Name for o in export_panel.exportable([], thick_doc)]
+    res["thickness"] = thick.Name
+    FreeCAD.closeDocument(thick_doc.Name)
+    FreeCAD.setActiveDocument(doc.Name)
     doc.saveAs(os.path.join(TMP, "parts.FCStd"))
     panel = export_panel.ExportStepPanel([solid])
     res["default"] = panel.path()
@@ -157,6 +164,7 @@ def test_export_step_chooses_the_only_sculpted_solid_and_refuses_a_bad_file_name
     assert out["two"] == [] and not out["active_two"]  # two candidates and none selected: which one?
     assert out["selected"] == [out["patch"]] and out["active_selected"]
     assert out["part"] == ["Box"]
+    assert out["thickened"] == [out["thickness"]]
     assert out["default"] == str(tmp_path / "SculptedSolid.step")  # (the saved document's folder, its label)
     assert out["refused"] is False  # (said in the report view; the panel stays open)
     assert out["accepted"] is True and out["written"] == str(tmp_path / "part.step")

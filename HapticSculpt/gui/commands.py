@@ -176,13 +176,13 @@ class Thicken:
 
 
 class ExportStep:
-    """Export the selection, else the document's only sculpt or sculpted solid, to a STEP file
+    """Export the selection, else the one visible result built on a sculpt, to a STEP file
     named in a task panel (FreeCAD's file chooser, STEP preselected)."""
 
     def GetResources(self) -> dict[str, str]:
         return {"Pixmap": icon("ExportStep"), "MenuText": "Export STEP",
-                "ToolTip": "Export the selected objects (else the document's only sculpt or sculpted solid) "
-                           "to a STEP file"}
+                "ToolTip": "Export the selected objects to a STEP file; with nothing selected, what you see of "
+                           "your sculpting (the thickened solid, the sculpted solid, or the sculpt)"}
 
     def IsActive(self) -> bool:
         from .export_panel import exportable

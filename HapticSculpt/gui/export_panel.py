@@ -16,14 +16,27 @@ _OK, _CANCEL = 0x00000400, 0x00400000  # QDialogButtonBox's Ok and Cancel (no Qt
 
 def exportable(selection: list[Any], doc: Any) -> list[Any]:
     """What to export: the selected objects that have a shape (a sculpt, a sculpted solid, a
-    thickened solid, any part), else the document's only sculpt or sculpted solid (a SculptedSolid's
-    own hidden sculpt does not count); empty if there is no such choice."""
+    thickened solid, any part); else what the user sees of their sculpting, when that is one
+    object: the visible end result built on a sculpt (the Thickness made from it, the Cut or
+    Body made from a sculpted solid, else the sculpt or the sculpted solid itself); else the
+    document's only sculpt or sculpted solid (a SculptedSolid's own hidden sculpt does not count);
+    empty if there is no such choice."""
     from ..app.sculpt_feature import is_sculpt
     from ..app.sculpted_solid import is_sculpted_solid, solid_of
 
     picked = [o for o in selection if hasattr(o, "Shape") and not o.Shape.isNull()]
     if picked or doc is None:
         return picked
+
+    def sculpted(o: Any) -> bool:
+        return is_sculpt(o) or is_sculpted_solid(o)
+
+    results = [o for o in doc.Objects
+               if getattr(o, "Visibility", False) and hasattr(o, "Shape") and not o.Shape.isNull()
+               and (sculpted(o) or any(sculpted(x) for x in o.OutListRecursive))
+               and not any(hasattr(user, "Shape") for user in o.InList)]
+    if len(results) == 1:
+        return results
     found = [o for o in doc.Objects if is_sculpted_solid(o) or (is_sculpt(o) and solid_of(o) is None)]
     return found if len(found) == 1 else []
 
