@@ -155,6 +155,12 @@ class TestEditsDuringASession(DocumentTestCase):
 
     def test_slider_constraint_paint_and_tool_apply_within_two_steps_and_keep_the_force(self):
         obj = hs.make_sculpt(self.doc, material="clay")
+        # Springs alone, as when this was written: it checks the edit queue (each edit taken up
+        # between two steps, the force carried over). With the default plate the held rope's
+        # force rings after the point constraint, paint and keep-shape edits (measured: 20 -> 28
+        # -> 19 within 20 ms after the constraint, 43 -> 229 -> 98 after keep shape), which the
+        # 10 % continuity check below cannot tell from a drop-out: an open issue (issue 26).
+        hs.set_uniform(obj, "bending", 0.0)
         live = obj.Proxy.live
         hold = hs.ReplayDevice.stroke((0, 0, 0), (0, 0, 20.0), seconds=0.5, hold=30.0)
         session = hs.Session().start(obj, hold, record_seconds=20.0)
