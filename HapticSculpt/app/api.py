@@ -279,8 +279,8 @@ def set_tool(obj: Any, tool: str, falloff: str | None = None) -> None:
 def set_uniform(obj: Any, map: str, value: float) -> None:
     """Sets material map ``map`` ("mass", "damping", "stiffness", "bending") to ``value`` everywhere
     (the slider panel's edit; damping and bending may be 0: off; bending is a ratio to the
-    stiffness, FAIR_BENDING for fair strokes). One undo step; a running session
-    takes it at once."""
+    stiffness, FAIR_BENDING for fair strokes: every new sculpt's). One undo step; a running
+    session takes it at once."""
     obj = _sculpt(obj, solids=True)
     sculpt_state.map_property(map)  # validates the name
     off = map in ("damping", "bending")
