@@ -36,9 +36,10 @@ interrupted (Ctrl-C writes what is done). ``--scenes rope,two_faces`` runs only 
 replaces their records in the JSON (every scene's solvers are compared within one run).
 
 ``--fairness`` runs only the fair-stroke measure (issue 26): curvature sign changes and total
-variation along sections of a rope stroke, free and pinned, clay and elastic, with and without the
-bending energy, and the per-step time of each integrator with and without it
-(bench/results/fairness.json; see fairness_table).
+variation along sections of a rope stroke (exact derivatives), free and pinned, clay and elastic,
+today's springs alone beside the default bending, and the per-step time of each integrator on each
+scene, today's and new, with the default's lead in both (bench/results/fairness.json; see
+fairness_table).
 """
 from __future__ import annotations
 
@@ -292,49 +293,108 @@ def plot(records: list[dict], path: str) -> None:
     fig.savefig(path, dpi=110)
 
 
-def fairness_table(out_dir: str) -> None:
+FAIRNESS_SOLVERS = [("explicit", "explicit", {}), ("implicit (5 CG)", "implicit", {"cg_iterations": 5}),
+                    ("local_global (default)", "local_global", {})]
+
+
+def fairness_table(out_dir: str, repeats: int = 3) -> None:
     """Issue 26's fair strokes: the rope scene of tests/fairness_scene.py (a flat 100 mm patch
     whose centre the rope pulls up 20 mm and holds for 4 s), free and corners pinned, elastic and
-    clay, with today's springs alone (bending 0) and with the default bending weight: curvature
-    sign changes and total variation along the central sections (and the diagonals when pinned),
-    the lift, and the wall time per step of each integrator on that scene at a session's 1 ms."""
+    clay, today's material (springs alone, bending 0) beside the new default (api.FAIR_BENDING):
+    the exact normal curvature of the core's B-spline along the central sections (and the
+    diagonals when pinned; HapticSculpt/app/fairness.py): sign changes, total variation over the
+    largest |curvature| (the issue's measure) and total variation itself (1/m; the shapes have the
+    same lift), the lift; then the wall time per step of each integrator on each scene at a
+    session's 1 ms, today's and new, median of ``repeats`` pulls, and the default's lead (the
+    paper's schemes' time over the default's)."""
     import fairness_scene as fs
+    from HapticSculpt.app import fairness
     from HapticSculpt.app.api import FAIR_BENDING as default
-    rows = []
-    print(f"\nfairness (default bending {default:g}; sign changes per section, variation = sum of "
-          "total variation / largest |curvature|)")
-    print(f"{'scene':<16}{'bending':>8}{'lift mm':>9}{'signs':>7}{'worst':>7}{'variation':>11}")
-    for material in ("elastic", "clay"):
-        for pinned in (False, True):
-            for bending in (0.0, default):
-                s = fs.build(material, pinned, bending)
-                report = fs.pull(s)
-                m = fs.measure(s, pinned)
-                rows.append({"material": material, "pinned": pinned, "bending": bending, "lift": report["lift"],
-                             "sign_changes": m.sign_changes, "worst_section": max(c for c, _ in m.per_section),
-                             "variation": m.variation})
-                r = rows[-1]
-                print(f"{material + (' pinned' if pinned else ' free'):<16}{bending:>8g}{r['lift']:>9.2f}"
-                      f"{r['sign_changes']:>7}{r['worst_section']:>7}{r['variation']:>11.1f}")
-    before = sum(r["variation"] for r in rows if r["bending"] == 0)
-    after = sum(r["variation"] for r in rows if r["bending"] != 0)
-    print(f"variation over the four scenes: {before:.1f} -> {after:.1f} ({100 * (1 - after / before):.0f} % less)")
-    timing = []
-    print(f"\nper-step wall time on the pinned elastic rope scene, dt 1 ms (median of 3 pulls)")
-    print(f"{'solver':<22}{'bending 0 us':>14}{'bending on us':>15}")
-    for label, integ, settings in [("explicit", "explicit", {}), ("implicit (5 CG)", "implicit", {"cg_iterations": 5}),
-                                   ("local_global (default)", "local_global", {})]:
-        cells = {}
+    rows, profiles = [], {}
+    print(f"\nfairness: today (bending 0) against the default bending {default:g}; exact normal curvature "
+          "along the sections; 'worst' = most sign changes on one section; variation = sum over the sections "
+          "of total variation / largest |curvature|; TV 1/m = sum of total variation")
+    print(f"{'scene':<16}{'bending':>8}{'lift mm':>9}{'signs':>7}{'worst':>7}{'variation':>11}{'TV 1/m':>9}")
+    scenes = [(material, pinned) for material in ("elastic", "clay") for pinned in (False, True)]
+    for material, pinned in scenes:
         for bending in (0.0, default):
-            runs = []
-            for _ in range(3):
-                s = configure(fs.build("elastic", True, bending), integ, settings)
-                runs.append(fs.pull(s, hold=1.0)["step_seconds"])
-            cells[bending] = float(np.median(runs))
-        timing.append({"solver": label, "off": cells[0.0], "on": cells[default]})
-        print(f"{label:<22}{1e6 * cells[0.0]:>14.0f}{1e6 * cells[default]:>15.0f}")
+            s = fs.build(material, pinned, bending)
+            report = fs.pull(s)
+            m = fs.measure(s, pinned)
+            sections = fs.sections(s, pinned)
+            profiles[material, pinned, bending] = [fairness.section_curvature(fairness.core_derivatives(s.surface),
+                                                                             sections[k]) for k in (2, 6 if pinned else 3)]
+            rows.append({"material": material, "pinned": pinned, "bending": bending, "lift": report["lift"],
+                         "sign_changes": m.sign_changes, "worst_section": max(c for c, _ in m.per_section),
+                         "variation": m.variation, "absolute_variation_per_m": 1000 * m.absolute_variation})
+            r = rows[-1]
+            print(f"{material + (' pinned' if pinned else ' free'):<16}{bending:>8g}{r['lift']:>9.2f}"
+                  f"{r['sign_changes']:>7}{r['worst_section']:>7}{r['variation']:>11.1f}"
+                  f"{r['absolute_variation_per_m']:>9.1f}")
+    for key, name in (("variation", "variation (over the largest |curvature|)"),
+                      ("absolute_variation_per_m", "total variation (1/m)")):
+        print(f"{name}, new against today:")
+        for material, pinned in scenes:
+            before, after = (next(r[key] for r in rows if (r["material"], r["pinned"], r["bending"]) ==
+                                  (material, pinned, b)) for b in (0.0, default))
+            print(f"  {material + (' pinned' if pinned else ' free'):<16}{before:9.1f} -> {after:9.1f}"
+                  + (f"  ({100 * (after / before - 1):+.0f} %)" if before else ""))
+        before = sum(r[key] for r in rows if r["bending"] == 0)
+        after = sum(r[key] for r in rows if r["bending"] != 0)
+        print(f"  {'all four':<16}{before:9.1f} -> {after:9.1f}  ({100 * (after / before - 1):+.0f} %)")
+    timing = []
+    print(f"\nper-step wall time (us), dt 1 ms, median of {repeats} pulls (held 1 s), today -> new; "
+          "lead = the scheme's time / the default's")
+    print(f"{'scene':<16}{'solver':<24}{'today':>8}{'new':>8}{'new/today':>10}{'lead today':>11}{'lead new':>9}")
+    for material, pinned in scenes:
+        cells: dict = {}
+        for label, integ, settings in FAIRNESS_SOLVERS:
+            for bending in (0.0, default):
+                runs = [fs.pull(configure(fs.build(material, pinned, bending), integ, settings), hold=1.0)["step_seconds"]
+                        for _ in range(repeats)]
+                cells[label, bending] = float(np.median(runs))
+        ours = FAIRNESS_SOLVERS[-1][0]
+        for label, _, _ in FAIRNESS_SOLVERS:
+            t0, t1 = cells[label, 0.0], cells[label, default]
+            lead0, lead1 = t0 / cells[ours, 0.0], t1 / cells[ours, default]
+            timing.append({"material": material, "pinned": pinned, "solver": label, "today": t0, "new": t1,
+                           "lead_today": lead0, "lead_new": lead1})
+            print(f"{material + (' pinned' if pinned else ' free'):<16}{label:<24}{1e6 * t0:>8.0f}{1e6 * t1:>8.0f}"
+                  f"{t1 / t0:>10.2f}{lead0:>11.2f}{lead1:>9.2f}")
+    for label, _, _ in FAIRNESS_SOLVERS[:-1]:
+        leads = [(t["lead_today"], t["lead_new"]) for t in timing if t["solver"] == label]
+        print(f"default's lead over {label}: median {np.median([a for a, _ in leads]):.2f}x today, "
+              f"{np.median([b for _, b in leads]):.2f}x new")
     with open(os.path.join(out_dir, "fairness.json"), "w") as f:
-        json.dump({"default_bending": default, "scenes": rows, "step_seconds": timing}, f, indent=1)
+        json.dump({"default_bending": default, "measure": "exact normal curvature (core B-spline derivatives)",
+                   "scenes": rows, "step_seconds": timing}, f, indent=1)
+    plot_fairness(profiles, default, os.path.join(out_dir, "fairness.png"))
+
+
+def plot_fairness(profiles: dict, default: float, path: str) -> None:
+    """The normal curvature along the central section (and a diagonal when pinned) of each scene,
+    today's against the new default's."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(2, 4, figsize=(15, 6), sharex=True)
+    scenes = sorted({(m, p) for m, p, _ in profiles})
+    for col, (material, pinned) in enumerate(scenes):
+        for row in range(2):
+            ax = axes[row, col]
+            for bending, style in ((0.0, "r-"), (default, "b-")):
+                k = profiles[material, pinned, bending][row]
+                ax.plot(np.linspace(0, 1, len(k)), 1000 * k, style, label=f"bending {bending:g}")
+            ax.axhline(0, color="0.6", lw=0.5)
+            what = "central section" if row == 0 else ("diagonal" if pinned else "central section along v")
+            ax.set_title(f"{material} {'pinned' if pinned else 'free'}: {what}", fontsize=9)
+            if col == 0:
+                ax.set_ylabel("normal curvature (1/m)")
+            if row == 1:
+                ax.set_xlabel("along the section")
+    axes[0, 0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
 
 
 def main() -> None:

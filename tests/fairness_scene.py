@@ -17,6 +17,7 @@ HOLD = 4.0    # s the rope holds it there
 RISE = 10.0   # mm/s the cursor rises
 DT = 1e-3     # a session's default step
 CENTRE = (20, 20)
+FLAT = 1 / (1000 * 100.0)  # 1/mm: a curvature radius of 100 m (1000 patch sizes) is flat
 
 
 def build(material: str, pinned: bool, bending: float = api.FAIR_BENDING) -> core.DynamicSurface:
@@ -59,8 +60,14 @@ def pull(s: core.DynamicSurface, lift: float = LIFT, hold: float = HOLD, max_tim
             "step_seconds": wall / steps}
 
 
-def measure(s: core.DynamicSurface, pinned: bool) -> fairness.Fairness:
-    """The six central sections (and with held corners the two diagonals, where a crease to a
-    corner would run)."""
+def sections(s: core.DynamicSurface, pinned: bool) -> list[fairness.Section]:
+    """The six central sections through and beside the pulled point (two mesh lines apart), and
+    with held corners the two diagonals, where a crease to a corner would run."""
     g, h = s.mesh_shape
-    return fairness.measure(np.array(s.mesh), fairness.central_sections(g, h, CENTRE, diagonals=pinned))
+    centre = (CENTRE[0] / (g - 1), CENTRE[1] / (h - 1))
+    return fairness.central_sections(centre, spread=2 / (g - 1), diagonals=pinned, domain=s.surface.domain)
+
+
+def measure(s: core.DynamicSurface, pinned: bool) -> fairness.Fairness:
+    """The exact normal curvature of the core's B-spline along ``sections``."""
+    return fairness.measure(fairness.core_derivatives(s.surface), sections(s, pinned), flat=FLAT)

@@ -192,8 +192,13 @@ def test_tangent_constraint_holds_plane():
 @pytest.mark.parametrize("integrator", ["local_global", "implicit", "explicit"])
 @pytest.mark.parametrize("start", ["flat", "bowl"])
 @pytest.mark.parametrize("target", [0.02, 0.05, 0.0])
-def test_curvature_constraint_reaches_target(integrator, start, target):
+@pytest.mark.parametrize("bending", [0.0, 10.0], ids=["springs", "plate"])
+def test_curvature_constraint_reaches_target(integrator, start, target, bending):
+    """Also against a plate (bending ratio 10, the sculpts' default): the constraint's penalty
+    grows with the bending ratio at its point, so the plate does not hold it off the target (with
+    the springs' penalty alone it met 61 % of it)."""
     ds = core.patch((10, 10), (3, 3), (21, 21))
+    ds.bending_map.set_uniform(bending)
     if start == "bowl":
         p = ds.poles.copy()
         p[..., 2] += 0.002 * (p[..., 0] ** 2 + p[..., 1] ** 2)

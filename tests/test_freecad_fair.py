@@ -11,6 +11,7 @@ from freecad_support import DocumentTestCase
 from test_freecad_layer import stroke
 
 import HapticSculpt as hs
+from HapticSculpt.app.api import FAIR_BENDING
 
 
 def curvature_variation(obj) -> float:
@@ -111,3 +112,32 @@ class TestFair(DocumentTestCase):
         again = self.doc.getObject(name).Proxy.live.snapshot()
         self.assertEqual(again.bending_map.values[0], 250.0)
         np.testing.assert_array_equal(again.bending_reference, reference)
+
+
+class TestFairByDefault(DocumentTestCase):
+    """Bending is on by default (issue 26): a new sculpt's bending map is FAIR_BENDING, and a rope
+    stroke leaves a surface whose written Part.BSplineSurface is fair by its exact derivatives."""
+
+    def test_new_sculpts_bend_by_default(self):
+        for kwargs in ({}, {"material": "clay"}, {"edges": "held"}):
+            obj = hs.make_sculpt(self.doc, **kwargs)
+            np.testing.assert_array_equal(obj.BendingMap, [FAIR_BENDING])
+        hs.set_uniform(obj, "bending", 0.0)  # still a map like the others: springs alone
+        self.assertEqual(list(obj.BendingMap), [0.0])
+
+    def test_a_stroke_on_a_held_sheet_is_fair_on_the_written_surface(self):
+        from HapticSculpt.app import fairness
+        obj = hs.make_sculpt(self.doc, material="clay", edges="held")
+        stroke(obj)
+        face = obj.Shape.Faces[0].Surface
+        sections = fairness.central_sections((0.5, 0.5), diagonals=True)
+        written = fairness.measure(fairness.part_derivatives(face), sections, flat=1e-5)
+        core_surface = obj.Proxy.live.snapshot().surface
+        ours = fairness.measure(fairness.core_derivatives(core_surface), sections, flat=1e-5)
+        # The document's surface has the core's poles: the same curvature, exactly derived.
+        for s in sections[:2]:
+            np.testing.assert_allclose(fairness.section_curvature(fairness.part_derivatives(face), s),
+                                       fairness.section_curvature(fairness.core_derivatives(core_surface), s),
+                                       rtol=1e-7, atol=1e-12)
+        self.assertEqual(written.sign_changes, ours.sign_changes)
+        self.assertLessEqual(max(c for c, _ in written.per_section), 2, written.per_section)

@@ -122,8 +122,13 @@ class TestHeldEdgesInSessions(DocumentTestCase):
         self.assertTrue(np.array_equal(poles[0], rows[0]))  # held before the session: never moved
         self.assertGreater(np.abs(poles[3:5] - rows[3:5]).max(), 0.5)  # the rope pulled the inside
         self.assertEqual(hs.held_boundary(obj), {"u0": "G0", "u1": "G1", "v0": "free", "v1": "free"})
-        # the hold made during the session stays: another stroke moves the inside, not the u1 rows
-        again = hs.ReplayDevice.stroke((-10.0, 0.0, 0.0), (-10.0, 0.0, 15.0), seconds=0.5, hold=0.3)
+        # the hold made during the session stays: another stroke moves the inside, not the u1 rows.
+        # It starts where the surface is: the plate (bending on by default) lifted the first bump
+        # broadly, so (-10, 0) already stands about 12.5 mm up (8.3 with springs alone) and a
+        # stroke from z = 0 to 15, as this test made when it was written, moved it 0.1 mm.
+        mesh = np.array(obj.Proxy.surface.mesh).reshape(-1, 3)
+        z = float(mesh[np.argmin(np.linalg.norm(mesh[:, :2] - (-10.0, 0.0), axis=1)), 2])
+        again = hs.ReplayDevice.stroke((-10.0, 0.0, z), (-10.0, 0.0, z + 15.0), seconds=0.5, hold=0.3)
         hs.Session().start(obj, again, stop_when_finished=True).wait(timeout=30)
         after = np.array(obj.Proxy.surface.poles)
         self.assertTrue(np.array_equal(after[-2:], poles[-2:]))

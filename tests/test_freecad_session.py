@@ -153,6 +153,31 @@ class TestSession(DocumentTestCase):
 class TestEditsDuringASession(DocumentTestCase):
     """Edits reach a running session through its edit queue: no stop, no restart, the rope held."""
 
+    def test_a_constraint_added_mid_stroke_targets_the_shape_now(self):
+        """In console mode no GUI takes the session's pole snapshots; the edit's copy still reads
+        the newest shape, so a point constraint's default target is where the point is now (it
+        was the document's shape from before the stroke: on the lifted plate the corner was
+        yanked down 16 mm and the held rope's force rang)."""
+        obj = hs.make_sculpt(self.doc, material="clay")  # the plate lifts as a whole, corners too
+        hold = hs.ReplayDevice.stroke((0, 0, 0), (0, 0, 20.0), seconds=0.5, hold=30.0)
+        session = hs.Session().start(obj, hold)
+        try:
+            end = time.monotonic() + 20
+            while session.status()["elapsed"] < 1.0:
+                self.assertLess(time.monotonic(), end, "the session never ran")
+                time.sleep(0.01)
+            cid = hs.add_constraint(obj, "point", uv=(0.0, 0.0))
+            while not session.applied_edits:
+                self.assertLess(time.monotonic(), end, "the edit never applied")
+                session.poll()
+                time.sleep(0.01)
+            corner = np.array(session.newest_poles()).reshape(8, 8, 3)[0, 0]
+        finally:
+            session.stop()
+        target = next(c["target"] for c in obj.Proxy.surface.constraints if c["id"] == cid)
+        self.assertGreater(target[2], 5.0)  # lifted with the sheet, not the flat sheet's 0
+        self.assertLess(np.linalg.norm(np.array(target) - corner), 2.0)
+
     def test_slider_constraint_paint_and_tool_apply_within_two_steps_and_keep_the_force(self):
         obj = hs.make_sculpt(self.doc, material="clay")
         live = obj.Proxy.live

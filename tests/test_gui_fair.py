@@ -73,3 +73,43 @@ def test_fair_command_is_one_undo_step_shown_at_once(tmp_path):
     import matplotlib.image as mpimg
     a, b = mpimg.imread(before)[..., :3], mpimg.imread(after)[..., :3]
     assert np.abs(a - b).max() > 0.2, "the picture did not change"
+
+
+NEW_PATCH_SCRIPT = """
+import json, os, traceback
+import FreeCAD, FreeCADGui as Gui
+out = {{}}
+try:
+    Gui.activateWorkbench("HapticSculptWorkbench")
+    import HapticSculpt as hs
+    doc = FreeCAD.newDocument("NewPatchTest")
+    made = {{}}
+    for command in ("HapticSculpt_NewPatch", "HapticSculpt_NewClampedPatch"):
+        before, undo = set(o.Name for o in doc.Objects), doc.UndoCount
+        Gui.runCommand(command)
+        for _ in range(3):
+            Gui.updateGui()
+        new = [o for o in doc.Objects if o.Name not in before]
+        made[command] = {{"objects": len(new), "undo": doc.UndoNames[:doc.UndoCount - undo],
+                          "edges": hs.held_boundary(new[0]), "bending": list(new[0].BendingMap)}}
+    out["made"] = made
+except Exception:
+    out["error"] = traceback.format_exc()
+json.dump(out, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+def test_new_patch_offers_free_or_held_edges(tmp_path):
+    """The create toolbar's New patch drop-down: New sculpt patch makes a free sheet, New clamped
+    patch one with every edge held G1; each one undo step, both bending by default."""
+    from HapticSculpt.app.api import FAIR_BENDING
+    out = run_freecad_gui(NEW_PATCH_SCRIPT.format(answer="{answer}"), str(tmp_path))
+    assert "error" not in out, out["error"]
+    free, held = out["made"]["HapticSculpt_NewPatch"], out["made"]["HapticSculpt_NewClampedPatch"]
+    assert free["objects"] == held["objects"] == 1
+    assert free["undo"] == held["undo"] == ["Create sculpt"]
+    assert set(free["edges"].values()) == {"free"}
+    assert held["edges"] == {"u0": "G1", "u1": "G1", "v0": "G1", "v1": "G1"}
+    assert free["bending"] == held["bending"] == [FAIR_BENDING]

@@ -274,9 +274,9 @@ def test_overlay_commands_keys_and_pictures(tmp_path):
     out = run_freecad_gui(GUI_SCRIPT.format(shots=SHOTS, recording=recording, answer="{answer}"), str(tmp_path))
     with open(os.path.join(SHOTS, "overlay_cost.json"), "w") as f:
         json.dump({k: v for k, v in out.items() if k.startswith(("frame_ms", "sim_hz"))}, f, indent=1)
-    # disabled without a document (but New patch, which makes one), enabled with a sculpt (constraint
-    # and paint need a cursor: they had one)
-    assert out["inactive"].pop("HapticSculpt_NewPatch")
+    # disabled without a document (but New patch and New clamped patch, which make one), enabled with
+    # a sculpt (constraint and paint need a cursor: they had one)
+    assert out["inactive"].pop("HapticSculpt_NewPatch") and out["inactive"].pop("HapticSculpt_NewClampedPatch")
     assert not any(v for k, v in out["inactive"].items()), out["inactive"]
     selection_based = {"HapticSculpt_SculptFace", "HapticSculpt_Thicken", "HapticSculpt_ExportStep"}
     assert all(v for k, v in out["active"].items() if k not in selection_based), out["active"]

@@ -98,3 +98,68 @@ def test_verlet_steps_run_the_guard():
     s.set_cursor([0, 0, 1.0], grab=True)
     assert s.step(1e-3).verlet
     assert s.energy_ceiling > 0.0
+
+
+# Extreme bending weights (issue 26: bending is on by default now). Off, tiny, the default, huge
+# and the largest a map takes, in every scheme, on a patch with held corners and a curvature
+# constraint (whose penalty grows with the bending ratio: the stiffest system a weight can make).
+BENDING_WEIGHTS = [0.0, 1e-12, 1e-6, 10.0, 1e4, 1e8, 1e12]
+SCHEMES = [("explicit", {}), ("implicit", {"cg_iterations": 5}),
+           ("local_global", {"explicit_when_stable": False}), ("local_global", {})]
+
+
+@pytest.mark.parametrize("bending", BENDING_WEIGHTS)
+@pytest.mark.parametrize("integrator,settings", SCHEMES, ids=["explicit", "implicit", "bdf2", "verlet"])
+def test_extreme_bending_weights_stay_finite_and_bounded(integrator, settings, bending):
+    """A rope pulls the centre up 10 mm in 0.1 s and lets go: every step is taken or refused with a
+    reason (the state kept), or the very first is refused naming dt (a step too long for so stiff
+    a plate); the state stays finite and the energy within the stress bound of the work put in."""
+    from stress_scenes import ENERGY_SLACK
+    s = core.patch((8, 8), (3, 3), (24, 24))
+    s.hold_poles([0, 7, 56, 63])
+    s.damping_map.set_uniform(5.0)
+    s.bending_map.set_uniform(bending)
+    s.integrator = integrator
+    for k, v in settings.items():
+        setattr(s, k, v)
+    s.max_halvings = min(s.max_halvings, 12)  # (a huge plate halves the explicit step to its limit)
+    s.add_constraint("curvature", uv=(0.3, 0.3), curvature=(0.01, 0.01))
+    s.set_tool("rope")
+    centre = s.mesh_index_at(0.5, 0.5)
+    cursor = np.array(s.mesh).reshape(-1, 3)[centre].copy()
+    energy0, work_in, last_work = s.kinetic_energy() + s.potential_energy(), 0.0, s.work_done
+    for k in range(150):
+        if k < 100:
+            cursor[2] += 0.1
+        s.set_cursor(list(cursor), grab=k < 100)
+        before = np.array(s.poles)
+        try:
+            report = s.step(1e-3)
+        except ValueError as exc:
+            assert k == 0 and "dt" in str(exc), exc  # only a first step can be too long, and it says so
+            assert np.array_equal(np.array(s.poles), before)
+            return
+        if report.refused:
+            assert report.reason
+            np.testing.assert_array_equal(np.array(s.poles), before)
+        assert np.isfinite(s.poles).all() and np.isfinite(s.velocities).all()
+        work_in += max(0.0, s.work_done - last_work)
+        last_work = s.work_done
+        energy = s.kinetic_energy() + s.potential_energy()
+        assert math.isfinite(energy) and math.isfinite(s.bending_energy) and s.bending_energy >= 0
+        assert energy <= ENERGY_SLACK * (energy0 + work_in) + 1e-6, (k, energy, energy0, work_in)
+
+
+@pytest.mark.parametrize("bad", [-1.0, -1e-300, math.nan, math.inf, -math.inf, 1e13])
+def test_invalid_bending_weights_are_refused_naming_the_map(bad):
+    s = core.patch((6, 6), (3, 3), (12, 12))
+    s.bending_map.set_uniform(10.0)
+    values = np.array(s.bending_map.values)
+    for set_it in (lambda: s.bending_map.set_uniform(bad),
+                   lambda: s.bending_map.set_values(np.full((2, 2), bad)),
+                   lambda: s.bending_map.dab((0.5, 0.5), radius=0.2, value=bad, falloff="conical", strength=1.0)):
+        with pytest.raises(ValueError, match="bending"):
+            set_it()
+        np.testing.assert_array_equal(np.array(s.bending_map.values), values)
+    s.step(1e-3)
+    assert np.isfinite(s.poles).all()

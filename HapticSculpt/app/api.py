@@ -127,6 +127,7 @@ def _sculpt_state(made: Any, mesh: tuple[int, int], material: str, held: Sequenc
         raise ValueError(f"mesh: must be at least the control resolution {(nu, nv)}, got {mesh}")
     surface = core.DynamicSurface(made.surface, mesh)
     _apply_material(surface, material)
+    surface.bending_map.set_uniform(FAIR_BENDING)
     if held or links:
         surface.hold_poles(list(held), list(links))
     if symmetry is not None:
@@ -152,9 +153,9 @@ CLAY = (True, 0.01, 5.0)
 CLAY_DAMPING = 10.0
 ELASTIC_DAMPING = 1.0  # the core's default
 #: The bending (thin-plate) weight, a ratio to the stiffness (docs/solver.md), at which a rope
-#: stroke leaves a fair bump, no tents or creases (tests/test_fairness.py):
-#: ``set_uniform(obj, "bending", FAIR_BENDING)``. Not the materials' default yet: strokes on it lift
-#: less (held edges, faces of solids: docs/benchmarks.md), so the default stays 0 (springs alone).
+#: stroke leaves a fair bump, no tents or creases (tests/test_fairness.py): every new sculpt's
+#: bending map (make_sculpt, sculpt_solid, the GUI's New patch), both materials. A map like the
+#: others: ``set_uniform(obj, "bending", 0)`` is springs alone (sculpts made before it existed).
 FAIR_BENDING = 10.0
 MATERIALS = ("elastic", "clay")
 
@@ -278,8 +279,8 @@ def set_tool(obj: Any, tool: str, falloff: str | None = None) -> None:
 def set_uniform(obj: Any, map: str, value: float) -> None:
     """Sets material map ``map`` ("mass", "damping", "stiffness", "bending") to ``value`` everywhere
     (the slider panel's edit; damping and bending may be 0: off; bending is a ratio to the
-    stiffness, FAIR_BENDING for fair strokes). One undo step; a running session
-    takes it at once."""
+    stiffness, FAIR_BENDING for fair strokes: every new sculpt's). One undo step; a running
+    session takes it at once."""
     obj = _sculpt(obj, solids=True)
     sculpt_state.map_property(map)  # validates the name
     off = map in ("damping", "bending")

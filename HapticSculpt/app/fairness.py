@@ -1,21 +1,32 @@
-"""How fair a shape is along sections: the normal curvature along straight lines of the mass-point
-mesh, how often it changes sign and its total variation (plain numpy, no FreeCAD).
+"""How fair a surface is along sections: the exact normal curvature along straight lines of its
+parameter domain, how often it changes sign and its total variation (plain numpy, no FreeCAD).
 
-A bump pulled out of a sheet is fair when its normal curvature along any section through it
-changes sign at most twice (skirt, crown, skirt); a tent, a crease or a wave adds sign changes and
+The curvature comes from the surface's exact first and second derivatives, not from differences of
+sampled points: along a section (u, v) = (u0, v0) + t (a, b) the section's curve on the surface has
+tangent T = a S_u + b S_v and second derivative C'' = a² S_uu + 2ab S_uv + b² S_vv, and its normal
+curvature is κ = n · C'' / |T|² (Meusnier), n the unit surface normal. Two sources of derivatives
+are taken: the core's own B-spline (``core.BSplineSurface.evaluate``: what a sculpt's poles make)
+and FreeCAD's ``Part.BSplineSurface`` (``getDN``: the surface the document holds), so a test can
+check that the written surface is as fair as the core's.
+
+A bump pulled out of a sheet is fair when its normal curvature along any section through it changes
+sign at most twice (skirt, crown, skirt); a tent, a crease or a wave adds sign changes and
 variation. Values below ``tolerance`` times the section's largest |curvature| count as zero, so
 rounding on the flat parts does not count as waves.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from .analysis import vertex_normals
+#: A section: from (u0, v0) to (u1, v1) in the surface's parameters.
+Section = tuple[tuple[float, float], tuple[float, float]]
+#: (u, v) -> (S_u, S_v, S_uu, S_uv, S_vv), each a 3-vector.
+Derivatives = Callable[[float, float], tuple[Any, Any, Any, Any, Any]]
 
-Section = tuple[tuple[int, int], tuple[int, int]]
+SAMPLES = 201  # points per section
 
 
 @dataclass
@@ -26,57 +37,98 @@ class Fairness:
     sign_changes: int
     variation: float
     per_section: list[tuple[int, float]]
+    #: Total variation itself (1/length, not over the largest |curvature|) summed over the
+    #: sections: what two shapes of the same lift can be compared by.
+    absolute_variation: float = 0.0
 
 
-def section_curvature(mesh: np.ndarray, section: Section, normals: np.ndarray | None = None) -> np.ndarray:
-    """Normal curvature at the interior points of the mesh line from ``section[0]`` to
-    ``section[1]`` (mesh indices (a, b); the line runs along u, v or a diagonal)."""
-    mesh = np.asarray(mesh, dtype=float)
-    (a0, b0), (a1, b1) = section
-    n = max(abs(a1 - a0), abs(b1 - b0))
-    if n < 2 or (a1 != a0 and b1 != b0 and abs(a1 - a0) != abs(b1 - b0)):
-        raise ValueError(f"section: a mesh line of at least 3 points along u, v or a diagonal, got {section!r}")
-    a = a0 + np.sign(a1 - a0) * np.arange(n + 1)
-    b = b0 + np.sign(b1 - b0) * np.arange(n + 1)
-    if min(a.min(), b.min()) < 0 or a.max() >= mesh.shape[0] or b.max() >= mesh.shape[1]:
-        raise ValueError(f"section: {section!r} leaves the {mesh.shape[0]} x {mesh.shape[1]} mesh")
-    p = mesh[a, b]
-    nrm = (vertex_normals(mesh) if normals is None else normals)[a[1:-1], b[1:-1]]
-    second = p[:-2] - 2 * p[1:-1] + p[2:]
-    half = 0.5 * np.linalg.norm(p[2:] - p[:-2], axis=1)
-    return np.einsum("ij,ij->i", nrm, second) / np.maximum(half, 1e-300) ** 2
+def core_derivatives(surface: Any) -> Derivatives:
+    """The exact derivatives of a ``core.BSplineSurface`` (e.g. ``DynamicSurface.surface``)."""
+    def derivatives(u: float, v: float) -> tuple[Any, Any, Any, Any, Any]:
+        d = surface.evaluate(u, v)
+        return d["du"], d["dv"], d["duu"], d["duv"], d["dvv"]
+    return derivatives
 
 
-def measure(mesh: np.ndarray, sections: Sequence[Section], tolerance: float = 0.05) -> Fairness:
-    """Sign changes of the normal curvature and its total variation over its largest magnitude,
-    summed over ``sections``."""
-    mesh = np.asarray(mesh, dtype=float)
-    normals = vertex_normals(mesh)
-    per = []
-    for section in sections:
-        k = section_curvature(mesh, section, normals)
-        top = float(np.abs(k).max())
-        if top == 0:
+def part_derivatives(surface: Any) -> Derivatives:
+    """The exact derivatives of a FreeCAD ``Part.BSplineSurface`` (``getDN``; no FreeCAD import
+    here: the surface brings it)."""
+    def derivatives(u: float, v: float) -> tuple[Any, Any, Any, Any, Any]:
+        return tuple(surface.getDN(u, v, nu, nv) for nu, nv in ((1, 0), (0, 1), (2, 0), (1, 1), (0, 2)))
+    return derivatives
+
+
+def section_curvature(derivatives: Derivatives, section: Section, samples: int = SAMPLES) -> np.ndarray:
+    """The exact normal curvature at ``samples`` points evenly spaced along ``section``, along its
+    direction."""
+    if not isinstance(samples, int) or samples < 3:
+        raise ValueError(f"samples: an integer of at least 3, got {samples!r}")
+    try:
+        (u0, v0), (u1, v1) = section
+        u0, v0, u1, v1 = (float(x) for x in (u0, v0, u1, v1))
+    except (TypeError, ValueError):
+        raise ValueError(f"section: ((u0, v0), (u1, v1)), got {section!r}") from None
+    a, b = u1 - u0, v1 - v0
+    if not np.isfinite([u0, v0, a, b]).all() or a == 0 and b == 0:
+        raise ValueError(f"section: two different finite (u, v) points, got {section!r}")
+    t = np.linspace(0.0, 1.0, samples)
+    d = np.array([[np.asarray(x, dtype=float) for x in derivatives(u0 + a * s, v0 + b * s)] for s in t])
+    su, sv, suu, suv, svv = (d[:, k] for k in range(5))
+    tangent = a * su + b * sv
+    second = a * a * suu + 2 * a * b * suv + b * b * svv
+    normal = np.cross(su, sv)
+    normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+    return np.einsum("ij,ij->i", normal, second) / np.maximum(np.einsum("ij,ij->i", tangent, tangent), 1e-300)
+
+
+def summarize(curvatures: Sequence[np.ndarray], tolerance: float = 0.05, flat: float = 0.0) -> Fairness:
+    """Sign changes and total variation over the largest magnitude of each curvature profile,
+    summed. |curvature| below ``tolerance`` times a profile's largest, or below ``flat`` (a
+    curvature radius too large to see: 1 / (1000 size)), counts as zero; a profile that is flat
+    throughout has no sign changes and no variation."""
+    if not (0 <= tolerance < 1) or not (flat >= 0) or not np.isfinite(flat):
+        raise ValueError(f"tolerance: in [0, 1) and flat: finite and >= 0, got {tolerance!r}, {flat!r}")
+    per, absolute = [], 0.0
+    for k in curvatures:
+        k = np.asarray(k, dtype=float)
+        if not np.isfinite(k).all():
+            raise ValueError("curvatures: not finite")
+        top = float(np.abs(k).max()) if k.size else 0.0
+        if top == 0 or top <= flat:
             per.append((0, 0.0))
             continue
-        signs = np.sign(k[np.abs(k) > tolerance * top])
-        per.append((int(np.count_nonzero(signs[1:] != signs[:-1])), float(np.abs(np.diff(k)).sum() / top)))
-    return Fairness(sum(c for c, _ in per), float(sum(v for _, v in per)), per)
+        signs = np.sign(k[np.abs(k) > max(tolerance * top, flat)])
+        tv = float(np.abs(np.diff(k)).sum())
+        absolute += tv
+        per.append((int(np.count_nonzero(signs[1:] != signs[:-1])), tv / top))
+    return Fairness(sum(c for c, _ in per), float(sum(v for _, v in per)), per, absolute)
 
 
-def central_sections(g: int, h: int, centre: tuple[int, int], spread: int = 2,
-                     diagonals: bool = False) -> list[Section]:
-    """Three lines along u and three along v through and beside ``centre`` (``spread`` mesh lines
-    apart), edge to edge; with ``diagonals``, also the two diagonals through it, corner to corner
-    as far as the mesh goes."""
-    ca, cb = centre
+def measure(derivatives: Derivatives, sections: Sequence[Section], tolerance: float = 0.05,
+            flat: float = 0.0, samples: int = SAMPLES) -> Fairness:
+    """Sign changes of the exact normal curvature and its total variation (over its largest
+    magnitude, and absolute), summed over ``sections``; ``tolerance`` and ``flat`` as
+    :func:`summarize` takes them."""
+    return summarize([section_curvature(derivatives, s, samples) for s in sections], tolerance, flat)
+
+
+def central_sections(centre: tuple[float, float], spread: float = 0.05, diagonals: bool = False,
+                     domain: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 1.0), (0.0, 1.0))
+                     ) -> list[Section]:
+    """Three lines along u and three along v through and beside ``centre`` (``spread`` apart in
+    the parameters), edge to edge of ``domain``; with ``diagonals``, also the two diagonals
+    through it, as far as the domain goes both ways (toward the corners)."""
+    (ua, ub), (va, vb) = domain
+    cu, cv = centre
+    if not (ua < cu < ub and va < cv < vb):
+        raise ValueError(f"centre: inside the domain {domain}, got {centre!r}")
     out: list[Section] = []
-    for off in (-spread, 0, spread):
-        out.append(((0, cb + off), (g - 1, cb + off)))
-        out.append(((ca + off, 0), (ca + off, h - 1)))
+    for off in (-spread, 0.0, spread):
+        out.append(((ua, cv + off), (ub, cv + off)))
+        out.append(((cu + off, va), (cu + off, vb)))
     if diagonals:
-        for sa, sb in ((1, 1), (1, -1)):
-            back = min(ca if sa > 0 else g - 1 - ca, cb if sb > 0 else h - 1 - cb)
-            ahead = min(g - 1 - ca if sa > 0 else ca, h - 1 - cb if sb > 0 else cb)
-            out.append(((ca - sa * back, cb - sb * back), (ca + sa * ahead, cb + sb * ahead)))
+        for su, sv in ((1, 1), (1, -1)):
+            back = min((cu - ua) if su > 0 else (ub - cu), (cv - va) if sv > 0 else (vb - cv))
+            ahead = min((ub - cu) if su > 0 else (cu - ua), (vb - cv) if sv > 0 else (cv - va))
+            out.append(((cu - su * back, cv - sv * back), (cu + su * ahead, cv + sv * ahead)))
     return out

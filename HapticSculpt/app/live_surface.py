@@ -160,7 +160,7 @@ class LiveSurface:
             self.commit(title, inside=inside)
             return result
         prepared = self._configured()
-        poles = self._session.latest_poles()
+        poles = self._session.newest_poles()
         if poles is not None:
             prepared.set_poles(np.asarray(poles, float).reshape(np.asarray(prepared.poles).shape))
         before = _maps(prepared)

@@ -11,6 +11,8 @@ from .view_provider import icon
 #: The drop-down command groups (FreeCAD group commands, as Draft's and PartDesign's): name ->
 #: (menu text, tool tip, the commands, the one the button runs until another entry is picked).
 GROUPS = {
+    "HapticSculpt_NewGroup": ("New patch", "A new flat sculpt patch: free edges (a free sheet) or held edges (a "
+                              "clamped sheet)", ["HapticSculpt_NewPatch", "HapticSculpt_NewClampedPatch"], 0),
     "HapticSculpt_OutputGroup": ("Output", "Export STEP, or thicken the selected sculpt into a solid",
                                  ["HapticSculpt_ExportStep", "HapticSculpt_Thicken"], 0),
     "HapticSculpt_ToolGroup": ("Tools", "Choose the sculpting tool: rope, magnet (and its falloff), orientation, "
@@ -38,14 +40,14 @@ GROUPS = {
 #: of its own: a toolbar squeezed by a narrow window keeps its first button, so Export STEP never
 #: hides behind "»" (next to create, as FreeCAD's File toolbar holds New and Save).
 TOOLBARS = {
-    "HapticSculpt create": ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace"],
+    "HapticSculpt create": ["HapticSculpt_NewGroup", "HapticSculpt_SculptFace"],
     "HapticSculpt output": ["HapticSculpt_OutputGroup"],
     "HapticSculpt sculpt": ["HapticSculpt_Session", "HapticSculpt_ToolGroup", "HapticSculpt_MaterialGroup"],
     "HapticSculpt tools": ["HapticSculpt_ConstraintGroup"],
     "HapticSculpt analysis": ["HapticSculpt_DisplayGroup"],
 }
 #: The menu: every command, in sections.
-MENU = ["HapticSculpt_NewPatch", "HapticSculpt_SculptFace", "Separator", "HapticSculpt_Session", "Separator",
+MENU = ["HapticSculpt_NewPatch", "HapticSculpt_NewClampedPatch", "HapticSculpt_SculptFace", "Separator", "HapticSculpt_Session", "Separator",
         *[name for group in ("HapticSculpt_ToolGroup", "HapticSculpt_MaterialGroup", "HapticSculpt_ConstraintGroup",
                              "HapticSculpt_DisplayGroup", "HapticSculpt_OutputGroup")
           for name in [*GROUPS[group][2], "Separator"]]][:-1]
@@ -57,13 +59,16 @@ def _selected_sculpts() -> list[Any]:
 
 
 class NewPatch:
-    """A flat 8x8 sculpt patch (100 x 100 mm) in the active document, or in a new one when none is
-    open (as Part's primitives do)."""
+    """A flat 8x8 sculpt patch (100 x 100 mm) with free edges in the active document, or in a new one
+    when none is open (as Part's primitives do)."""
+
+    #: make_sculpt's ``edges``.
+    EDGES = "free"
 
     def GetResources(self) -> dict[str, str]:
         return {"Pixmap": icon("NewPatch"), "MenuText": "New sculpt patch",
-                "ToolTip": "Create a flat 100 x 100 mm B-spline patch (8 x 8 poles, degree 3) to sculpt "
-                           "(in a new document when none is open)"}
+                "ToolTip": "Create a flat 100 x 100 mm B-spline patch (8 x 8 poles, degree 3) with free edges to "
+                           "sculpt (in a new document when none is open)"}
 
     def IsActive(self) -> bool:
         return True
@@ -72,10 +77,25 @@ class NewPatch:
         from .echo import run_echoed
         if FreeCAD.ActiveDocument is None:
             run_echoed("App.newDocument()", modules=())
+        edges = "" if self.EDGES == "free" else f", edges={self.EDGES!r}"
         # clay: designers expect what they pull to stay
-        run_echoed(f"HapticSculpt.make_sculpt(App.getDocument({FreeCAD.ActiveDocument.Name!r}), material='clay')")
+        run_echoed(f"HapticSculpt.make_sculpt(App.getDocument({FreeCAD.ActiveDocument.Name!r}), material='clay'"
+                   f"{edges})")
         FreeCAD.ActiveDocument.recompute()
         Gui.SendMsgToActiveView("ViewFit")
+
+
+class NewClampedPatch(NewPatch):
+    """The same patch with every edge and its tangent plane held (a clamped sheet:
+    ``make_sculpt(edges="held")``); Hold edges frees them again."""
+
+    EDGES = "held"
+
+    def GetResources(self) -> dict[str, str]:
+        return {"Pixmap": icon("NewClampedPatch"), "MenuText": "New clamped patch",
+                "ToolTip": "Create a flat 100 x 100 mm B-spline patch (8 x 8 poles, degree 3) whose edges and "
+                           "tangent planes are held (a clamped sheet: strokes raise bumps inside it; Hold edges "
+                           "frees them)"}
 
 
 def _face_selection() -> tuple[Any, list[str], Any] | None:
@@ -518,7 +538,8 @@ class Group:
         return any(COMMANDS[name]().IsActive() for name in self.commands)
 
 
-COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_SculptFace": SculptFace, "HapticSculpt_Session": Session,
+COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_NewClampedPatch": NewClampedPatch,
+            "HapticSculpt_SculptFace": SculptFace, "HapticSculpt_Session": Session,
             "HapticSculpt_Material": Material, "HapticSculpt_KeepShape": KeepShape,
             "HapticSculpt_HoldEdges": HoldEdges, "HapticSculpt_Fair": Fair,
             "HapticSculpt_ToolRope": ToolRope, "HapticSculpt_ToolMagnet": ToolMagnet,

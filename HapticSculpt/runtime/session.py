@@ -189,6 +189,20 @@ class Session:
         """The newest pole snapshot ((nu*nv, 3)) the GUI received, None before the first."""
         return self._latest_poles
 
+    def newest_poles(self) -> np.ndarray | None:
+        """The newest pole snapshot the simulation published (at most 1/60 s old), taken now as
+        the GUI's frame takes it, else the newest the GUI received; None before the first. An edit
+        configures its copy with it, so what the edit reads off the shape (a new constraint's
+        target) is the shape now: in console mode no GUI takes snapshots, and the copy had the
+        document's shape from before the stroke (a point constraint added mid-stroke on a lifted
+        sheet pulled its corner back down to where it was)."""
+        runtime = self._runtime
+        if runtime is not None:
+            poles = runtime.take_poles()
+            if poles is not None:
+                self._latest_poles = poles
+        return self._latest_poles
+
     def latest_map(self, name: str) -> np.ndarray | None:
         """The newest snapshot of map ``name`` the airbrush sprayed this run, None if none."""
         return self._latest_maps.get(name)

@@ -159,11 +159,11 @@ void ConstraintSet::terms(const Points& d, std::vector<ConstraintTerm>& out) con
         const Vec3 x = d.row(p);
         switch (c.kind) {
             case ConstraintKind::Point:
-                out.push_back({p, -1, c.stiffness, c.target});
+                out.push_back({p, -1, effectiveStiffness(c), c.target});
                 break;
             case ConstraintKind::Tangent: {
                 const int nb[4] = {p + h_, p - h_, p + 1, p - 1};
-                for (int k = 0; k < 4; ++k) out.push_back({nb[k], p, c.stiffness, c.offsets[k]});
+                for (int k = 0; k < 4; ++k) out.push_back({nb[k], p, effectiveStiffness(c), c.offsets[k]});
                 break;
             }
             case ConstraintKind::Normal: {
@@ -177,7 +177,7 @@ void ConstraintSet::terms(const Points& d, std::vector<ConstraintTerm>& out) con
                 const int nb[4] = {p + h_, p - h_, p + 1, p - 1};
                 for (int k = 0; k < 4; ++k) {
                     const Vec3 e = Vec3(d.row(nb[k])) - x;
-                    out.push_back({nb[k], p, c.stiffness, e - e.dot(c.target) * c.target});
+                    out.push_back({nb[k], p, effectiveStiffness(c), e - e.dot(c.target) * c.target});
                 }
                 break;
             }
@@ -208,8 +208,8 @@ void ConstraintSet::terms(const Points& d, std::vector<ConstraintTerm>& out) con
                     const double half = 0.5 * ((xa - x).norm() + (x - xb).norm());
                     const double halfChord = 0.5 * curvatureChord(kappa[k], half, half);
                     const double sagitta = std::sqrt(std::max(0.0, half * half - halfChord * halfChord));
-                    out.push_back({a, p, c.stiffness, halfChord * e - sagitta * w});
-                    out.push_back({b, p, c.stiffness, -halfChord * e - sagitta * w});
+                    out.push_back({a, p, effectiveStiffness(c), halfChord * e - sagitta * w});
+                    out.push_back({b, p, effectiveStiffness(c), -halfChord * e - sagitta * w});
                 }
                 break;
             }
@@ -244,13 +244,13 @@ void ConstraintSet::addLaplacian(std::vector<Eigen::Triplet<double>>& trip) cons
     for (const Constraint& c : items_) {
         const int p = c.point;
         auto pair = [&](int a, int b) {
-            trip.emplace_back(a, a, c.stiffness);
-            trip.emplace_back(b, b, c.stiffness);
-            trip.emplace_back(a, b, -c.stiffness);
-            trip.emplace_back(b, a, -c.stiffness);
+            trip.emplace_back(a, a, effectiveStiffness(c));
+            trip.emplace_back(b, b, effectiveStiffness(c));
+            trip.emplace_back(a, b, -effectiveStiffness(c));
+            trip.emplace_back(b, a, -effectiveStiffness(c));
         };
         switch (c.kind) {
-            case ConstraintKind::Point: trip.emplace_back(p, p, c.stiffness); break;
+            case ConstraintKind::Point: trip.emplace_back(p, p, effectiveStiffness(c)); break;
             case ConstraintKind::Tangent:
             case ConstraintKind::Normal:
                 pair(p + h_, p); pair(p - h_, p); pair(p + 1, p); pair(p - 1, p);
@@ -266,12 +266,12 @@ void ConstraintSet::addStiffness(const Points& y, Points& out) const {
     for (const Constraint& c : items_) {
         const int p = c.point;
         auto pair = [&](int a, int b) {
-            const Vec3 r = c.stiffness * Vec3(y.row(a) - y.row(b));
+            const Vec3 r = effectiveStiffness(c) * Vec3(y.row(a) - y.row(b));
             out.row(a) += r.transpose();
             out.row(b) -= r.transpose();
         };
         switch (c.kind) {
-            case ConstraintKind::Point: out.row(p) += c.stiffness * y.row(p); break;
+            case ConstraintKind::Point: out.row(p) += effectiveStiffness(c) * y.row(p); break;
             case ConstraintKind::Tangent:
             case ConstraintKind::Normal:
                 pair(p + h_, p); pair(p - h_, p); pair(p + 1, p); pair(p - 1, p);
@@ -280,6 +280,20 @@ void ConstraintSet::addStiffness(const Points& y, Points& out) const {
                 pair(p + h_, p); pair(p - h_, p); pair(p + 1, p); pair(p - 1, p);
                 break;
         }
+    }
+}
+
+void ConstraintSet::setBendingRatio(const Eigen::VectorXd& ratio) {
+    curvatureScale_.resize(static_cast<std::size_t>(ratio.size()));
+    bool changed = false;
+    for (Eigen::Index i = 0; i < ratio.size(); ++i) {
+        const double scale = std::min(1.0 + kCurvatureBendingGain * ratio[i], kMaxCurvatureScale);
+        changed = changed || scale != curvatureScale_[static_cast<std::size_t>(i)];
+        curvatureScale_[static_cast<std::size_t>(i)] = scale;
+    }
+    if (changed && anyNonConvex()) {
+        ++structureVersion_;
+        ++version_;
     }
 }
 

@@ -185,13 +185,16 @@ void DynamicSurface::refreshMaterials() {
     if (key[0] == materialKey_[0] && key[1] == materialKey_[1] && key[2] == materialKey_[2] && key[3] == materialKey_[3]) return;
     // Densities per unit parameter area, lumped with trapezoid weights that sum to one.
     const int G = g(), H = h();
+    if (bendingRatio_.size() != G * H) bendingRatio_.resize(G * H);  // (once: the mesh does not change)
     for (int a = 0; a < G; ++a)
         for (int b = 0; b < H; ++b) {
             const double w = ((a == 0 || a == G - 1) ? 0.5 : 1.0) / (G - 1) * ((b == 0 || b == H - 1) ? 0.5 : 1.0) / (H - 1);
             const double u = static_cast<double>(a) / (G - 1), v = static_cast<double>(b) / (H - 1);
             m_[a * H + b] = mass_.at(u, v) * w;
             gamma_[a * H + b] = damping_.at(u, v) * w;
+            bendingRatio_[a * H + b] = bendingMap_.at(u, v);
         }
+    constraints_.setBendingRatio(bendingRatio_);  // curvature constraints beat the plate they bend
     springs_.setStiffness(stiffness_, A_.us(), A_.vs());
     if (key[2] != materialKey_[2] || key[3] != materialKey_[3]) bending_.setWeights(bendingMap_, stiffness_);
     minMass_ = m_.minCoeff();

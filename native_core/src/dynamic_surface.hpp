@@ -307,6 +307,7 @@ private:
     MirrorSymmetry mirror_;
     // Material: per mesh point masses and damping rates, the maps, springs, constraints, tool.
     Eigen::VectorXd m_, gamma_;
+    Eigen::VectorXd bendingRatio_;  // the bending map at each mesh point (curvature constraints' scale)
     MaterialMap mass_, damping_, stiffness_, bendingMap_;
     SpringMesh springs_;
     BendingEnergy bending_;
