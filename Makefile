@@ -114,7 +114,8 @@ wheel-debian-%: deps
 
 # The Addon Manager's install without a compiler: a copy of the repository without build output in
 # a private FreeCAD home's Mod folder, the wheel in its AdditionalPythonPackages; then, from there,
-# the FreeCAD-layer tests through FreeCAD's runner and the GUI tests (tests/addon_install.py).
+# the FreeCAD-layer tests through FreeCAD's runner and the GUI tests (tests/addon_install.py): every
+# tests/test_gui_*.py, on every Debian's FreeCAD; GUI_TESTS='tests/test_gui_a.py ...' runs only those.
 GUI_TESTS ?=
 test-addon: build wheel ocp-venv
 	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) tests/addon_install.py \

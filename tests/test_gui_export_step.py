@@ -51,18 +51,19 @@ def test_export_step_with_nothing_selected_writes_the_only_sculpt(tmp_path, monk
         d.press_button("NewPatch", lambda s: s["active"] and s["inputs"] == 1 and sculpt(s)["screen"], "a new patch")
         d.xdo("mousemove", "1100", "900", "click", "1")  # an empty corner of the view: nothing selected
         d.wait(lambda s: not sculpt(s)["selected"], "the selection to be cleared")
-        s = d.press_button("ExportStep", lambda s: "OK" in s["task_buttons"], "the Export STEP panel")
-        d.shot("export_step_panel")
+        d.press_button("ExportStep", lambda s: "OK" in s["task_buttons"], "the Export STEP panel")
         # the chooser's button: FreeCAD's save dialog, STEP preselected; a name typed without suffix
-        choose = s["task_buttons"]["..."]
+        # (where the button is once the panel has laid itself out: FreeCAD 1.0 moved it after OK showed)
+        choose = d.wait_still(lambda s: s["task_buttons"]["..."], "the chooser's button")
+        d.shot("export_step_panel")
         d.xdo("mousemove", str(choose[0]), str(choose[1]), "click", "1")
         d.wait_window("Select a file")
         d.shot("export_step_save_dialog")
         d.xdo("key", "ctrl+a")
         d.xdo("type", str(home / "renamed"))
         d.xdo("key", "Return")
-        s = d.wait(lambda s: "OK" in s["task_buttons"] and len(s["task_buttons"]) == 3, "the panel back")
-        ok = s["task_buttons"]["OK"]
+        d.wait(lambda s: "OK" in s["task_buttons"] and len(s["task_buttons"]) == 3, "the panel back")
+        ok = d.wait_still(lambda s: s["task_buttons"]["OK"], "the OK button")
         d.xdo("mousemove", str(ok[0]), str(ok[1]), "click", "1")
         target = home / "renamed.step"
         s = d.wait(lambda s: not s["task_buttons"] and target.exists(), "the panel to close and the STEP file")

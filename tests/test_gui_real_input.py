@@ -133,6 +133,29 @@ class Desktop:
                                        for c in doc["sculpts"]]}
         raise AssertionError(f"timed out waiting for {what}; last state: {json.dumps(brief)[:3000]}")
 
+    def wait_still(self, value, what: str, writes: int = 5, timeout: float = 20.0):
+        """``value(state)`` once it has stayed the same over ``writes`` of the observer's writes in a
+        row (a widget's place while its panel still lays itself out is not where a click finds it)."""
+        end, last, same, stamp = time.monotonic() + timeout, None, 0, None
+        while time.monotonic() < end:
+            try:
+                now = os.stat(self.state_file).st_mtime_ns
+            except OSError:
+                now = None
+            if now is not None and now != stamp:
+                stamp = now
+                try:
+                    current = value(self.state())
+                except (KeyError, IndexError):
+                    current = None
+                same = same + 1 if current is not None and current == last else 0
+                last = current
+                if same >= writes:
+                    return current
+            time.sleep(0.05)
+        self.shot("timeout")
+        raise AssertionError(f"timed out waiting for {what} to stay put; last: {last}")
+
     def shot(self, name: str) -> np.ndarray:
         import matplotlib.image as mpimg
         path = os.path.join(SHOTS, f"real_{name}.png")
