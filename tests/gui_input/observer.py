@@ -85,14 +85,17 @@ def _tree_items():
     tree, out = next((t for t in _TREE if t.isVisible()), None), {}
     if tree is None:
         return out
-    items = [tree.topLevelItem(k) for k in range(tree.topLevelItemCount())]
-    while items:
-        item = items.pop()
-        items.extend(item.child(k) for k in range(item.childCount()))
-        rect = tree.visualItemRect(item)
+    # (walked through the model's indices, plain values: PySide6 wrappers of the items themselves, as
+    # FreeCAD 1.1's tree rebuilds them, were found already deleted while walked)
+    model = tree.model()
+    indices = [model.index(k, 0) for k in range(model.rowCount())]
+    while indices:
+        index = indices.pop()
+        indices.extend(model.index(k, 0, index) for k in range(model.rowCount(index)))
+        rect = tree.visualRect(index)
         if rect.height() > 0:
             p, scale = tree.viewport().mapToGlobal(rect.center()), tree.devicePixelRatioF()
-            out[item.text(0)] = [round(p.x() * scale), round(p.y() * scale)]
+            out[model.data(index)] = [round(p.x() * scale), round(p.y() * scale)]
     return out
 
 
