@@ -220,8 +220,8 @@ class Controller:
         return np.array([p.x, p.y, p.z], float)
 
     def on_move(self, view: Any, cb: Any) -> None:
-        from .view_focus import give_keyboard_to_view_under_pointer
-        give_keyboard_to_view_under_pointer()  # (keys and ctrl+z reach it, whoever had them last)
+        from .view_focus import give_keyboard_to_view
+        give_keyboard_to_view(view)  # (keys and ctrl+z reach it, whoever had them last)
         pos = cb.getEvent().getPosition()
         if any(ov.panel_drag(float(pos[0])) for ov in self.overlays.values()):
             cb.setHandled()  # a slider drag: neither a stroke nor a rotation
