@@ -12,14 +12,14 @@ import numpy as np
 import pytest
 from freecad_support import GUI_AVAILABLE, run_freecad_gui, run_ocp
 from test_freecad_step_ocp import READ_STEP
-from test_gui_real_input import NEEDS, RECORD_BUTTON, Desktop, sculpt
+from test_gui_real_input import MACRO_DIALOG, NEEDS, RECORD_BUTTON, Desktop, sculpt
 
 
 def start_macro(d: Desktop, name: str) -> None:
     """Macro > Macro recording..., the name typed, Record clicked (real keys and clicks)."""
     d.xdo("key", "alt+m")
     d.xdo("key", "m")
-    d.wait_window("Macro recording")
+    d.wait_window(MACRO_DIALOG)
     d.xdo("key", "ctrl+a")
     d.xdo("type", name)
     d.xdo("mousemove", str(RECORD_BUTTON[0]), str(RECORD_BUTTON[1]), "click", "1")

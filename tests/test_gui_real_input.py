@@ -17,6 +17,9 @@ from freecad_support import ROOT, SCREENSHOTS, make_addon_home, run_freecadcmd
 
 SHOTS = SCREENSHOTS
 RECORD_BUTTON = (536, 552)  # the Record button of FreeCAD's macro recording dialog
+#: That dialog's title (a regular expression for xdotool): "Macro recording" up to FreeCAD 1.0,
+#: "Record Macro" in 1.1.
+MACRO_DIALOG = "Macro recording|Record Macro"
 STYLES = {"CAD": "Gui::CADNavigationStyle", "OpenInventor": "Gui::InventorNavigationStyle",
           "Blender": "Gui::BlenderNavigationStyle", "Gesture": "Gui::GestureNavigationStyle"}
 NEEDS = [shutil.which(t) for t in ("Xvfb", "xdotool", "import", "freecad")]
@@ -369,7 +372,7 @@ def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
     try:
         d.xdo("key", "alt+m")  # Macro > Macro recording...
         d.xdo("key", "m")
-        d.wait_window("Macro recording")
+        d.wait_window(MACRO_DIALOG)
         d.xdo("key", "ctrl+a")
         d.xdo("type", "session")
         d.xdo("mousemove", str(RECORD_BUTTON[0]), str(RECORD_BUTTON[1]), "click", "1")
