@@ -54,7 +54,9 @@ def test_export_step_with_nothing_selected_writes_the_only_sculpt(tmp_path, monk
         d.press_button("ExportStep", lambda s: "OK" in s["task_buttons"], "the Export STEP panel")
         # the chooser's button: FreeCAD's save dialog, STEP preselected; a name typed without suffix
         # (where the button is once the panel has laid itself out: FreeCAD 1.0 moved it after OK showed)
-        choose = d.wait_still(lambda s: s["task_buttons"]["..."], "the chooser's button")
+        # (its text: "..." up to FreeCAD 1.0, "…" in 1.1)
+        choose = d.wait_still(lambda s: s["task_buttons"].get("...") or s["task_buttons"]["…"],
+                              "the chooser's button")
         d.shot("export_step_panel")
         d.xdo("mousemove", str(choose[0]), str(choose[1]), "click", "1")
         d.wait_window("Select a file")
