@@ -26,6 +26,18 @@ BUILD_OUTPUT = shutil.ignore_patterns(".git", "build", "out", "__pycache__", "*.
                                       ".hypothesis")
 
 
+#: A sculpt, one rope stroke and its face, in console mode: the installed core at work.
+SMOKE = """
+import FreeCAD, HapticSculpt as hs
+doc = FreeCAD.newDocument("smoke")
+obj = hs.make_sculpt(doc)
+hs.run(obj, 0.5, hs.ReplayDevice.stroke((0, 0, 0), (0, 0, 10.0), seconds=0.3))
+lift = max(p.z for row in obj.Shape.Faces[0].Surface.getPoles() for p in row)
+assert lift > 1.0, lift
+print("HS_SMOKE lift %.2f mm" % lift)
+"""
+
+
 def run(what: str, command: list[str], **kwargs) -> subprocess.CompletedProcess:
     """Runs ``command``, printing what it is and how long it took; fails the script if it fails."""
     print(f"== {what}", flush=True)
@@ -44,6 +56,8 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--out", required=True)
     parser.add_argument("--pytest-args", default="", help="more arguments for the GUI tests' pytest")
     parser.add_argument("--gui-tests", default="", help="the GUI test files to run (default: every tests/test_gui_*.py)")
+    parser.add_argument("--load-only", action="store_true",
+                        help="install the wheel and check that FreeCAD loads it and sculpts with it; no test suites")
     args = parser.parse_args(argv)
     out = os.path.abspath(args.out)
     shutil.rmtree(out, ignore_errors=True)
@@ -69,6 +83,9 @@ def main(argv: list[str]) -> int:
     if not (line.startswith("HS_ORIGIN=installed package") and f"({packages}" in line):
         sys.exit(f"addon install: FreeCAD did not load the installed core:\n{origin.stdout[-2000:]}{origin.stderr[-2000:]}")
 
+    if args.load_only:
+        run("a stroke in freecadcmd with the installed core", ["freecadcmd", "-c", SMOKE], env=env, cwd=out)
+        return 0
     run("freecadcmd -t TestHapticSculpt (from the installed addon)", ["freecadcmd", "-t", "TestHapticSculpt"],
         env=env, cwd=out)
     gui_tests = args.gui_tests.split() or sorted(

@@ -12,14 +12,14 @@ import numpy as np
 import pytest
 from freecad_support import GUI_AVAILABLE, run_freecad_gui, run_ocp
 from test_freecad_step_ocp import READ_STEP
-from test_gui_real_input import NEEDS, RECORD_BUTTON, Desktop, sculpt
+from test_gui_real_input import MACRO_DIALOG, NEEDS, RECORD_BUTTON, Desktop, sculpt
 
 
 def start_macro(d: Desktop, name: str) -> None:
     """Macro > Macro recording..., the name typed, Record clicked (real keys and clicks)."""
     d.xdo("key", "alt+m")
     d.xdo("key", "m")
-    d.wait_window("Macro recording")
+    d.wait_window(MACRO_DIALOG)
     d.xdo("key", "ctrl+a")
     d.xdo("type", name)
     d.xdo("mousemove", str(RECORD_BUTTON[0]), str(RECORD_BUTTON[1]), "click", "1")
@@ -54,7 +54,9 @@ def test_export_step_with_nothing_selected_writes_the_only_sculpt(tmp_path, monk
         d.press_button("ExportStep", lambda s: "OK" in s["task_buttons"], "the Export STEP panel")
         # the chooser's button: FreeCAD's save dialog, STEP preselected; a name typed without suffix
         # (where the button is once the panel has laid itself out: FreeCAD 1.0 moved it after OK showed)
-        choose = d.wait_still(lambda s: s["task_buttons"]["..."], "the chooser's button")
+        # (its text: "..." up to FreeCAD 1.0, "…" in 1.1)
+        choose = d.wait_still(lambda s: s["task_buttons"].get("...") or s["task_buttons"]["…"],
+                              "the chooser's button")
         d.shot("export_step_panel")
         d.xdo("mousemove", str(choose[0]), str(choose[1]), "click", "1")
         d.wait_window("Select a file")

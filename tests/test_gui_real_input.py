@@ -17,6 +17,9 @@ from freecad_support import ROOT, SCREENSHOTS, make_addon_home, run_freecadcmd
 
 SHOTS = SCREENSHOTS
 RECORD_BUTTON = (536, 552)  # the Record button of FreeCAD's macro recording dialog
+#: That dialog's title (a regular expression for xdotool): "Macro recording" up to FreeCAD 1.0,
+#: "Record Macro" in 1.1.
+MACRO_DIALOG = "Macro recording|Record Macro"
 STYLES = {"CAD": "Gui::CADNavigationStyle", "OpenInventor": "Gui::InventorNavigationStyle",
           "Blender": "Gui::BlenderNavigationStyle", "Gesture": "Gui::GestureNavigationStyle"}
 NEEDS = [shutil.which(t) for t in ("Xvfb", "xdotool", "import", "freecad")]
@@ -155,6 +158,17 @@ class Desktop:
             time.sleep(0.05)
         self.shot("timeout")
         raise AssertionError(f"timed out waiting for {what} to stay put; last: {last}")
+
+    def clear_of_panels(self, point: tuple[int, int]) -> tuple[int, int]:
+        """``point`` (screen pixels), or the nearest point left of it on the same row that no panel
+        of FreeCAD's lies over: FreeCAD 1.1 lays its Tasks panel, even empty, over the 3D view's right
+        part, and a wheel turned there does not reach the view (FreeCAD issue 21141; a user zooms
+        where the view shows). The view's centre is just under that panel's edge at 1280 px."""
+        x, y = point
+        for px, py, pw, ph in sorted(self.state().get("overlay_panels", []), key=lambda r: -r[0]):
+            if px <= x < px + pw and py <= y < py + ph:
+                x = px - 12
+        return x, y
 
     def shot(self, name: str) -> np.ndarray:
         import matplotlib.image as mpimg
@@ -305,7 +319,8 @@ def test_workbench_first_keys_stroke_undo_redo_paint(tmp_path, style):
         d.xdo("key", "m")
         d.wait(lambda s: all(o["display"] == "shading" for o in s["overlays"]), "M again: shading")
         assert undo(d.state())[:3] == ["Add curvature constraint", "Add normal constraint", "Add point constraint"]
-        # the navigation style still navigates: the wheel zooms
+        # the navigation style still navigates: the wheel zooms (over the patch, where the view shows)
+        d.xdo("mousemove", *map(str, d.clear_of_panels(centre)))
         camera = d.state()["views"][0]["camera"]
         d.xdo("click", "--repeat", "2", "4")
         d.wait(lambda s: s["views"][0]["camera"] != camera, "the wheel to zoom")
@@ -371,7 +386,7 @@ def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
     try:
         d.xdo("key", "alt+m")  # Macro > Macro recording...
         d.xdo("key", "m")
-        d.wait_window("Macro recording")
+        d.wait_window(MACRO_DIALOG)
         d.xdo("key", "ctrl+a")
         d.xdo("type", "session")
         d.xdo("mousemove", str(RECORD_BUTTON[0]), str(RECORD_BUTTON[1]), "click", "1")
@@ -570,7 +585,10 @@ def test_keys_follow_the_view_across_documents_opened_switched_and_closed(tmp_pa
         d.xdo("key", "ctrl+w")  # close the second document's window; FreeCAD asks whether to save it
         d.wait_window("Unsaved document")  # FreeCAD's question
         d.shot("close_question")
-        d.xdo("key", "alt+d")  # "Discard"
+        # "Discard" clicked where the observer sees it (alt+d, its mnemonic up to FreeCAD 1.0, did
+        # nothing on 1.1: Qt 6)
+        discard = d.wait(lambda s: s["message_buttons"]["Discard"], "the Discard button")["message_buttons"]["Discard"]
+        d.xdo("mousemove", str(discard[0]), str(discard[1]), "click", "1")
         d.wait(lambda s: second not in s["docs"] and s["inputs"] == 1, "the closed view forgotten")
         d.focus()
         d.calibrate()  # click in the view first, as a user does (FreeCAD 1.0 gives the keys to the tree)

@@ -27,7 +27,16 @@ class ThicknessPanel:
         self.form.thickness.setProperty("rawValue", value)
 
     def open(self) -> None:
-        """Shown: the value is selected, so typing replaces it (as in FreeCAD's own dialogs)."""
+        """Shown: the value is selected, so typing replaces it (as in FreeCAD's own dialogs). Again
+        once the event that opened the panel is done: FreeCAD 1.1's model tree takes the keyboard
+        back after the double-click that opens the panel to edit a Thickness (ctrl+a then selected
+        the tree's items, and the typed value went nowhere)."""
+        from pivy import coin
+        self._select_value()
+        self._again = coin.SoOneShotSensor(lambda *_: self._select_value(), None)
+        self._again.schedule()
+
+    def _select_value(self) -> None:
         self.form.thickness.setFocus()
         self.form.thickness.selectAll()
 

@@ -10,12 +10,15 @@ object: no Qt module is imported.
 from __future__ import annotations
 
 
-def give_keyboard_to_view_under_pointer() -> None:
-    """Focus to the widget under the pointer (a 3D view's: called from its mouse moves)."""
+def give_keyboard_to_view(view) -> None:
+    """Focus to the widget of ``view``, a 3D view the pointer moves over (called from its mouse
+    moves). The view's own widget, not the widget under the pointer: FreeCAD 1.1 lays its Tasks panel
+    over the 3D view (an overlay that lets the mouse through to the view), and the widget under the
+    pointer there is the panel, which took the keys meant for the view."""
     import FreeCADGui as Gui
     main = Gui.getMainWindow()
     if main is None or not main.isActiveWindow() or Gui.Control.activeDialog():
         return
-    widget = main.childAt(main.mapFromGlobal(main.cursor().pos()))
+    widget = view.graphicsView()
     if widget is not None and not widget.hasFocus():
         widget.setFocus()

@@ -46,12 +46,22 @@ HELLO = ("HapticSculpt: click in the 3D view, then P / N / C toggle point, norma
          "mouse, M shows the material map; Start/stop sculpting grabs with the left button\n")
 
 
+#: The Python object of every 3D viewer the workbench reached (``view.getViewer()``), kept for the
+#: session (one small object a view): FreeCAD 1.1 on Python 3.14 releases a viewer's Python object
+#: in the viewer's destructor without holding the interpreter, and crashed there (SIGSEGV in
+#: _Py_Dealloc) whenever that release was the last one, that is as soon as a view whose viewer had
+#: been asked for from Python was closed (FreeCAD issue 27562, pull request 28920). Held here, the
+#: release in the destructor is never the last.
+_KEPT_VIEWERS: list[Any] = []
+
+
 class ViewInput:
     """The workbench's event callbacks in one 3D view; each handler knows its view."""
 
     def __init__(self, ctl: "Controller", view: Any) -> None:
         from pivy import coin
         self.view = view
+        _KEPT_VIEWERS.append(view.getViewer())  # (first: see _KEPT_VIEWERS)
         self._callbacks = FrontCallbacks(view, [(event, (lambda h: lambda cb: h(view, cb))(handler))
                                                 for event, handler in ((coin.SoLocation2Event, ctl.on_move),
                                                                        (coin.SoKeyboardEvent, ctl.on_key),
@@ -220,8 +230,8 @@ class Controller:
         return np.array([p.x, p.y, p.z], float)
 
     def on_move(self, view: Any, cb: Any) -> None:
-        from .view_focus import give_keyboard_to_view_under_pointer
-        give_keyboard_to_view_under_pointer()  # (keys and ctrl+z reach it, whoever had them last)
+        from .view_focus import give_keyboard_to_view
+        give_keyboard_to_view(view)  # (keys and ctrl+z reach it, whoever had them last)
         pos = cb.getEvent().getPosition()
         if any(ov.panel_drag(float(pos[0])) for ov in self.overlays.values()):
             cb.setHandled()  # a slider drag: neither a stroke nor a rotation

@@ -97,14 +97,17 @@ def _tree_items():
     tree, out = next((t for t in _TREE if t.isVisible()), None), {}
     if tree is None:
         return out
-    items = [tree.topLevelItem(k) for k in range(tree.topLevelItemCount())]
-    while items:
-        item = items.pop()
-        items.extend(item.child(k) for k in range(item.childCount()))
-        rect = tree.visualItemRect(item)
+    # (walked through the model's indices, plain values: PySide6 wrappers of the items themselves, as
+    # FreeCAD 1.1's tree rebuilds them, were found already deleted while walked)
+    model = tree.model()
+    indices = [model.index(k, 0) for k in range(model.rowCount())]
+    while indices:
+        index = indices.pop()
+        indices.extend(model.index(k, 0, index) for k in range(model.rowCount(index)))
+        rect = tree.visualRect(index)
         if rect.height() > 0:
             p, scale = tree.viewport().mapToGlobal(rect.center()), tree.devicePixelRatioF()
-            out[item.text(0)] = [round(p.x() * scale), round(p.y() * scale)]
+            out[model.data(index)] = [round(p.x() * scale), round(p.y() * scale)]
     return out
 
 
@@ -264,6 +267,28 @@ def _widget_rect(class_name):
     return None
 
 
+def _panels_and_questions():
+    """Two things found in one walk of the main window's widgets: [x, y, width, height] on the screen
+    of each shown panel FreeCAD lays over the 3D view (FreeCAD 1.1's Tasks panel on the view's right:
+    a wheel turned over it does not reach the view, FreeCAD issue 21141; none before 1.0), and the
+    buttons of a question FreeCAD shows (a QMessageBox: "Save all changes...?") by text, at their
+    centres in screen pixels."""
+    panels, buttons, stack = [], {}, [(Gui.getMainWindow(), False)]
+    while stack:
+        w, in_box = stack.pop()
+        name = w.metaObject().className()
+        if name == "Gui::OverlayTabWidget":
+            if w.isVisible():
+                panels.append(_rect(w))
+            continue
+        in_box = in_box or (w.inherits("QMessageBox") and w.isVisible())
+        if in_box and w.inherits("QPushButton") and w.isVisible() and w.text():
+            centre, ratio = w.mapToGlobal(w.rect().center()), w.devicePixelRatioF()
+            buttons[w.text().replace("&", "")] = [round(centre.x() * ratio), round(centre.y() * ratio)]
+        stack.extend((c, in_box) for c in w.children() if c.isWidgetType())
+    return panels, buttons
+
+
 def _focus():
     """The class of the widget that has the main window's keyboard focus."""
     w = Gui.getMainWindow().focusWidget()
@@ -278,6 +303,7 @@ def write(*_):
              "task_buttons": _task_buttons(), "toolbars": _toolbars(), "console": _widget_rect("Gui::PythonConsole"),
              "focus": _focus(), "selection": [[o.ObjectName, list(o.SubElementNames)]
                                               for o in Gui.Selection.getSelectionEx()]}
+    state["overlay_panels"], state["message_buttons"] = _panels_and_questions()
     for name, doc in FreeCAD.listDocuments().items():
         state["docs"][name] = {"undo": list(doc.UndoNames), "redo": list(doc.RedoNames), "file": doc.FileName,
                                "modified": bool(getattr(doc, "isTouched", lambda: False)()),
