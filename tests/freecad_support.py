@@ -88,7 +88,7 @@ def run_freecadcmd(script: str, tmp: str, timeout: float = 300) -> dict:
 
 
 #: The first X display number xvfb-run tries (it takes the next free one): a Debian root started
-#: from the host shares the host's abstract X sockets, so it starts elsewhere (Makefile: test-other-debian).
+#: from the host shares the host's abstract X sockets, so it starts elsewhere (Makefile: test-other-debians).
 XVFB_FIRST = os.environ.get("HS_XVFB_FIRST", "99")
 #: The FreeCAD GUI can run here (under Xvfb); GUI tests skip otherwise (make deps installs both).
 GUI_AVAILABLE = shutil.which("xvfb-run") is not None and shutil.which("freecad") is not None

@@ -2,7 +2,7 @@
 point (as in many containers), a mount namespace cannot make its mounts private; the script then
 keeps the propagation as it is and takes its mounts down when the command ends. Where no mount
 namespace can be made at all it says so in one line and exits with 77, which make test reports and
-goes on. The chroot is the other Debian's cached root (make test-other-debian builds it)."""
+goes on. The chroot is the other Debian's cached root (make test-other-debians builds it)."""
 from __future__ import annotations
 
 import os
@@ -40,7 +40,7 @@ def _in_outer_chroot(root: str, script: str, scratch: str) -> subprocess.Complet
                           capture_output=True, text=True, timeout=120)
 
 
-@pytest.mark.skipif(not ROOTED or not SUITES, reason="needs root and a cached Debian root (make test-other-debian)")
+@pytest.mark.skipif(not ROOTED or not SUITES, reason="needs root and a cached Debian root (make test-other-debians)")
 def test_a_root_is_used_inside_a_chroot_whose_root_is_no_mount_point(tmp_path):
     root = os.path.join(CACHE, f"debian-{SUITES[0]}-root")
     r = _in_outer_chroot(root, """
