@@ -32,9 +32,7 @@ def test_the_session_takes_the_falcon_and_its_stroke_is_one_undo_step(tmp_path, 
     os.makedirs(SHOTS, exist_ok=True)
     d = Desktop(str(tmp_path), "Gesture")
     try:
-        d.xdo("key", "ctrl+n")
-        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
-        d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        d.new_patch()
         before = undo(d.state())[0]
         s = d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
         assert sculpt(s)["device"] == "falcon", "the session did not take the attached Falcon"

@@ -233,6 +233,12 @@ class Desktop:
         self.wait(lambda s: group not in s["toolbars"]["open"], f"the drop-down {group} to close", 10)
         return True
 
+    def new_patch(self) -> dict:
+        """ctrl+n (a new document, its view attached), then the New patch button; the state."""
+        self.xdo("key", "ctrl+n")
+        self.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
+        return self.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+
     def press_button(self, button: str, condition, what: str) -> dict:
         """Clicks a command's button (or drop-down entry) until ``condition`` holds (FreeCAD enables a
         command's button on its next update after the command becomes usable: a click before that
@@ -282,9 +288,7 @@ class Desktop:
 def patch_with_keyed_constraints(d: Desktop) -> tuple[dict, list[tuple[int, int]]]:
     """ctrl+n, New patch, then P, N and C with the mouse over three points of it. Returns the state
     and the screen pixels of the patch's centre, east, west, north and south points."""
-    d.xdo("key", "ctrl+n")  # a new document after the workbench was chosen
-    d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
-    s = d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+    s = d.new_patch()
     d.calibrate()
     points = [d.to_screen(p) for p in sculpt(s)["screen"]]
     _, east, west, north, _ = points
@@ -473,9 +477,7 @@ def test_the_hud_stays_inside_the_view_at_every_zoom_and_window_size(tmp_path, w
         name = d.xdo("search", "--name", "FreeCAD").split()[-1]
         d.xdo("windowsize", "--sync", name, str(window[0]), str(window[1]))
         d.xdo("mousemove", "500", "400")
-        d.xdo("key", "ctrl+n")
-        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view")
-        d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        d.new_patch()
         d.press_button("ShowCurvature", lambda s: s["overlays"] and "legend_v" in s["overlays"][0]["hud"], "the legend")
         d.press_button("Panel", lambda s: "slider5" in s["overlays"][0]["hud"], "the slider values")
         d.xdo("mousemove", str(window[0] // 2), str(window[1] // 2))
@@ -508,9 +510,7 @@ def test_save_quit_reopen_and_a_restarted_session_stays_still(tmp_path):
     d = Desktop(str(tmp_path), "CAD")
     try:
         d.xdo("mousemove", "640", "500")
-        d.xdo("key", "ctrl+n")
-        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view")
-        d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        d.new_patch()
         s = d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
         d.calibrate()
         centre, east, west, north, south = [d.to_screen(p) for p in sculpt(s)["screen"]]
@@ -659,9 +659,7 @@ def test_stop_right_after_a_stroke_on_an_elastic_patch_keeps_what_was_shown_in_t
     d = Desktop(str(tmp_path), "CAD")
     try:
         d.xdo("mousemove", "640", "500")
-        d.xdo("key", "ctrl+n")
-        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view")
-        d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        d.new_patch()
         d.press_button("Material", lambda s: undo(s)[0] == "Material: elastic", "Material: elastic")
         d.press_button("Zebra", lambda s: any(o["display"] == "zebra" for o in s["overlays"]), "the zebra stripes")
         s = d.press_button("Session", lambda s: sculpt(s)["session"], "the session")

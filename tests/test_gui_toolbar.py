@@ -40,9 +40,7 @@ def _opened(d: Desktop, menu: str) -> dict[str, list[int]]:
 def test_every_command_reachable_and_every_icon_distinct(tmp_path):
     d = Desktop(str(tmp_path), "CAD", screen=f"{WIDTH}x{HEIGHT}")
     try:
-        d.xdo("key", "ctrl+n")
-        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
-        s = d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        s = d.new_patch()
         d.calibrate()
         centre = d.to_screen(sculpt(s)["screen"][0])
         d.xdo("mousemove", str(centre[0]), str(centre[1]), "click", "1")  # (selected: Output's commands run)
