@@ -33,8 +33,8 @@ def exportable(selection: list[Any], doc: Any) -> list[Any]:
 
     results = [o for o in doc.Objects
                if getattr(o, "Visibility", False) and hasattr(o, "Shape") and not o.Shape.isNull()
-               and (sculpted(o) or any(sculpted(x) for x in o.OutListRecursive))
-               and not any(hasattr(user, "Shape") for user in o.InList)]
+               and not any(hasattr(user, "Shape") for user in o.InList)  # (cheap first: IsActive runs often)
+               and (sculpted(o) or any(sculpted(x) for x in o.OutListRecursive))]
     if len(results) == 1:
         return results
     found = [o for o in doc.Objects if is_sculpted_solid(o) or (is_sculpt(o) and solid_of(o) is None)]
