@@ -157,6 +157,24 @@ def _pixel(v):
     return _pixels[id(v)][0]
 
 
+_renders = {}  # id(view) -> [the number of times Coin drew its scene, the callback node counting them]
+
+
+def _rendered(v):
+    """How many times the view's scene has been drawn (a GL render traversal of its root): a picture
+    taken after this grew shows what the scene graph held before it did, whatever Qt's paint timing."""
+    if id(v) not in _renders:
+        counter = [0, coin.SoCallback()]
+
+        def count(_, action, counter=counter):
+            if action.isOfType(coin.SoGLRenderAction.getClassTypeId()):
+                counter[0] += 1
+        counter[1].setCallback(count)
+        v.getSceneGraph().insertChild(counter[1], 0)
+        _renders[id(v)] = counter
+    return _renders[id(v)][0]
+
+
 def _views():
     out = []
     for name in FreeCAD.listDocuments():
@@ -164,7 +182,7 @@ def _views():
         for v in gdoc.mdiViewsOfType("Gui::View3DInventor") if gdoc else []:
             try:
                 out.append({"doc": name, "size": list(v.getSize()), "cursor": list(v.getCursorPos()),
-                            "pixel": _pixel(v),
+                            "pixel": _pixel(v), "renders": _rendered(v),
                             "camera": v.getCamera(),
                             "active": v is getattr(Gui.ActiveDocument, "ActiveView", None), "id": id(v),
                             "redirect": bool(v.getViewer().isRedirectedToSceneGraph())})
