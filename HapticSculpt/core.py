@@ -74,6 +74,8 @@ MagnetTool = native.MagnetTool
 OrientationTool = native.OrientationTool
 SmoothTool = native.SmoothTool
 MAX_DEGREE: int = native.MAX_DEGREE
+#: How much harder the rope pulls per unit of the bending ratio where it is tied (RopeTool.gain).
+ROPE_PLATE_GAIN: float = native.ROPE_PLATE_GAIN
 
 # The names of the core's choices, from its one table of each (native_core/src/names.hpp).
 INTEGRATORS: tuple[str, ...] = native.INTEGRATORS
@@ -91,5 +93,5 @@ def patch(controls: tuple[int, int] = (8, 8), degree: tuple[int, int] = (3, 3),
 
 
 __all__ = ["BSplineSurface", "DynamicSurface", "MaterialMap", "StepReport", "Tool", "RopeTool", "MagnetTool",
-           "OrientationTool", "SmoothTool", "MAX_DEGREE", "INTEGRATORS", "TOOLS", "CONSTRAINTS", "FALLOFFS",
+           "OrientationTool", "SmoothTool", "MAX_DEGREE", "ROPE_PLATE_GAIN", "INTEGRATORS", "TOOLS", "CONSTRAINTS", "FALLOFFS",
            "LAWS", "patch"]

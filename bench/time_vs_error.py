@@ -342,6 +342,7 @@ def fairness_table(out_dir: str, repeats: int = 3) -> None:
         before = sum(r[key] for r in rows if r["bending"] == 0)
         after = sum(r[key] for r in rows if r["bending"] != 0)
         print(f"  {'all four':<16}{before:9.1f} -> {after:9.1f}  ({100 * (after / before - 1):+.0f} %)")
+    reach = reach_table(fs)
     timing = []
     print(f"\nper-step wall time (us), dt 1 ms, median of {repeats} pulls (held 1 s), today -> new; "
           "lead = the scheme's time / the default's")
@@ -367,8 +368,33 @@ def fairness_table(out_dir: str, repeats: int = 3) -> None:
               f"{np.median([b for _, b in leads]):.2f}x new")
     with open(os.path.join(out_dir, "fairness.json"), "w") as f:
         json.dump({"default_bending": default, "measure": "exact normal curvature (core B-spline derivatives)",
-                   "scenes": rows, "step_seconds": timing}, f, indent=1)
+                   "scenes": rows, "reach": reach, "step_seconds": timing}, f, indent=1)
     plot_fairness(profiles, default, os.path.join(out_dir, "fairness.png"))
+
+
+def reach_table(fs) -> list[dict]:
+    """How far a drag takes the sheet (fairness_scene.reach: the cursor 20 mm up over 0.5 s, held
+    1 s, let go, 1 s): springs alone, the plate with the rope as it pulled before its plate gain,
+    and the plate now (the rope 1 + ROPE_PLATE_GAIN x bending harder where it is tied); clamped
+    (New clamped patch, G1), G0 edges and held corners. The default's sign changes (worst
+    section) after the drag."""
+    from HapticSculpt.app import fairness
+    print("\nreach: a 20 mm drag over 0.5 s, held 1 s (lift held / lift kept 1 s after letting go, mm)")
+    print(f"{'scene':<18}{'springs':>14}{'plate, rope before':>20}{'plate now':>14}{'now/springs':>13}{'worst signs':>13}")
+    rows = []
+    for material in ("clay", "elastic"):
+        for edges in ("G1", "G0", "corners"):
+            springs = fs.reach(fs.build_held(material, edges, bending=0.0))
+            before = fs.reach(fs.build_held(material, edges, rope_as_before=True))
+            s = fs.build_held(material, edges)
+            now = fs.reach(s)
+            worst = max(c for c, _ in fs.measure(s, edges == "corners").per_section)
+            rows.append({"material": material, "edges": edges, "springs": springs, "rope_before": before,
+                         "now": now, "worst_section_sign_changes": worst})
+            print(f"{material + ' ' + edges:<18}{springs['held']:>7.1f}/{springs['kept']:<6.1f}"
+                  f"{before['held']:>12.1f}/{before['kept']:<7.1f}{now['held']:>7.1f}/{now['kept']:<6.1f}"
+                  f"{now['held'] / springs['held']:>13.2f}{worst:>13}")
+    return rows
 
 
 def plot_fairness(profiles: dict, default: float, path: str) -> None:

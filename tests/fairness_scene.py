@@ -60,6 +60,45 @@ def pull(s: core.DynamicSurface, lift: float = LIFT, hold: float = HOLD, max_tim
             "step_seconds": wall / steps}
 
 
+#: The reach scenes: a mouse drag that raises the rope REACH mm over 0.5 s above the centre, held 1 s.
+REACH = 20.0
+
+
+def build_held(material: str, edges: str, bending: float = api.FAIR_BENDING, rope_as_before: bool = False
+               ) -> core.DynamicSurface:
+    """The patch with ``edges`` held ("free", "corners", or a boundary as make_sculpt takes it:
+    "G1" is New clamped patch); ``rope_as_before``: the rope's settings divided by its plate gain,
+    so it pulls as it did before the gain (the same forces, for comparison)."""
+    s = build(material, edges == "corners", bending)
+    if edges not in ("free", "corners"):
+        s.hold_poles(api.boundary_poles(tuple(s.controls), edges), s.linked_poles)
+    if rope_as_before:
+        gain = 1 + core.ROPE_PLATE_GAIN * bending
+        s.tool.stiffness, s.tool.stiff_stiffness = s.tool.stiffness / gain, s.tool.stiff_stiffness / gain
+        s.tool.max_force /= gain
+    return s
+
+
+def reach(s: core.DynamicSurface, pull_mm: float = REACH, rise: float = 0.5, hold: float = 1.0,
+          after: float = 1.0) -> dict:
+    """How far a drag takes the surface: the cursor rises ``pull_mm`` above the centre over
+    ``rise`` s and stays ``hold`` s (the lift then), the rope lets go and the sheet settles
+    ``after`` s (the lift kept)."""
+    z0 = float(s.mesh[CENTRE][2])
+    cursor = np.array(s.mesh[CENTRE], dtype=float)
+    steps = round((rise + hold) / DT)
+    for k in range(steps):
+        cursor[2] = z0 + pull_mm * min(1.0, (k + 1) * DT / rise)
+        s.set_cursor(list(cursor), grab=True)
+        s.step(DT)
+    held = float(s.mesh[CENTRE][2]) - z0
+    gain = s.tool.gain
+    s.set_cursor(list(cursor), grab=False)
+    for _ in range(round(after / DT)):
+        s.step(DT)
+    return {"held": held, "kept": float(s.mesh[CENTRE][2]) - z0, "gain": gain}
+
+
 def sections(s: core.DynamicSurface, pinned: bool) -> list[fairness.Section]:
     """The six central sections through and beside the pulled point (two mesh lines apart), and
     with held corners the two diagonals, where a crease to a corner would run."""

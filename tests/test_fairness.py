@@ -61,6 +61,83 @@ def test_without_bending_the_pinned_sheet_creases_toward_its_corners(strokes):
         assert max(c for c, _ in before.per_section[6:]) > 2, before.per_section
 
 
+@pytest.mark.parametrize("material", ["clay", "elastic"])
+@pytest.mark.parametrize("edges", ["G1", "corners"])
+def test_the_rope_reaches_as_far_on_the_plate_as_on_springs_alone(material, edges):
+    """A drag of 20 mm on a clamped sheet (New clamped patch) or one with held corners: the plate
+    resists a point load far more than the springs (the rope as it was: about half the lift), so
+    the rope pulls 1 + ROPE_PLATE_GAIN x the bending ratio harder where it is tied; the sheet then
+    goes about as far as springs alone took it, and the bump stays fair."""
+    springs = fairness_scene.reach(fairness_scene.build_held(material, edges, bending=0.0))
+    before = fairness_scene.reach(fairness_scene.build_held(material, edges, rope_as_before=True))
+    s = fairness_scene.build_held(material, edges)
+    now = fairness_scene.reach(s)
+    assert now["gain"] == pytest.approx(1 + core.ROPE_PLATE_GAIN * api.FAIR_BENDING)
+    assert springs["gain"] == 1.0
+    assert now["held"] >= 0.85 * springs["held"], (springs, before, now)
+    if edges == "G1":  # (held corners alone: the whole sheet lifts, plate or not)
+        assert now["held"] >= 1.4 * before["held"], (springs, before, now)
+    if material == "clay":
+        assert now["kept"] >= 0.8 * springs["kept"], (springs, now)
+        for changes, _ in measure(s, edges == "corners").per_section:
+            assert changes <= 2
+
+
+@pytest.mark.parametrize("integrator", ["local_global", "implicit", "explicit"])
+def test_the_stiffer_rope_holds_an_elastic_plate_still_in_every_integrator(integrator):
+    """An elastic sheet held at its corners, its centre held 20 mm up by the rope for 6 s: the rope
+    on the plate is 4x stiffer (slope 800), and the default solver took it explicitly and rang
+    the sheet up (the lift swung 17..28 mm and grew, kinetic energy 7e4); taken implicitly at its
+    anchor it holds still, as the other integrators do."""
+    s = fairness_scene.build_held("elastic", "corners")
+    s.integrator = integrator
+    report = pull(s, hold=6.0)
+    assert abs(report["lift"] - 20.0) < 0.5, report
+    assert report["kinetic_energy"] < 1.0, report
+
+
+def test_the_stiffer_rope_holds_a_mirrored_elastic_plate_still():
+    """Mirrored, the rope pulls its anchor and the anchor's mirror image: both join the default
+    solver's solve (kinetic energy 900 and growing after 6 s while the image stayed explicit)."""
+    s = fairness_scene.build_held("elastic", "corners")
+    s.set_symmetry(0, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0])
+    at = (12, 20)  # off the mirror plane
+    z0 = float(s.mesh[at][2])
+    cursor = np.array(s.mesh[at], dtype=float)
+    while float(s.mesh[at][2]) - z0 < 20.0:
+        cursor[2] += 0.01
+        s.set_cursor(list(cursor), grab=True)
+        s.step(1e-3)
+    lifts = []
+    for _ in range(6000):
+        s.set_cursor(list(cursor), grab=True)
+        s.step(1e-3)
+        lifts.append(float(s.mesh[at][2]) - z0)
+    assert max(abs(x - 20.0) for x in lifts[-2000:]) < 0.5
+    assert s.kinetic_energy() < 1.0
+    mesh = np.array(s.mesh)
+    assert np.allclose(mesh[39 - at[0], at[1], 2], mesh[at][2])  # (the image lifted the same)
+
+
+def test_the_rope_gain_follows_the_painted_bending_map():
+    """Tied where the bending map is 0 the rope pulls as set, where it is the default 4x harder.
+    (The haptic estimate renders the same stiffer law: native_core/tests/test_runtime.cpp.)"""
+    s = build("clay", False)
+    values = np.full((8, 8), api.FAIR_BENDING)
+    values[:4] = 0.0  # (u < 0.5: springs alone)
+    s.bending_map.set_values(values)
+    corner = np.array(s.mesh[2, 2], dtype=float)
+    s.set_cursor(list(corner + [0, 0, 5.0]), grab=True)
+    s.step(1e-3)
+    assert s.tool.gain == 1.0
+    s.set_cursor(list(corner + [0, 0, 5.0]), grab=False)
+    s.step(1e-3)
+    far = np.array(s.mesh[37, 37], dtype=float)
+    s.set_cursor(list(far + [0, 0, 5.0]), grab=True)
+    s.step(1e-3)
+    assert s.tool.gain == pytest.approx(1 + core.ROPE_PLATE_GAIN * api.FAIR_BENDING)
+
+
 def test_the_measure_takes_exact_derivatives():
     """On a paraboloid z = c (x^2 + y^2) (exact on cubic poles) the measured normal curvature along
     a line of u is the closed form f_xx / (sqrt(1 + |grad f|^2) (1 + f_x^2)) to rounding: no

@@ -32,9 +32,12 @@ void bindTools(py::module_& m) {
         .def_property_readonly("anchor", &Tool::anchor, "Mesh index the tool holds, -1 if none");
     parameters(tool, kToolLimitParameters);
 
+    m.attr("ROPE_PLATE_GAIN") = kRopePlateGain;
     py::class_<RopeTool, Tool> rope(m, "RopeTool");
     parameters(rope, kRopeParameters);
-    rope.def_property_readonly("rest_length", &RopeTool::restLength);
+    rope.def_property_readonly("rest_length", &RopeTool::restLength)
+        .def_property_readonly("gain", &RopeTool::gain,
+                               "its pull over its settings where it is tied: 1 + ROPE_PLATE_GAIN x the bending ratio there");
 
     py::class_<MagnetTool, Tool> magnet(m, "MagnetTool");
     parameters(magnet, kMagnetParameters);

@@ -12,7 +12,7 @@ DynamicSurface::DynamicSurface(BSplineSurface surface, int g, int h)
     const Eigen::Index S = static_cast<Eigen::Index>(g) * h, N = surface_.poles().rows();
     for (Points* m : {&d_, &dd_, &fext_, &ftool_, &force_, &meshTmp_, &meshTmp2_, &base_, &dPrev_, &av_, &history_.d, &history_.av, &history_.dHat, &yMesh_})
         m->setZero(S, 3);
-    for (Points* m : {&v_, &fp_, &explicit_.p0, &explicit_.v0, &explicit_.a0, &backup_.p, &backup_.v, &acc_, &cg_.r, &cg_.z, &cg_.p, &cg_.q, &x_, &history_.p, &history_.v, &history_.xHat, &verlet_.a})
+    for (Points* m : {&v_, &fp_, &explicit_.p0, &explicit_.v0, &explicit_.a0, &backup_.p, &backup_.v, &acc_, &cg_.r, &cg_.z, &cg_.p, &cg_.q, &x_, &implicitTool_.z[0], &implicitTool_.z[1], &history_.p, &history_.v, &history_.xHat, &verlet_.a})
         m->setZero(N, 3);
     m_.setZero(S);
     gamma_.setZero(S);
@@ -253,6 +253,7 @@ void DynamicSurface::ensureSystem(double dt, bool factor) {
         }
     }
     slot.factored = factor;
+    slot.built = ++systemBuilds_;
     slot.dt = dt;
     for (int i = 0; i < 5; ++i) slot.key[i] = key[i];
 }

@@ -280,7 +280,7 @@ private:
     /// of the step's end; with `fixedTargets`, point constraints count too: the history's start).
     double predictorWeight(double dt, bool fixedTargets) const;
     void checkSleep(double dt);
-    MeshView meshView() const { return {d_, g(), h(), spacingU_, spacingV_}; }
+    MeshView meshView() const { return {d_, g(), h(), spacingU_, spacingV_, &bendingMap_}; }
     /// What the factored systems' structure depends on: the constraints' and the held poles'
     /// (both versions only grow, so the sum changes whenever either does).
     std::uint64_t structureKey() const { return constraints_.structureVersion() + held_.version(); }
@@ -329,11 +329,24 @@ private:
         std::uint64_t key[5] = {~0ull, ~0ull, ~0ull, ~0ull, ~0ull};
         double dt = -1;
         bool factored = false;
-        std::uint64_t used = 0;
+        std::uint64_t used = 0, built = 0;
     };
     std::array<SystemSlot, 2> systems_;
     std::size_t system_ = 0;  // the slot in use
-    std::uint64_t systemUses_ = 0;
+    std::uint64_t systemUses_ = 0, systemBuilds_ = 0;
+    // A one-point tool taken implicitly in the local/global step: its anchor and, mirrored, the
+    // anchor's partner (Woodbury on S + c sum_k a_k a_k^T, a_k = A^T e_anchor_k), with z_k =
+    // S^-1 a_k and gram(k, l) = a_k^T z_l for the system they were solved for.
+    struct ImplicitTool {
+        int anchors[2] = {-1, -1};
+        int count = 0;
+        Points z[2];
+        Eigen::Matrix2d gram = Eigen::Matrix2d::Zero();
+        std::uint64_t system = 0;
+        Vec3 at[2] = {Vec3::Zero(), Vec3::Zero()};  // where the force on each was taken this step
+    };
+    ImplicitTool implicitTool_;
+    void ensureImplicitTool(int anchor);
     // Measures of the material and the initial shape; the clock.
     double minMass_ = 0, maxStiffness_ = 0, maxDampingRate_ = 0, size_ = 1, spacingU_ = 1, spacingV_ = 1;
     double time_ = 0, work_ = 0;

@@ -26,7 +26,35 @@ double extrapolationWeight(double rho) {
     const double w = rho <= 1 ? 1.0 : 1.0 / (rho * rho);
     return w >= 0.1 ? w : 0.0;
 }
+/// Row i of M x (M: mesh x poles, x: poles x 3).
+Vec3 meshRow(const CsrMatrix& m, int i, const Points& x) {
+    Vec3 out = Vec3::Zero();
+    for (int k = m.rowStart[i]; k < m.rowStart[i + 1]; ++k) out += m.value[k] * x.row(m.col[k]).transpose();
+    return out;
+}
 }  // namespace
+
+void DynamicSurface::ensureImplicitTool(int anchor) {
+    ImplicitTool& t = implicitTool_;
+    const SystemSlot& slot = systems_[system_];
+    const int partner = mirror_.empty() ? anchor : mirror_.mirrorPoint(anchor);
+    if (anchor == t.anchors[0] && partner == t.anchors[1] && slot.built == t.system) return;
+    t.anchors[0] = anchor;
+    t.anchors[1] = partner;
+    t.count = partner != anchor ? 2 : 1;
+    t.system = slot.built;
+    for (int k = 0; k < t.count; ++k) {  // z_k = S^-1 A^T e_anchor_k (the same in x, y, z: column 0)
+        meshTmp2_.setZero();
+        meshTmp2_.row(t.anchors[k]).setOnes();
+        A_.applyTransposed(meshTmp2_, fp_);
+        held_.reduce(fp_);
+        slot.solver.solve(fp_, t.z[k]);
+        held_.expand(t.z[k]);
+    }
+    t.gram.setZero();
+    for (int k = 0; k < t.count; ++k)
+        for (int l = 0; l < t.count; ++l) t.gram(k, l) = meshRow(A_.matrix(), t.anchors[k], t.z[l])[0];
+}
 
 double DynamicSurface::predictorWeight(double dt, bool fixedTargets) const {
     // The prediction d_n + dt A v_n + dt^2/2 A a_n (a_n from the BDF2 history) is O(dt^3) off the
@@ -96,6 +124,22 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     } else {
         applyToolForces(dt, r, d_);
     }
+    // A one-point tool (the rope) is stiff, and on a plate it pulls harder still (kRopePlateGain):
+    // taken explicitly it rang the sheet's slow modes up (an elastic sheet held at its corners, a
+    // rope of slope 800: the lift swung 17..28 mm over 4 s and grew; mirrored, kinetic energy 900
+    // after 6 s). Its linearisation where it was taken joins the solve, on its anchor and the
+    // anchor's mirror image: S + c sum a_k a_k^T with c = h^2 slope, by Woodbury on one more solve
+    // per anchor and grab.
+    const int anchor = tool_->grabbed() ? tool_->anchor() : -1;
+    const double toolC = anchor >= 0 ? h * h * tool_->anchorSlope() : 0.0;
+    ImplicitTool& implicit = implicitTool_;
+    Eigen::Matrix2d capacitance = Eigen::Matrix2d::Identity();
+    if (toolC > 0) {
+        ensureImplicitTool(anchor);
+        implicit.at[0] = (wt > 0 ? meshTmp_ : d_).row(anchor).transpose();
+        implicit.at[1] = mirror_.empty() ? implicit.at[0] : mirror_.reflectPoint(implicit.at[0]);
+        capacitance = (Eigen::Matrix2d::Identity() + toolC * implicit.gram).inverse();
+    }
     // The parts of the right-hand side that do not depend on the iterate (see the loop).
     base_ = (h * gamma_).asDiagonal() * (*dBase - yMesh_);
     if (hasExternal_) base_ += (h * h) * fext_;
@@ -134,10 +178,21 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
         springs_.addProjections(*iterate, meshTmp2_, 0.25 * minMass_ / (h * h), h * h);
         bending_.addForces(*iterate, meshTmp2_, h * h);  // quadratic: its force is J t - L d's part
         if (!constraints_.empty()) constraints_.addProjections(*iterate, meshTmp2_, terms_, h * h);
+        if (toolC > 0)
+            for (int k = 0; k < implicit.count; ++k)
+                meshTmp2_.row(implicit.anchors[k]) -= toolC * (iterate->row(implicit.anchors[k]) - implicit.at[k].transpose());
         A_.applyTransposed(meshTmp2_, fp_);
         held_.reduce(fp_);
         systems_[system_].solver.solve(fp_, acc_);
         held_.expand(acc_);
+        if (toolC > 0) {  // acc -= Z (I + c G)^-1 c A_anchors acc, per coordinate
+            const Vec3 moved0 = meshRow(A_.matrix(), implicit.anchors[0], acc_);
+            const Vec3 moved1 = implicit.count == 2 ? meshRow(A_.matrix(), implicit.anchors[1], acc_) : Vec3::Zero();
+            for (int c = 0; c < 3; ++c) {
+                const Eigen::Vector2d weights = capacitance * (toolC * Eigen::Vector2d(moved0[c], moved1[c]));
+                for (int k = 0; k < implicit.count; ++k) acc_.col(c) -= weights[k] * implicit.z[k].col(0);
+            }
+        }
         change = acc_.cwiseAbs().maxCoeff();
         x_ += acc_;
         ++r.iterations;
@@ -155,6 +210,20 @@ StepReport DynamicSurface::stepLocalGlobal(double dt) {
     }
     surface_.mutablePoles() = x_;
     A_.apply(surface_.poles(), d_);
+    if (toolC > 0) {
+        // What the surface received is the linearised force at the step's end: the work the guard
+        // counts takes it, and the reaction stays the exact opposite of the tool's own (not its
+        // mirror image's) force.
+        for (int k = 0; k < implicit.count; ++k) {
+            const int a = implicit.anchors[k];
+            const Vec3 part = -(toolC / (h * h)) * (d_.row(a).transpose() - implicit.at[k]);
+            ftool_.row(a) += part.transpose();
+            if (k == 0) {
+                r.reaction.force -= part;
+                r.reaction.torque -= (implicit.at[0] - cursor_.position).cross(part);
+            }
+        }
+    }
     // A v up to rounding, since A is linear, without a product by A
     if (bdf2) av_ = (d_ - history_.dHat) / h;
     else av_ = (d_ - dPrev_) / dt;

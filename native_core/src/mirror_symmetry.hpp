@@ -27,6 +27,9 @@ public:
     void clear() { direction_ = -1; }
     /// The mirror partner of pole i (itself on the plane's row).
     int mirrorPole(int i) const { return mirror(i, nu_, nv_); }
+    /// The mirror partner of mesh point i, and the mirror image of a point.
+    int mirrorPoint(int i) const { return mirror(i, g_, h_); }
+    Vec3 reflectPoint(const Vec3& x) const { return reflect(x); }
     /// Throws std::invalid_argument naming "indices" unless the held set is symmetric.
     void requireSymmetric(const std::vector<int>& held) const;
     /// f_i += M f_mirror(i) on the mesh (M the reflection): the forces of a mirrored tool added.

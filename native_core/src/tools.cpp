@@ -1,5 +1,6 @@
 #include "tools.hpp"
 
+#include "material_map.hpp"
 #include "names.hpp"
 
 #include <cmath>
@@ -31,7 +32,8 @@ Reaction Tool::apply(const MeshView& mesh, const Cursor& cursor, double dt, Poin
     // Ramp in after the grab, then clamp the total; one scale for all points keeps the reaction exact.
     double scale = limits.rampTime > 0 ? std::min(1.0, forceTime_ / limits.rampTime) : 1.0;
     const double mag = total.norm() * scale;
-    if (mag > limits.maxForce) scale *= limits.maxForce / mag;
+    if (mag > gain_ * limits.maxForce) scale *= gain_ * limits.maxForce / mag;
+    appliedScale_ = scale;
     for (size_t i = 0; i < index_.size(); ++i) {
         const Vec3 fi = scale * force_[i];
         f.row(index_[i]) += fi.transpose();
@@ -43,7 +45,7 @@ Reaction Tool::apply(const MeshView& mesh, const Cursor& cursor, double dt, Poin
 
 void Tool::describe(const MeshView& mesh, const Reaction& last, HapticEstimate& e) const {
     e.toolTime = time_;
-    e.maxForce = limits.maxForce;
+    e.maxForce = gain_ * limits.maxForce;
     e.rampTime = limits.rampTime;
     e.points = 0;
     e.heldForce = last.force;
@@ -59,12 +61,12 @@ bool RopeTool::describeLaw(const MeshView& mesh, HapticEstimate& e) const {
     e.kind = EstimateKind::Rope;
     e.points = 1;
     e.x[0] = mesh.d.row(point_).transpose();
-    e.stiffness = stiffness;
-    e.stiffStiffness = stiffStiffness;
+    e.stiffness = gain_ * stiffness;
+    e.stiffStiffness = gain_ * stiffStiffness;
     e.threshold = threshold;
     e.length0 = length0_;
     e.reelTime = reelTime;
-    e.slope = std::max(stiffness, stiffStiffness);
+    e.slope = slope();
     return true;
 }
 
@@ -103,6 +105,9 @@ bool OrientationTool::describeLaw(const MeshView& mesh, HapticEstimate& e) const
 void RopeTool::grab(const MeshView& mesh, const Cursor& cursor) {
     point_ = nearestPoint(mesh.d, cursor.position);
     length0_ = (mesh.d.row(point_).transpose() - cursor.position).norm();
+    const double u = mesh.g > 1 ? double(point_ / mesh.h) / (mesh.g - 1) : 0.0;
+    const double v = mesh.h > 1 ? double(point_ % mesh.h) / (mesh.h - 1) : 0.0;
+    gain_ = 1.0 + (mesh.bending ? kRopePlateGain * mesh.bending->at(u, v) : 0.0);
     time_ = 0;
     grabbed_ = true;
 }
@@ -116,8 +121,11 @@ void RopeTool::computeForces(const MeshView& mesh, const Cursor& cursor) {
     const Vec3 toCursor = cursor.position - x;
     const double dist = toCursor.norm();
     const double ext = dist - restLengthAt(forceTime_);
+    slopeNow_ = 0;
     if (ext <= 0 || !(dist > 0)) return;  // a slack rope transmits nothing: it cannot push
-    const double tension = stiffness * std::min(ext, threshold) + stiffStiffness * std::max(0.0, ext - threshold);
+    slopeNow_ = gain_ * (ext < threshold ? stiffness : stiffStiffness);
+    const double tension =
+        gain_ * (stiffness * std::min(ext, threshold) + stiffStiffness * std::max(0.0, ext - threshold));
     emit(point_, tension / dist * toCursor);
 }
 

@@ -29,11 +29,20 @@ struct Reaction {
 };
 
 /// What a tool may read of the mesh.
+class MaterialMap;
+
 struct MeshView {
     const Points& d;
     int g, h;
     double spacingU, spacingV;  ///< mean rest distance between neighbours along u and v
+    const MaterialMap* bending = nullptr;  ///< the plate's map (a ratio to the springs), if any
 };
+
+/// How much stronger the rope pulls per unit of the plate's bending ratio where it is tied: a point
+/// load on a plate moves it far less than on springs alone (a 100 mm clamped patch pulled 20 mm:
+/// 7.6 mm with the default ratio 10 against 14.5 without); 1 + 0.3 x 10 = 4 gives back 90 % of the
+/// springs' reach with the plate's fair shape (bench/time_vs_error.py --fairness, lift per pull).
+inline constexpr double kRopePlateGain = 0.3;
 
 /// Settings shared by every tool: force ramp on grab and clamp.
 struct ToolLimits {
@@ -61,6 +70,9 @@ public:
     /// Steepest force per unit displacement on one mass point (infinite when unknown): how stiff
     /// the tool is as an explicit force, for the local/global step's prediction.
     virtual double slope() const { return std::numeric_limits<double>::infinity(); }
+    /// The force's slope on anchor() as last applied (0 when it pulled nothing): the local/global
+    /// step takes a one-point tool implicitly with it.
+    virtual double anchorSlope() const { return 0.0; }
     /// Fills the local model the haptic loop renders between steps (positions, law, parameters;
     /// velocities are left to the caller). The default holds the last reaction.
     void describe(const MeshView& mesh, const Reaction& last, HapticEstimate& e) const;
@@ -75,6 +87,8 @@ protected:
     virtual void computeForces(const MeshView& mesh, const Cursor& cursor) = 0;
     void emit(int index, const Vec3& force);
     bool grabbed_ = false;
+    double gain_ = 1;  ///< the tool's forces and clamp over its settings, on what it grabbed
+    double appliedScale_ = 0;  ///< the ramp and clamp's factor on the forces last applied
     double time_ = 0;  ///< seconds since grab
     double forceTime_ = 0;  ///< the clock the current forces are taken at (apply's phase)
 
@@ -94,8 +108,11 @@ public:
     void grab(const MeshView& mesh, const Cursor& cursor) override;
     void copySettings(const Tool& other) override;
     int anchor() const override { return grabbed_ ? point_ : -1; }
-    double slope() const override { return std::max(stiffness, stiffStiffness); }
+    double slope() const override { return gain_ * std::max(stiffness, stiffStiffness); }
     double restLength() const { return restLengthAt(time_); }
+    /// Its pull over its settings where it is tied: 1 + kRopePlateGain x the bending ratio there.
+    double gain() const { return gain_; }
+    double anchorSlope() const override { return appliedScale_ * slopeNow_; }
     double stiffness = 10.0;        ///< force per length while slack is below threshold
     double stiffStiffness = 200.0;  ///< past the threshold
     double threshold = 5.0;         ///< extension beyond rest where the rope turns stiff
@@ -107,6 +124,7 @@ protected:
 
 private:
     double restLengthAt(double t) const;
+    double slopeNow_ = 0;  ///< d tension / d extension at the last forces (0 slack)
     int point_ = -1;
     double length0_ = 0;
 };
