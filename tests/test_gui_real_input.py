@@ -394,6 +394,38 @@ def test_workbench_first_keys_stroke_undo_redo_paint(tmp_path, style):
 
 
 @pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_the_bending_map_is_painted_and_shown_like_the_other_maps(tmp_path):
+    """Paint bending (the Material drop-down) sprays the plate's map along a drag, one undo step;
+    the map shows in pseudo-colour while painting, and M toggles it (the slider: test_gui_panel_hud)."""
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        d.xdo("mousemove", "640", "500")
+        s = d.new_patch()
+        d.calibrate()
+        centre, east, west, north, south = [d.to_screen(p) for p in sculpt(s)["screen"]]
+        lo, hi, _ = sculpt(s)["bending_map"]
+        assert lo == hi == 10.0, "a new patch bends (api.FAIR_BENDING)"
+        d.press_button("PaintBending", lambda s: s["painting"] == "bending", "the bending airbrush")
+        d.wait(lambda s: any(o["display"] == "bending" for o in s["overlays"]), "the bending map shown")
+        before = undo(d.state())[0]
+        d.drag([west, ((west[0] + centre[0]) // 2, (west[1] + centre[1]) // 2), east], seconds=0.1)
+        s = d.wait(lambda s: undo(s)[0] == "Paint bending", f"one paint step (was {before})")
+        lo, hi, n = sculpt(s)["bending_map"]
+        assert n > 1 and lo == 10.0 and hi > 15.0, (lo, hi, n)  # (toward 3x its mean along the line)
+        assert undo(s)[1] == before
+        painted = d.shot("bending_painted")
+        d.press_button("PaintBending", lambda s: s["painting"] is None, "the airbrush off")
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.xdo("key", "m")
+        d.wait(lambda s: all(o["display"] == "shading" for o in s["overlays"]), "M: shading")
+        d.shot_changed("bending_shading", painted, "M (the map off)")
+        d.xdo("key", "m")
+        d.wait(lambda s: any(o["display"] == "bending" for o in s["overlays"]), "M again: the bending map")
+    finally:
+        d.close()
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
 def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
     """Every command and key echoes its scripting call (FreeCADGui.doCommand): FreeCAD's own macro
     recorder, started from its menu with real keys, records a session that freecadcmd replays, with

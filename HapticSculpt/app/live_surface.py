@@ -129,7 +129,7 @@ class LiveSurface:
         return self._shadow
 
     def map_values(self, name: str) -> np.ndarray:
-        """Material map ``name`` ("mass", "damping", "stiffness") as a (rows, cols) array, newest first
+        """Material map ``name`` ("mass", "damping", "stiffness", "bending") as a (rows, cols) array, newest first
         (a spray under way in a session included)."""
         if self._session is not None:
             sprayed = self._session.latest_map(name)

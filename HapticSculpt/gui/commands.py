@@ -20,10 +20,10 @@ GROUPS = {
                                ["HapticSculpt_ToolRope", "HapticSculpt_ToolMagnet", "HapticSculpt_MagnetFalloff",
                                 "HapticSculpt_ToolOrientation", "HapticSculpt_ToolSmooth"], 0),
     "HapticSculpt_MaterialGroup": ("Material", "The material: elastic or clay, keep the shape, fair it, airbrush "
-                                   "the mass, damping or stiffness map, the slider panel",
+                                   "the mass, damping, stiffness or bending map, the slider panel",
                                    ["HapticSculpt_Material", "HapticSculpt_KeepShape", "HapticSculpt_Fair",
-                                    "HapticSculpt_PaintMass",
-                                    "HapticSculpt_PaintDamping", "HapticSculpt_PaintStiffness", "HapticSculpt_Panel"],
+                                    "HapticSculpt_PaintMass", "HapticSculpt_PaintDamping",
+                                    "HapticSculpt_PaintStiffness", "HapticSculpt_PaintBending", "HapticSculpt_Panel"],
                                    0),
     "HapticSculpt_ConstraintGroup": ("Constraints and edges", "Hold the edges (free / G0 / G1), or toggle a point, "
                                      "normal or curvature constraint at the cursor",
@@ -403,9 +403,15 @@ class PaintStiffness(_Paint):
     tip = "Airbrush on the stiffness map: hold the left button (or the device's button during a session) and move over the surface"
 
 
+class PaintBending(_Paint):
+    which, icon_name, menu = "bending", "PaintBending", "Paint bending"
+    tip = ("Airbrush on the bending map (the plate's stiffness over the springs': higher is fairer and stiffer): "
+           "hold the left button (or the device's button during a session) and move over the surface")
+
+
 class ShowMap(_SculptCommand):
     icon_name, menu = "ShowMap", "Show map (M)"
-    tip = "Cycle the material map display in pseudo-colour: mass, damping, stiffness, off (key M toggles)"
+    tip = "Cycle the material map display in pseudo-colour: mass, damping, stiffness, bending, off (key M toggles)"
 
     def Activated(self) -> None:
         from .workbench import MAP_CYCLE
@@ -547,7 +553,8 @@ COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_NewClampedPatch": N
             "HapticSculpt_ToolSmooth": ToolSmooth, "HapticSculpt_PointConstraint": PointConstraint,
             "HapticSculpt_NormalConstraint": NormalConstraint, "HapticSculpt_CurvatureConstraint": CurvatureConstraint,
             "HapticSculpt_PaintMass": PaintMass, "HapticSculpt_PaintDamping": PaintDamping,
-            "HapticSculpt_PaintStiffness": PaintStiffness, "HapticSculpt_ShowMap": ShowMap,
+            "HapticSculpt_PaintStiffness": PaintStiffness, "HapticSculpt_PaintBending": PaintBending,
+            "HapticSculpt_ShowMap": ShowMap,
             "HapticSculpt_ShowCurvature": ShowCurvature, "HapticSculpt_Combs": Combs, "HapticSculpt_Zebra": Zebra,
             "HapticSculpt_ZebraMode": ZebraMode, "HapticSculpt_ZebraStripes": ZebraStripes,
             "HapticSculpt_ZebraDirection": ZebraDirection,

@@ -28,7 +28,8 @@ from . import stripes as stripe_shading
 from .hud import Hud
 from .panel import SLIDERS, SliderPanel
 
-DISPLAYS = ("shading", "mass", "damping", "stiffness", "curvature", "mean", "gauss", "zebra")
+MAPS = ("mass", "damping", "stiffness", "bending")
+DISPLAYS = ("shading", *MAPS, "curvature", "mean", "gauss", "zebra")
 JACK_COLOURS = {"point": (1.0, 0.0, 0.0), "tangent": (1.0, 0.5, 0.0), "normal": (0.0, 0.3, 1.0), "curvature": (1.0, 1.0, 1.0)}
 
 
@@ -312,7 +313,7 @@ class Overlay:
 
     def _colours(self, s: core.DynamicSurface, mesh: np.ndarray) -> tuple[np.ndarray, tuple[float, float]]:
         g, h = mesh.shape[:2]
-        if self.display in ("mass", "damping", "stiffness"):
+        if self.display in MAPS:
             return analysis.map_colours(self.obj.Proxy.live.map_values(self.display), (g, h))
         if self.display == "zebra":
             d = self.view.getViewDirection()

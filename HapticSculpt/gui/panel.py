@@ -1,4 +1,4 @@
-"""The paper's control panel: sliders for mass, damping, stiffness and the curvature targets, drawn
+"""The paper's control panel: sliders for mass, damping, stiffness, bending and the curvature targets, drawn
 in the screen-space HUD (:mod:`hud`, top-left corner) and operated with the mouse in view pixels.
 
 The HUD lays the tracks out (in a column, one under another, so they never overlap in any view) and
@@ -16,7 +16,11 @@ import numpy as np
 
 # name, label, low, high (log scale)
 SLIDERS = (("mass", "mass", 1e-2, 1e2), ("damping", "damping", 1e-2, 1e3), ("stiffness", "stiffness", 1e0, 1e5),
+           ("bending", "bending (plate/springs)", 1e-1, 1e3),
            ("curvature_u", "curvature u (1/mm)", 1e-4, 1e-1), ("curvature_v", "curvature v (1/mm)", 1e-4, 1e-1))
+MAPS = ("mass", "damping", "stiffness", "bending")
+#: Sliders whose left end is 0, not their low value: no plate at all is springs alone.
+ZERO_AT_LEFT = ("bending",)
 
 Box = tuple[float, float, float, float]  # x0, y0, x1, y1 in view pixels, origin bottom-left
 REACH = 8  # pixels beyond a track's ends that still take it (a knob at an end sticks out by half)
@@ -34,7 +38,7 @@ class SliderPanel:
     @staticmethod
     def value(obj: Any, name: str) -> float:
         live = obj.Proxy.live
-        if name in ("mass", "damping", "stiffness"):
+        if name in MAPS:
             return float(np.mean(live.map_values(name)))
         s = live.snapshot()
         curv = [c for c in s.constraints if c["kind"] == "curvature"]
@@ -47,7 +51,7 @@ class SliderPanel:
         """Sets slider ``name`` to ``value`` as one undo step through the scripting call (echoed to
         the Python console and a recorded macro); a running session takes it at once."""
         from .echo import ref, run_echoed
-        if name in ("mass", "damping", "stiffness"):
+        if name in MAPS:
             run_echoed(f"HapticSculpt.set_uniform({ref(obj)}, {name!r}, {float(value)!r})")
         elif [c for c in obj.Proxy.live.snapshot().constraints if c["kind"] == "curvature"]:
             run_echoed(f"HapticSculpt.set_curvature_target({ref(obj)}, {name[-1]}={float(value)!r})")
@@ -66,6 +70,8 @@ class SliderPanel:
     @staticmethod
     def from_fraction(name: str, f: float) -> float:
         _, _, low, high = next(s for s in SLIDERS if s[0] == name)
+        if f <= 0 and name in ZERO_AT_LEFT:
+            return 0.0
         return 10 ** (math.log10(low) + float(np.clip(f, 0, 1)) * (math.log10(high) - math.log10(low)))
 
     # --- the mouse, in view pixels ----------------------------------------------------------------

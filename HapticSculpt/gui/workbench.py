@@ -33,7 +33,7 @@ from .coin_events import FrontCallbacks
 from .echo import ref, run_echoed
 from .overlay import Overlay
 
-MAP_CYCLE = ("mass", "damping", "stiffness")
+MAP_CYCLE = ("mass", "damping", "stiffness", "bending")
 CURVATURE_CYCLE = ("curvature", "mean", "gauss")
 KEYS = {"p": "point", "n": "normal", "c": "curvature"}
 AIRBRUSH_FACTOR = 3.0  # a stroke moves the map toward this times its mean when the stroke began

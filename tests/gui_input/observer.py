@@ -30,6 +30,8 @@ def _sculpts(doc):
                     "plasticity": settings.get("plasticity"), "tool": settings.get("tool", {}).get("name"),
                     "stiffness_map": [min(o.StiffnessMap), max(o.StiffnessMap), len(o.StiffnessMap)],
                     "stiffness_values": list(o.StiffnessMap),
+                    "bending_map": [min(o.BendingMap), max(o.BendingMap), len(o.BendingMap)]
+                    if hasattr(o, "BendingMap") else [],
                     "session": o.Proxy.live.session is not None if getattr(o.Proxy, "live", None) else False,
                     "device": o.Proxy.live.session.device_name
                     if getattr(o.Proxy, "live", None) and o.Proxy.live.session else "",
