@@ -1,5 +1,6 @@
-"""Held edges (hs.hold_boundary): a sculpt's edges kept exactly (G0) or with their tangent planes
-(G1) through strokes, as hard constraints; undo, redo, save and reopen; clear errors."""
+"""Held edges (hs.hold_boundary): a sculpt's edges kept exactly (G0), with their tangent planes
+(G1), the curvature across them (G2) and its rate (G3) through strokes, as hard constraints; undo,
+redo, save and reopen; clear errors."""
 from __future__ import annotations
 
 import math
@@ -26,6 +27,26 @@ def edge_samples(face, n=100):
                    np.array([tuple(surface.normal(u, v)) for u, v in uvs])) for edge, uvs in lines.items()}
 
 
+def edge_derivatives(face, order, n=60):
+    """(edge, k) -> the derivatives of order k (every d^k/du^a dv^b, a + b = k) at n points along
+    each of the face's four edges, from the B-spline itself (getDN)."""
+    (u0, u1, v0, v1) = face.ParameterRange
+    lines = {"u0": [(u0, v0 + (v1 - v0) * k / (n - 1)) for k in range(n)],
+             "u1": [(u1, v0 + (v1 - v0) * k / (n - 1)) for k in range(n)],
+             "v0": [(u0 + (u1 - u0) * k / (n - 1), v0) for k in range(n)],
+             "v1": [(u0 + (u1 - u0) * k / (n - 1), v1) for k in range(n)]}
+    surface = face.Surface
+    out = {}
+    for edge, uvs in lines.items():
+        for k in range(order + 1):
+            if k == 0:
+                out[edge, 0] = np.array([tuple(surface.value(u, v)) for u, v in uvs])
+            else:
+                out[edge, k] = np.array([[tuple(surface.getDN(u, v, a, k - a)) for a in range(k + 1)]
+                                         for u, v in uvs])
+    return out
+
+
 def seams(before, after):
     """Per edge: the largest gap (mm) and normal angle (degrees) between two samplings."""
     out = {}
@@ -50,6 +71,42 @@ class TestHeldEdges(DocumentTestCase):
             self.assertLessEqual(angle, 0.01, edge)
         self.assertGreater(obj.Shape.Faces[0].Surface.value(0.5, 0.5).z - middle, 2.0)  # the inside moved
         self.assertEqual(hs.held_boundary(obj), {"u0": "G1", "u1": "G1", "v0": "G1", "v1": "G1"})
+
+    def test_g2_and_g3_keep_the_derivatives_across_the_edges_through_a_stroke(self):
+        """G2 keeps every derivative up to the second along the edges (so the curvature across
+        them: a neighbour meets the face as before, to second order), G3 up to the third."""
+        obj = hs.make_sculpt(self.doc, controls=(10, 10), mesh=(40, 40))
+        held = hs.hold_boundary(obj, "G2")
+        self.assertEqual(len(held), 100 - 16)  # three rings of a 10 x 10 net
+        self.assertEqual(hs.held_boundary(obj), {"u0": "G2", "u1": "G2", "v0": "G2", "v1": "G2"})
+        before = edge_derivatives(obj.Shape.Faces[0], 3)
+        middle = obj.Shape.Faces[0].Surface.value(0.5, 0.5).z
+        stroke(obj)
+        after = edge_derivatives(obj.Shape.Faces[0], 3)
+        self.assertGreater(obj.Shape.Faces[0].Surface.value(0.5, 0.5).z - middle, 2.0)  # the inside moved
+        third = 0.0
+        for (edge, order), values in before.items():
+            change = float(np.max(np.abs(after[edge, order] - values)))
+            if order <= 2:
+                self.assertLessEqual(change, 1e-9, (edge, order))
+            else:
+                third = max(third, change)
+        self.assertGreater(third, 1e-6, "G2 leaves the third derivative free")
+        # G3 on two opposite edges (four rows each, two left free between them)
+        hs.hold_boundary(obj, {"u0": "G3", "u1": "G3"})
+        self.assertEqual(hs.held_boundary(obj), {"u0": "G3", "u1": "G3", "v0": "free", "v1": "free"})
+        before = edge_derivatives(obj.Shape.Faces[0], 3)
+        stroke(obj, lift=10.0)
+        after = edge_derivatives(obj.Shape.Faces[0], 3)
+        for edge in ("u0", "u1"):
+            for order in range(4):
+                self.assertLessEqual(float(np.max(np.abs(after[edge, order] - before[edge, order]))), 1e-9,
+                                     (edge, order))
+        # too few poles: refused, saying what would make it possible; nothing changed
+        with self.assertRaisesRegex(ValueError, r"u0 and u1 hold 8 rows of the 8 poles along u.*use more controls"):
+            hs.hold_boundary(hs.make_sculpt(self.doc, controls=(8, 8)), "G3")
+        with self.assertRaisesRegex(ValueError, "G4"):
+            hs.hold_boundary(obj, "G4")
 
     def test_g0_on_some_edges_keeps_those_and_frees_the_others(self):
         obj = hs.make_sculpt(self.doc, controls=(8, 8), mesh=(30, 30))
@@ -89,7 +146,7 @@ class TestHeldEdges(DocumentTestCase):
     def test_bad_boundaries_are_refused_by_name_and_change_nothing(self):
         obj = hs.make_sculpt(self.doc, controls=(4, 8), mesh=(20, 20))
         n = self.doc.UndoCount
-        for boundary, message in (("G2", "one of free, G0, G1"), ({"w0": "G0"}, "unknown edge 'w0'"),
+        for boundary, message in (("G4", "one of free, G0, G1, G2, G3"), ({"w0": "G0"}, "unknown edge 'w0'"),
                                   ({"u0": "G1", "u1": "G1"}, "too few to leave any free"), (3, "boundary: one of")):
             with self.assertRaises((ValueError, TypeError)) as ctx:
                 hs.hold_boundary(obj, boundary)

@@ -145,7 +145,7 @@ class SolidChecks(DocumentTestCase):
         self.assertEqual(sorted(r["edge"] for r in report), sorted(kinds))
         for r in report:
             self.assertLessEqual(r["g0_mm"], 1e-7, r)
-            if kinds[r["edge"]] == "G1":
+            if kinds[r["edge"]] in ("G1", "G2", "G3"):
                 self.assertLessEqual(r["g1_deg"], 0.01, r)
             else:
                 self.assertIsNone(r["g1_deg"])
@@ -355,6 +355,39 @@ class TestSeveralFaces(SolidChecks):
         self.assertEqual(again.Shape.Volume, volume)
         pull(again, mass_point_near(again, 30, 6), (0, 0, -2))
         self.check_sculpted(again, self.doc.getObject("Part"), [top, fillet], min_volume=0.0)
+
+    def test_g2_and_g3_outer_edges_meet_the_neighbours_as_the_base_did(self):
+        """The top of a block beside a round, held G2: along every edge (beside the round and the
+        sides) the sculpted top has the base's derivatives up to the second (its curvature across
+        the edge: the round and the sides meet it as they met the base, to second order); G3 up to
+        the third. A G2 seam between faces sculpted together is refused, saying why."""
+        part, top, fillet = self.filleted_box()
+        obj = hs.sculpt_solid(self.doc, part, [top], boundary="G2", controls=(10, 10))
+        self.assertEqual(set(hs.boundary_of(obj).values()), {"G2"})
+        base = reference = nurbs_face(part.Shape.getElement(top)).Surface
+        for kind, order in (("G2", 2), ("G3", 3)):
+            if kind == "G3":  # (held from where the G2 stroke left it: its third derivative was free)
+                hs.set_boundary(obj, "G3")
+                self.assertEqual(set(hs.boundary_of(obj).values()), {"G3"})
+                reference = sculpted_surface(obj.Sculpts[0])
+            pull(obj, mass_point_near(obj, 20, 17), (0, 0, 6))
+            self.check_sculpted(obj, part, top)
+            surface = sculpted_surface(obj.Sculpts[0])
+            worst = [0.0] * (order + 1)
+            for e in face_edges(part.Shape, top):
+                for u, v in e.uv[::8]:
+                    worst[0] = max(worst[0], (surface.value(u, v) - base.value(u, v)).Length)
+                    for k in range(1, order + 1):
+                        was = base if k <= 2 else reference
+                        for a in range(k + 1):
+                            worst[k] = max(worst[k], (surface.getDN(u, v, a, k - a) - was.getDN(u, v, a, k - a)).Length)
+            self.assertTrue(all(w <= 1e-9 for w in worst), (kind, worst))
+            inside = (surface.value(0.5 * sum(surface.bounds()[:2]), 0.5 * sum(surface.bounds()[2:])) -
+                      base.value(0.5 * sum(base.bounds()[:2]), 0.5 * sum(base.bounds()[2:]))).Length
+            self.assertGreater(inside, 0.5, f"{kind}: the stroke moved the inside")
+        seam = next(e.name for e in face_edges(part.Shape, top) if fillet in e.neighbours)
+        with self.assertRaisesRegex(ValueError, f"{seam} is a seam between faces sculpted together.*G1"):
+            hs.sculpt_solid(self.doc, part, [top, fillet], boundary={seam: "G2"})
 
     def test_two_sides_of_a_loft_keep_their_crease(self):
         bottom = Part.makePolygon([FreeCAD.Vector(x, y, 0) for x, y in ((0, 0), (40, 0), (40, 30), (0, 30), (0, 0))])
@@ -572,7 +605,7 @@ class TestSculptedSolidDocument(SolidChecks):
             (dict(base=box, faces="Face1"), TypeError, "faces:"),
             (dict(base=box, faces=["Face9"]), ValueError, "faces: 'Face9'"),
             (dict(base=box, faces=[top, top]), ValueError, "twice"),
-            (dict(base=box, faces=[top], boundary="G2"), ValueError, "boundary:"),
+            (dict(base=box, faces=[top], boundary="G4"), ValueError, "boundary:"),
             (dict(base=box, faces=[top], boundary={"Edge99": "G0"}), ValueError, "'Edge99' is not an edge"),
             (dict(base=box, faces=[top], boundary={edge: "free"}), ValueError, f"{edge} is shared with"),
             (dict(base=box, faces=[top], controls=(1, 8)), ValueError, "controls:"),

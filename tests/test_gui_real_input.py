@@ -426,6 +426,28 @@ def test_the_bending_map_is_painted_and_shown_like_the_other_maps(tmp_path):
 
 
 @pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_hold_edges_goes_free_g0_g1_g2_and_skips_what_the_net_cannot_hold(tmp_path):
+    """Hold edges (the Constraints drop-down), pressed again and again on a new 8 x 8 patch: free,
+    G0, G1, G2, then free again (G3 on all four edges would hold every pole: skipped), each press
+    one undo step; ctrl+z goes back one."""
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        d.xdo("mousemove", "640", "500")
+        s = d.new_patch()
+        assert set(sculpt(s)["edges"].values()) == {"free"}
+        for kind in ("G0", "G1", "G2", "free"):
+            s = d.press_button("HoldEdges", lambda s, kind=kind: set(sculpt(s)["edges"].values()) == {kind},
+                               f"Hold edges: {kind}")
+            assert undo(s)[0] == "Hold edges"
+        assert undo(s)[:4] == ["Hold edges"] * 4
+        d.xdo("key", "ctrl+z")
+        d.wait(lambda s: set(sculpt(s)["edges"].values()) == {"G2"}, "ctrl+z: back to G2")
+        d.shot("hold_edges_g2")
+    finally:
+        d.close()
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
 def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
     """Every command and key echoes its scripting call (FreeCADGui.doCommand): FreeCAD's own macro
     recorder, started from its menu with real keys, records a session that freecadcmd replays, with

@@ -505,13 +505,14 @@ def remove_constraint(obj: Any, cid: int) -> None:
 #: The four edges of a sculpt's control net, by the side of its parameter domain they lie on.
 EDGES = ("u0", "u1", "v0", "v1")
 #: How an edge may be held: not at all, in place (G0), in place with its tangent planes (G1).
-BOUNDARIES = ("free", "G0", "G1")
+BOUNDARIES = ("free", "G0", "G1", "G2", "G3")
 
 
 def boundary_poles(controls: tuple[int, int], boundary: Any) -> list[int]:
     """The pole indices (i * nv + j for pole (i, j)) that hold ``boundary`` on a net of ``controls``
     poles: G0 holds an edge's row of poles (a clamped B-spline's edge curve depends on it alone), G1
-    that row and the next (the derivative across the edge depends on those two)."""
+    that row and the next (the derivative across the edge depends on those two), G2 three rows (the
+    second derivative: the curvature across it), G3 four (its rate)."""
     nu, nv = controls
     if isinstance(boundary, str):
         boundary = {edge: boundary for edge in EDGES}
@@ -524,7 +525,7 @@ def boundary_poles(controls: tuple[int, int], boundary: Any) -> list[int]:
             raise ValueError(f"boundary: unknown edge {edge!r} (one of {', '.join(EDGES)})")
         if kind not in BOUNDARIES:
             raise ValueError(f"boundary: {edge} must be one of {', '.join(BOUNDARIES)}, not {kind!r}")
-        rows[edge] = BOUNDARIES.index(kind)  # rows of poles held: 0, 1 or 2
+        rows[edge] = BOUNDARIES.index(kind)  # rows of poles held: 0 to 4
     for side, count in (("u", nu), ("v", nv)):
         if rows.get(side + "0", 0) + rows.get(side + "1", 0) >= count:
             raise ValueError(f"boundary: {side}0 and {side}1 hold {rows.get(side + '0', 0) + rows.get(side + '1', 0)} "
@@ -548,8 +549,9 @@ def _edges(edges: Any) -> Any:
 
 def hold_boundary(obj: Any, boundary: Any = "G0") -> list[int]:
     """Holds the sculpt's edges exactly, as hard constraints (the poles do not move at all; not
-    penalties): "G0" keeps an edge where it is, "G1" its tangent planes along it too, "free" lets it
-    move. ``boundary`` is one of those for all four edges, or a dict from edge ("u0", "u1", "v0",
+    penalties): "G0" keeps an edge where it is, "G1" its tangent planes along it too, "G2" its
+    curvature across it too (a face beside it met as it does now, to second order), "G3" that
+    curvature's rate too, "free" lets it move. ``boundary`` is one of those for all four edges, or a dict from edge ("u0", "u1", "v0",
     "v1": the sides of the parameter domain) to one of them, the others free. Replaces what was held
     before. One undo transaction (also during a session); returns the held pole indices."""
     _sculpt(obj)
@@ -560,14 +562,14 @@ def hold_boundary(obj: Any, boundary: Any = "G0") -> list[int]:
 
 
 def held_boundary(obj: Any) -> dict[str, str]:
-    """What each edge of the sculpt is held as ("free", "G0" or "G1"), read from its held poles."""
+    """What each edge of the sculpt is held as ("free", "G0" to "G3"), read from its held poles."""
     _sculpt(obj)
     surface = obj.Proxy.live.snapshot()
     held, controls = set(surface.held_poles), tuple(surface.surface.controls)
     out = {}
     for edge in EDGES:
         out[edge] = "free"
-        for kind in ("G1", "G0"):
+        for kind in reversed(BOUNDARIES[1:]):
             try:
                 rows = set(boundary_poles(controls, {edge: kind}))
             except ValueError:

@@ -1,6 +1,6 @@
 """A face of a solid seen from its own parameter space, so it can be sculpted in place: its edges
 as curves in (u, v), the poles that hold them (G0: the surface stays on the edge; G1: its tangent
-planes along it too), the sculpted surface bounded by the face's own wires (outer wire and holes,
+planes along it too; G2, G3: its curvature across it and that curvature's rate), the sculpted surface bounded by the face's own wires (outer wire and holes,
 mapped through (u, v): the mass points move, the parameterisation does not), and the solid sewn
 back around it, with a report of how well each seam holds.
 
@@ -20,8 +20,10 @@ import numpy as np
 HOLD_SAMPLES = 400
 SEAM_SAMPLES = 100
 SIDES = ("u0", "u1", "v0", "v1")
-#: How an edge may be held: not at all, in place (G0), in place with its tangent planes (G1).
-KINDS = ("free", "G0", "G1")
+#: How an edge may be held: not at all, in place (G0), in place with its tangent planes (G1), and
+#: its curvature across it (G2) and that curvature's rate (G3): as the base met its neighbour.
+KINDS = ("free", "G0", "G1", "G2", "G3")
+TANGENT = ("G1", "G2", "G3")  # the kinds that hold the tangent planes
 
 
 @dataclass(frozen=True)
@@ -104,42 +106,59 @@ def face_edges(shape: Any, face_name: str) -> list[FaceEdge]:
 
 
 # --- the poles that hold an edge -------------------------------------------------------------------
-def _basis(knots: np.ndarray, p: int, x: float, k: int | None = None) -> tuple[int, np.ndarray, np.ndarray]:
-    """The span index k (knots[k] <= x < knots[k + 1], the last span closed; or the given one, whose
-    polynomials are then evaluated at x) and the values and first derivatives of the p + 1 basis
-    functions N_{k-p..k} at x (Cox-de Boor)."""
-    n = len(knots) - p - 1
-    if k is None:
-        k = int(np.searchsorted(knots, x, side="right") - 1)
-        k = min(max(k, p), n - 1)
+def _derivatives(knots: np.ndarray, p: int, x: float, k: int, n: int) -> np.ndarray:
+    """The values and derivatives up to order n of the p + 1 basis functions N_{k-p..k} of span k
+    at x, as an (n + 1, p + 1) array (Piegl & Tiller, The NURBS Book, A2.3)."""
+    ndu = np.zeros((p + 1, p + 1))  # ndu[j][r]: degree-j values; ndu[r][j] (r > j): knot differences
+    ndu[0, 0] = 1.0
     left, right = np.zeros(p + 1), np.zeros(p + 1)
-    table = np.zeros((p + 1, p + 1))  # table[j][r]: degree-j values; table[r][j] (r > j): knot differences
-    table[0, 0] = 1.0
     for j in range(1, p + 1):
         left[j] = x - knots[k + 1 - j]
         right[j] = knots[k + j] - x
         saved = 0.0
         for r in range(j):
-            table[j, r] = right[r + 1] + left[j - r]
-            temp = table[r, j - 1] / table[j, r] if table[j, r] != 0 else 0.0
-            table[r, j] = saved + right[r + 1] * temp
+            ndu[j, r] = right[r + 1] + left[j - r]
+            temp = ndu[r, j - 1] / ndu[j, r] if ndu[j, r] else 0.0
+            ndu[r, j] = saved + right[r + 1] * temp
             saved = left[j - r] * temp
-        table[j, j] = saved
-    values = table[:, p].copy()
-    deriv = np.zeros(p + 1)
-    if p > 0:  # N'_{i,p} = p (N_{i,p-1} / (t_{i+p} - t_i) - N_{i+1,p-1} / (t_{i+p+1} - t_{i+1}))
-        lower = np.concatenate([[0.0], table[:p, p - 1], [0.0]])
-        for r in range(p + 1):
-            i = k - p + r
-            a = knots[i + p] - knots[i]
-            b = knots[i + p + 1] - knots[i + 1]
-            deriv[r] = p * ((lower[r] / a if a else 0.0) - (lower[r + 1] / b if b else 0.0))
-    return k, values, deriv
+        ndu[j, j] = saved
+    n = min(n, p)
+    ders = np.zeros((n + 1, p + 1))
+    ders[0] = ndu[:, p]
+
+    def over(a: float, b: float) -> float:
+        return a / b if b else 0.0
+    for r in range(p + 1):
+        a = np.zeros((2, p + 1))
+        s1, s2 = 0, 1
+        a[0, 0] = 1.0
+        for kk in range(1, n + 1):
+            d = 0.0
+            rk, pk = r - kk, p - kk
+            if r >= kk:
+                a[s2, 0] = over(a[s1, 0], ndu[pk + 1, rk])
+                d = a[s2, 0] * ndu[rk, pk]
+            j1 = 1 if rk >= -1 else -rk
+            j2 = kk - 1 if r - 1 <= pk else p - r
+            for j in range(j1, j2 + 1):
+                a[s2, j] = over(a[s1, j] - a[s1, j - 1], ndu[pk + 1, rk + j])
+                d += a[s2, j] * ndu[rk + j, pk]
+            if r <= pk:
+                a[s2, kk] = over(-a[s1, kk - 1], ndu[pk + 1, r])
+                d += a[s2, kk] * ndu[r, pk]
+            ders[kk, r] = d
+            s1, s2 = s2, s1
+    factor = p
+    for kk in range(1, n + 1):
+        ders[kk] *= factor
+        factor *= p - kk
+    return ders
 
 
-def _active(knots: np.ndarray, p: int, x: float, with_derivative: bool) -> set[int]:
-    """Basis functions not zero at x (and, with_derivative, those whose derivative is not zero);
-    at an interior knot from both sides (a derivative may jump there)."""
+def _active(knots: np.ndarray, p: int, x: float, order: int) -> set[int]:
+    """Basis functions that are not zero at x, or whose derivatives up to ``order`` are not (the
+    surface's value, tangent plane, curvature and its rate there depend on those alone); at an
+    interior knot from both sides (a derivative may jump there)."""
     n = len(knots) - p - 1
     right = min(max(int(np.searchsorted(knots, x, side="right") - 1), p), n - 1)
     spans = {right}
@@ -148,10 +167,10 @@ def _active(knots: np.ndarray, p: int, x: float, with_derivative: bool) -> set[i
         spans.add(left)
     out: set[int] = set()
     for k in spans:
-        _, values, deriv = _basis(knots, p, x, k)
-        scale = max(1.0, float(np.max(np.abs(deriv))))
-        out.update(k - p + r for r in range(p + 1)
-                   if abs(values[r]) > 1e-12 or (with_derivative and abs(deriv[r]) > 1e-12 * scale))
+        ders = _derivatives(knots, p, x, k, order)
+        for d in range(len(ders)):
+            scale = max(1.0, float(np.max(np.abs(ders[d]))))
+            out.update(k - p + r for r in range(p + 1) if abs(ders[d, r]) > 1e-12 * scale)
     return out
 
 
@@ -159,7 +178,8 @@ def held_poles(knots_u: np.ndarray, knots_v: np.ndarray, degree: tuple[int, int]
                edges: list[FaceEdge], kinds: dict[str, str]) -> list[int]:
     """The pole indices (i * nv + j) to hold so that each edge keeps its kind exactly: G0 holds every
     pole whose basis function is not zero somewhere on the edge (the surface there depends on those
-    alone), G1 also those whose derivative is not zero there (the tangent plane along it)."""
+    alone), G1 also those whose derivative is not zero there (the tangent plane along it), G2 and
+    G3 those whose second and third derivatives are not (the curvature along it and its rate)."""
     nv = controls[1]
     p, q = degree
     held: set[int] = set()
@@ -167,10 +187,10 @@ def held_poles(knots_u: np.ndarray, knots_v: np.ndarray, degree: tuple[int, int]
         kind = kinds[e.name]
         if kind == "free":
             continue
-        g1 = kind == "G1"
+        order = KINDS.index(kind) - 1
         for u, v in e.uv:
-            iu = _active(knots_u, p, float(u), g1)
-            jv = _active(knots_v, q, float(v), g1)
+            iu = _active(knots_u, p, float(u), order)
+            jv = _active(knots_v, q, float(v), order)
             held.update(i * nv + j for i in iu for j in jv)
     return sorted(held)
 
@@ -243,7 +263,7 @@ def seam_report(surface: Any, shape: Any, face_name: str, kinds: dict[str, str],
         gap = max((surface.value(u, v) - occ.valueAt(t)).Length for (u, v), t in zip(uv, ts))
         entry = report.setdefault(name, {"edge": name, "g0_mm": 0.0, "g1_deg": None})
         entry["g0_mm"] = max(entry["g0_mm"], float(gap))
-        if kinds.get(name) == "G1":
+        if kinds.get(name) in TANGENT:
             cosines = [surface.normal(u, v).dot(original.normal(u, v)) for u, v in uv]
             angle = float(np.degrees(np.arccos(max(-1.0, min(1.0, min(cosines))))))
             entry["g1_deg"] = max(entry["g1_deg"] or 0.0, angle)
@@ -269,7 +289,7 @@ def seam_between(surfaces: dict[str, Any], shape: Any, faces: tuple[str, str], e
         raise RuntimeError(f"{edge}: the two faces' curves of it are parameterised differently ({drift:.3g} mm apart)")
     gap = max((a[0] - b[0]).Length for a, b in zip(*sides))
     angle = None
-    if kind == "G1":
+    if kind in TANGENT:
         cosines = [a[1].dot(b[1]) for a, b in zip(*sides)]
         angle = float(np.degrees(np.arccos(max(-1.0, min(1.0, min(cosines))))))
     return {"edge": edge, "g0_mm": float(gap), "g1_deg": angle}

@@ -101,6 +101,9 @@ def seam_links(made: SourceSurface, chain: FaceChain, kinds: dict[str, str], hel
     weights = np.asarray(s.weights, float).reshape(nu, nv) if s.weights is not None else None
     links: list[Any] = []
     for seam in chain.seams:
+        if kinds.get(seam.edge) in ("G2", "G3"):
+            raise ValueError(f"boundary: {seam.edge} is a seam between faces sculpted together, and holding it "
+                             f"{kinds[seam.edge]} there is not available yet: hold it G1 (tangent) or G0")
         if kinds.get(seam.edge) == "G1":
             row = seam_row(np.asarray(s.knots_u), seam.u)
             links += g1_links(poles, weights, row, set(held), seam.edge)

@@ -33,7 +33,7 @@ def ensure_properties(obj: Any) -> None:
     for kind, name, doc, mode in (
             ("App::PropertyLink", "Base", "The solid whose faces are sculpted", 0),
             ("App::PropertyStringList", "SculptFaces", "The faces of the base that are sculpted (FaceN)", 1),
-            ("App::PropertyString", "Boundary", "How each edge of those faces is held: free, G0 or G1 (JSON)", 1),
+            ("App::PropertyString", "Boundary", "How each edge of those faces is held: free, G0, G1, G2 or G3 (JSON)", 1),
             ("App::PropertyLinkList", "Sculpts", "The sculpts of those faces (hidden)", 1),
             ("App::PropertyString", "SeamReport", "Per edge: the largest gap (mm) and, for G1 edges, the largest "
                                                   "normal angle (degrees) between the sculpted face and the seam (JSON)", 1),
@@ -157,7 +157,7 @@ def trim_mask(sculpt: Any, us: Any, vs: Any) -> Any:
 
 
 def boundary_of(obj: Any) -> dict[str, str]:
-    """How each edge of the sculpted faces is held ({"EdgeN": "free" | "G0" | "G1"})."""
+    """How each edge of the sculpted faces is held ({"EdgeN": "free" | "G0" | "G1" | "G2" | "G3"})."""
     return json.loads(obj.Boundary) if obj.Boundary else {}
 
 

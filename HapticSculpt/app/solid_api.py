@@ -25,7 +25,7 @@ from .undo import transaction
 
 
 def _boundary_kinds(boundary: Any, edges: list[face_in_solid.FaceEdge], faces: Sequence[str]) -> dict[str, str]:
-    """Every edge of the faces to "free", "G0" or "G1" (G0 where ``boundary`` does not say)."""
+    """Every edge of the faces to "free" or "G0" to "G3" (G0 where ``boundary`` does not say)."""
     names = [e.name for e in edges]
     if isinstance(boundary, str):
         if boundary not in face_in_solid.KINDS:
@@ -48,7 +48,7 @@ def _boundary_kinds(boundary: Any, edges: list[face_in_solid.FaceEdge], faces: S
             what = "the seam of " + e.neighbours[0] if e.neighbours == (faces[0],) else \
                 "shared with " + ", ".join(n for n in e.neighbours if n not in faces)
             raise ValueError(f"boundary: {e.name} is {what}, which is not sculpted with it: a free edge would "
-                             f"open the solid there (hold it G0 or G1)")
+                             f"open the solid there (hold it G0 to G3)")
     return kinds
 
 
@@ -88,8 +88,9 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
 
     ``boundary``: how the faces' edges are held while sculpting, "G0" (they stay where they are, so
     the neighbour faces still meet them: the poles that shape the surface along them do not move),
-    "G1" (their tangent planes too) or "free", for all edges or as a dict from edge name ("Edge3")
-    to one of them, G0 for the others. A free edge must not border a face that is not sculpted (it
+    "G1" (their tangent planes too), "G2" (the curvature across them too: the neighbour face meets
+    the sculpted one as it met the base, to second order), "G3" (that curvature's rate too) or
+    "free", for all edges or as a dict from edge name ("Edge3") to one of them, G0 for the others. A free edge must not border a face that is not sculpted (it
     would open the solid). A seam between two of the faces is G1 where they meet tangentially and
     G0 (a crease that may move) where they meet at an angle, unless the dict says otherwise.
     ``controls``/``degree`` are the least net per face (each face is converted exactly, then
@@ -155,10 +156,9 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
     return obj
 
 
-def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
-    """Changes how a SculptedSolid's edges are held (``boundary`` as in :func:`sculpt_solid`: one
-    kind for all, or a dict from edge name to kind, the others kept). One undo step (not during a
-    session: RuntimeError); returns the kind of every edge."""
+def _boundary_plan(obj: Any, boundary: Any) -> tuple[dict[str, str], list[int], list[Any]]:
+    """What :func:`set_boundary` would hold: every edge's kind, the held poles and the seams' links
+    (ValueError where it cannot hold, saying why)."""
     if not is_sculpted_solid(obj):
         raise TypeError(f"obj: expected a HapticSculpt SculptedSolid, got {getattr(obj, 'TypeId', type(obj).__name__)}")
     shape = base_solid(obj.Base)
@@ -168,11 +168,28 @@ def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
     if isinstance(boundary, dict):
         boundary = {**boundary_of(obj), **boundary}
     kinds = _boundary_kinds(boundary, edges + _seam_edges(chain), faces)
-    sculpt = sculpt_of(obj)
-    made = _made_of(sculpt)
+    made = _made_of(sculpt_of(obj))
     if isinstance(boundary, str):  # (a seam is as tangent as its faces let it be)
         kinds = seam_kinds(made, chain, kinds, set())
     held, links = _holds(made, chain, edges, kinds, mirror_of(obj), ", ".join(faces))
+    return kinds, held, links
+
+
+def can_hold(obj: Any, boundary: Any) -> bool:
+    """Whether :func:`set_boundary` can hold ``boundary`` on the SculptedSolid (nothing changes)."""
+    try:
+        _boundary_plan(obj, boundary)
+    except ValueError:
+        return False
+    return True
+
+
+def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
+    """Changes how a SculptedSolid's edges are held (``boundary`` as in :func:`sculpt_solid`: one
+    kind for all, or a dict from edge name to kind, the others kept). One undo step (not during a
+    session: RuntimeError); returns the kind of every edge."""
+    kinds, held, links = _boundary_plan(obj, boundary)
+    sculpt = sculpt_of(obj)
     live = sculpt.Proxy.live
     if live.session is not None:
         raise RuntimeError(f"{obj.Label}: stop the sculpting session before changing how its edges are held")

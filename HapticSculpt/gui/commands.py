@@ -292,24 +292,38 @@ class Fair(_SculptCommand):
 
 
 class HoldEdges(_SculptCommand):
-    icon_name, menu = "HoldEdges", "Hold edges: free / G0 / G1"
+    icon_name, menu = "HoldEdges", "Hold edges: free / G0 / G1 / G2 / G3"
     tip = ("Hold the sculpt's edges exactly (hard constraints): G0 keeps them where they are, G1 their "
-           "tangent planes too; each press goes free, G0, G1, free (a face sculpted in its solid: G0, G1)")
+           "tangent planes too, G2 the curvature across them too, G3 its rate; each press goes free, G0, G1, "
+           "G2, G3, free, skipping what the net cannot hold (a face sculpted in its solid: G0 to G3)")
 
     def Activated(self) -> None:
-        from ..app.api import held_boundary
+        from ..app.api import BOUNDARIES, boundary_poles, held_boundary
         from ..app.sculpted_solid import boundary_of, chain_of_solid, solid_of
+        from ..app.solid_api import can_hold
         from .echo import ref, run_echoed
         obj = _ctl().active_sculpt()
         solid = solid_of(obj)
         if solid is not None:  # (the seams between its faces stay as tangent as they can)
             seams = chain_of_solid(solid).seam_edges()
             outer = {v for k, v in boundary_of(solid).items() if k not in seams}
-            following = "G1" if outer == {"G0"} else "G0"
+            cycle = BOUNDARIES[1:]  # (a solid's edges are never free: that would open it)
+            only = next(iter(outer)) if len(outer) == 1 else None
+            now = cycle.index(only) if only in cycle else -1
+            following = next((k for k in cycle[now + 1:] + cycle[:now + 1] if can_hold(solid, k)), "G0")
             run_echoed(f"HapticSculpt.set_boundary({ref(solid)}, {following!r})")
             return
         now = set(held_boundary(obj).values())
-        following = "G0" if now == {"free"} else "G1" if now == {"G0"} else "free"
+        current = BOUNDARIES.index(now.pop()) if len(now) == 1 else 0
+        controls = tuple(obj.Proxy.live.snapshot().surface.controls)
+
+        def holds(kind: str) -> bool:
+            try:
+                boundary_poles(controls, kind)
+            except ValueError:
+                return False
+            return True
+        following = next((k for k in BOUNDARIES[current + 1:] if holds(k)), "free")
         run_echoed(f"HapticSculpt.hold_boundary({ref(obj)}, {following!r})")
 
 

@@ -31,13 +31,21 @@ def _sculpts(doc):
                     "stiffness_map": [min(o.StiffnessMap), max(o.StiffnessMap), len(o.StiffnessMap)],
                     "stiffness_values": list(o.StiffnessMap),
                     "bending_map": [min(o.BendingMap), max(o.BendingMap), len(o.BendingMap)]
-                    if hasattr(o, "BendingMap") else [],
+                    if hasattr(o, "BendingMap") else [], "edges": _held_edges(o),
                     "session": o.Proxy.live.session is not None if getattr(o.Proxy, "live", None) else False,
                     "device": o.Proxy.live.session.device_name
                     if getattr(o.Proxy, "live", None) and o.Proxy.live.session else "",
                     "selected": o in Gui.Selection.getSelection(), "screen": _on_screen(o), "digest": digest(o),
                     "drawn_poles": _drawn_poles(o)})
     return out
+
+
+def _held_edges(o):
+    """How the sculpt's four edges are held (HapticSculpt.held_boundary), {} for a face of a solid."""
+    try:
+        return HapticSculpt.held_boundary(o)
+    except Exception:  # noqa: BLE001 - a face sculpted in its solid, or a state being read
+        return {}
 
 
 def _drawn_poles(o):
