@@ -106,7 +106,7 @@ def face_edges(shape: Any, face_name: str) -> list[FaceEdge]:
 
 
 # --- the poles that hold an edge -------------------------------------------------------------------
-def _derivatives(knots: np.ndarray, p: int, x: float, k: int, n: int) -> np.ndarray:
+def basis_derivatives(knots: np.ndarray, p: int, x: float, k: int, n: int) -> np.ndarray:
     """The values and derivatives up to order n of the p + 1 basis functions N_{k-p..k} of span k
     at x, as an (n + 1, p + 1) array (Piegl & Tiller, The NURBS Book, A2.3)."""
     ndu = np.zeros((p + 1, p + 1))  # ndu[j][r]: degree-j values; ndu[r][j] (r > j): knot differences
@@ -167,7 +167,7 @@ def _active(knots: np.ndarray, p: int, x: float, order: int) -> set[int]:
         spans.add(left)
     out: set[int] = set()
     for k in spans:
-        ders = _derivatives(knots, p, x, k, order)
+        ders = basis_derivatives(knots, p, x, k, order)
         for d in range(len(ders)):
             scale = max(1.0, float(np.max(np.abs(ders[d]))))
             out.update(k - p + r for r in range(p + 1) if abs(ders[d, r]) > 1e-12 * scale)

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from . import face_in_solid, face_symmetry
+from . import face_in_solid, face_symmetry, seam_continuity
 from .face_chain import FaceChain, g1_links, joined_surface, seam_row
 from .source_surface import SourceSurface, source_surface
 
@@ -93,27 +93,55 @@ def face_held(made: SourceSurface, edges: list[face_in_solid.FaceEdge], kinds: d
     return held
 
 
+def _net(surface: Any) -> tuple[np.ndarray, np.ndarray | None]:
+    nu, nv = surface.controls
+    poles = np.asarray(surface.poles, float).reshape(nu, nv, 3)
+    weights = np.asarray(surface.weights, float).reshape(nu, nv) if surface.weights is not None else None
+    return poles, weights
+
+
 def seam_links(made: SourceSurface, chain: FaceChain, kinds: dict[str, str], held: list[int]) -> list[Any]:
-    """The linked poles that keep the tangent planes matched across each G1 seam of the chain."""
+    """The linked poles that keep the tangent planes matched across each G1 seam of the chain, and
+    the curvature across each G2 seam too (its net made G2 first: :func:`g2_net`)."""
     s = made.surface
-    nu, nv = s.controls
-    poles = np.asarray(s.poles, float).reshape(nu, nv, 3)
-    weights = np.asarray(s.weights, float).reshape(nu, nv) if s.weights is not None else None
+    poles, weights = _net(s)
+    knots = np.asarray(s.knots_u)
     links: list[Any] = []
     for seam in chain.seams:
-        if kinds.get(seam.edge) in ("G2", "G3"):
+        kind = kinds.get(seam.edge)
+        if kind == "G3":
             raise ValueError(f"boundary: {seam.edge} is a seam between faces sculpted together, and holding it "
-                             f"{kinds[seam.edge]} there is not available yet: hold it G1 (tangent) or G0")
-        if kinds.get(seam.edge) == "G1":
-            row = seam_row(np.asarray(s.knots_u), seam.u)
+                             f"G3 there is not available: hold it G2, G1 or G0")
+        row = seam_row(knots, seam.u)
+        if kind == "G1":
             links += g1_links(poles, weights, row, set(held), seam.edge)
+        elif kind == "G2":
+            links += seam_continuity.links(poles, weights, knots, s.degree[0], row, seam.u, set(held), seam.edge)
     return links
 
 
+def g2_net(surface: Any, chain: FaceChain, kinds: dict[str, str], held: list[int]) -> np.ndarray | None:
+    """The poles (nu, nv, 3) moved as little as possible so that every G2 seam of the chain is
+    curvature-continuous (seam_continuity.project), or None when there is no G2 seam."""
+    seams = [seam for seam in chain.seams if kinds.get(seam.edge) == "G2"]
+    if not seams:
+        return None
+    poles, weights = _net(surface)
+    knots = np.asarray(surface.knots_u)
+    for seam in seams:
+        poles = seam_continuity.project(poles, weights, knots, surface.degree[0], seam_row(knots, seam.u),
+                                        seam.u, set(held), seam.edge)
+    return poles
+
+
 def seam_kinds(made: SourceSurface, chain: FaceChain, kinds: dict[str, str], asked: set[str]) -> dict[str, str]:
-    """``kinds`` with each seam not ``asked`` about made G1 where its faces meet tangentially (so
-    G1 can hold there) and G0 where they meet at an angle."""
+    """``kinds`` with each seam not ``asked`` about made G2 where its faces meet curvature-
+    continuously already (the jump of normal curvature across it within seam_continuity.G2_SHARE),
+    G1 where they meet tangentially (so G1 can hold there) and G0 where they meet at an angle."""
     out = dict(kinds)
+    poles, weights = _net(made.surface)
+    knots = np.asarray(made.surface.knots_u)
+    size = float(np.linalg.norm(np.ptp(poles.reshape(-1, 3), axis=0))) or 1.0
     for seam in chain.seams:
         if seam.edge in asked:
             continue
@@ -122,4 +150,12 @@ def seam_kinds(made: SourceSurface, chain: FaceChain, kinds: dict[str, str], ask
             out[seam.edge] = "G1"
         except ValueError:
             out[seam.edge] = "G0"
+            continue
+        try:
+            share = seam_continuity.jump_share(poles, weights, knots, made.surface.degree[0],
+                                               seam_row(knots, seam.u), seam.u, seam.edge, 1 / (1000 * size))
+        except ValueError:
+            continue
+        if share <= seam_continuity.G2_SHARE:
+            out[seam.edge] = "G2"
     return out

@@ -8,9 +8,11 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from .. import core
 from . import face_chain, face_in_solid, face_symmetry, sculpt_state
 from .api import _add_sculpt, _checked_resolution, _document, _material, _sculpt_state
-from .face_net import TRIM_SPANS, Mirror, face_held, face_source, mirror_of, seam_kinds, seam_links
+from .source_surface import SourceSurface
+from .face_net import TRIM_SPANS, Mirror, face_held, face_source, g2_net, mirror_of, seam_kinds, seam_links
 from .sculpted_solid import (
     SculptedSolidFeature,
     attach_view_provider,
@@ -64,15 +66,22 @@ def _made_of(sculpt: Any) -> Any:
 
 
 def _holds(made: Any, chain: face_chain.FaceChain, edges: list[face_in_solid.FaceEdge], kinds: dict[str, str],
-           mirror: Mirror | None, what: str) -> tuple[list[int], list[Any]]:
-    """The held poles and the seams' linked poles; ValueError if they would hold every pole."""
+           mirror: Mirror | None, what: str) -> tuple[Any, list[int], list[Any]]:
+    """The net to hold (``made``, its G2 seams made curvature-continuous first), the held poles
+    and the seams' linked poles; ValueError if they would hold every pole."""
     held = face_held(made, edges, kinds, mirror)
+    g2 = g2_net(made.surface, chain, kinds, held)
+    if g2 is not None:
+        s = made.surface
+        made = SourceSurface(core.BSplineSurface(g2, tuple(s.degree), list(s.knots_u), list(s.knots_v),
+                                                 None if s.weights is None else np.asarray(s.weights)),
+                             made.method, made.error, made.description)
     links = seam_links(made, chain, kinds, held)
     nu, nv = made.surface.controls
     if len(held) + len(links) >= nu * nv:
         raise ValueError(f"boundary: holding the edges as asked holds every pole of {what}'s {nu} x {nv} net "
                          f"(give more controls)")
-    return held, links
+    return made, held, links
 
 
 def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0", symmetry: Any = None,
@@ -135,7 +144,7 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
     made = face_source(base, chain, edges, controls, degree, TRIM_SPANS, mirror)
     asked = set(boundary) & seams if isinstance(boundary, dict) else set()
     kinds = seam_kinds(made, chain, kinds, asked)
-    held, links = _holds(made, chain, edges, kinds, mirror, ", ".join(faces))
+    made, held, links = _holds(made, chain, edges, kinds, mirror, ", ".join(faces))
     state = _sculpt_state(made, mesh, material, held, mirror.settings() if mirror else None, links)
     if doc.UndoMode == 0:
         doc.UndoMode = 1
@@ -156,9 +165,10 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
     return obj
 
 
-def _boundary_plan(obj: Any, boundary: Any) -> tuple[dict[str, str], list[int], list[Any]]:
-    """What :func:`set_boundary` would hold: every edge's kind, the held poles and the seams' links
-    (ValueError where it cannot hold, saying why)."""
+def _boundary_plan(obj: Any, boundary: Any) -> tuple[dict[str, str], Any, list[int], list[Any]]:
+    """What :func:`set_boundary` would hold: every edge's kind, the net (its G2 seams made
+    curvature-continuous), the held poles and the seams' links (ValueError where it cannot hold,
+    saying why)."""
     if not is_sculpted_solid(obj):
         raise TypeError(f"obj: expected a HapticSculpt SculptedSolid, got {getattr(obj, 'TypeId', type(obj).__name__)}")
     shape = base_solid(obj.Base)
@@ -171,8 +181,8 @@ def _boundary_plan(obj: Any, boundary: Any) -> tuple[dict[str, str], list[int], 
     made = _made_of(sculpt_of(obj))
     if isinstance(boundary, str):  # (a seam is as tangent as its faces let it be)
         kinds = seam_kinds(made, chain, kinds, set())
-    held, links = _holds(made, chain, edges, kinds, mirror_of(obj), ", ".join(faces))
-    return kinds, held, links
+    made, held, links = _holds(made, chain, edges, kinds, mirror_of(obj), ", ".join(faces))
+    return kinds, made, held, links
 
 
 def can_hold(obj: Any, boundary: Any) -> bool:
@@ -188,13 +198,14 @@ def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
     """Changes how a SculptedSolid's edges are held (``boundary`` as in :func:`sculpt_solid`: one
     kind for all, or a dict from edge name to kind, the others kept). One undo step (not during a
     session: RuntimeError); returns the kind of every edge."""
-    kinds, held, links = _boundary_plan(obj, boundary)
+    kinds, made, held, links = _boundary_plan(obj, boundary)
     sculpt = sculpt_of(obj)
     live = sculpt.Proxy.live
     if live.session is not None:
         raise RuntimeError(f"{obj.Label}: stop the sculpting session before changing how its edges are held")
     surface = live.surface
     with transaction(obj.Document, "Hold edges"):
+        surface.set_poles(np.asarray(made.surface.poles))  # (a G2 seam made so: the least move)
         surface.hold_poles(held, links)
         live.write(sculpt_state.capture(surface))
         obj.Boundary = json.dumps(kinds)
