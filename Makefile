@@ -161,19 +161,13 @@ IN_ROOT = tools/debian-root $(1) run env HS_STRESS_SEEDS=$(STRESS_SEEDS_$(1)) ma
 STRESS_SEEDS_bookworm := 10000:2000
 STRESS_SEEDS_trixie   := 12000:2000
 STRESS_SEEDS_forky    := 14000:2000
-# GUI tests left out on FreeCAD 1.1 until they are fixed there (issue 27): the HUD at a 1000 px
-# window (1.1's Tasks panel lies over the view's right part and eats the wheel there: zooming left
-# of it cannot fill the view) and the part sculpted in place (undo changes 0.07 % of the picture
-# under 1.1's paler selection, the test asks 0.1 %).
-GUI_PYTEST_ARGS_forky := --deselect tests/test_gui_panel_hud.py::test_the_hud_reads_over_white_zebra_stripes_and_its_legend_counts_the_stripes[window1] \
-                         --deselect tests/test_gui_sculpted_solid.py::test_a_face_of_a_part_sculpted_in_place
 test-other-debians: $(addprefix test-debian-,$(OTHER_SUITES))
 
 # Where no root can be made (no mount namespace: tools/debian-root exits 77 with one line saying what
 # is missing), the rest of make test still counts.
 test-debian-%: deps
 	@set +e; tools/debian-root $* ensure $(ROOT_PACKAGES) && \
-	  $(call IN_ROOT,$*) test-cpp test-python test-addon demo "GUI_PYTEST_ARGS='$(GUI_PYTEST_ARGS_$*)'"; rc=$$?; \
+	  $(call IN_ROOT,$*) test-cpp test-python test-addon demo "GUI_PYTEST_ARGS=$(GUI_PYTEST_ARGS)"; rc=$$?; \
 	  if [ $$rc = 77 ]; then echo "make test: Debian $*'s FreeCAD was not tested (see the line above)"; exit 0; fi; \
 	  exit $$rc
 

@@ -176,15 +176,16 @@ class Desktop:
         subprocess.run(["import", "-window", "root", path], env=self.env, check=True)
         return mpimg.imread(path)[..., :3]
 
-    def shot_changed(self, name: str, before: np.ndarray, what: str, share: float = 1e-3,
+    def shot_changed(self, name: str, before: np.ndarray, what: str, share: float = 1e-3, level: float = 0.1,
                      timeout: float = 10.0) -> np.ndarray:
-        """A screenshot once more than ``share`` of its pixels differ from ``before``: the state the
-        observer reports is the scene graph's; the window shows it after Qt's next paint, which
-        FreeCAD 1.1 (Qt6) may run a few frames later. Fails if the picture does not change."""
+        """A screenshot once more than ``share`` of its pixels differ from ``before`` by more than
+        ``level`` (of full scale): the state the observer reports is the scene graph's; the window
+        shows it after Qt's next paint, which FreeCAD 1.1 (Qt6) may run a few frames later. Fails if
+        the picture does not change."""
         end, t0 = time.monotonic() + timeout, time.monotonic()
         while True:
             picture = self.shot(name)
-            changed = float(np.mean(np.abs(picture - before) > 0.1))
+            changed = float(np.mean(np.abs(picture - before).max(axis=2) > level))
             if changed > share:
                 print(f"{what}: the picture changed ({changed:.2%} of it) after {time.monotonic() - t0:.2f} s")
                 return picture

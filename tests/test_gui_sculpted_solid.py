@@ -92,7 +92,9 @@ def test_a_face_of_a_part_sculpted_in_place(tmp_path):
         d.xdo("key", "ctrl+z")
         s = d.wait(lambda s: undo(s)[0] == "Sculpt solid" and
                    abs(solid(s)["volume"] - made["volume"]) < 1e-6 * made["volume"], "Undo of the stroke to show")
-        d.shot_changed("solid_undone", picture, "Undo of the stroke")
+        # (a bump on a grey face is a change of shading: FreeCAD 1.1 lights it paler, and no pixel
+        # changes by a tenth there; 4 % of the picture by more than 2 %)
+        d.shot_changed("solid_undone", picture, "Undo of the stroke", level=0.02)
         d.xdo("key", "ctrl+shift+z")
         d.wait(lambda s: undo(s)[0] == "Sculpt stroke" and abs(solid(s)["volume"] - made["volume"]) > 1.0, "Redo to show")
         frames = sum(o["frames"] for o in d.state()["overlays"])
