@@ -215,6 +215,14 @@ def run_scene(seed: int, steps: int = STEPS) -> SceneResult:
         if not held and extra_rng.random() < 0.25 and controls[0] >= 3:
             row, a = int(extra_rng.integers(1, controls[0] - 1)), float(extra_rng.uniform(0.05, 0.95))
             links = [(row * nv + j, [((row - 1) * nv + j, a), ((row + 1) * nv + j, 1.0 - a)]) for j in range(nv)]
+            if row + 3 < controls[0] and extra_rng.random() < 0.5:
+                # a G2 seam's second follower: the pole two rows past it, an affine combination of
+                # four others with weights like seam_continuity's (some negative, summing to 1)
+                masters = sorted({max(row - 2, 0), row - 1, row + 1, row + 3})
+                w = extra_rng.uniform(-1.5, 2.5, len(masters))
+                w[-1] = 1.0 - w[:-1].sum()
+                links.extend(((row + 2) * nv + j, [(m * nv + j, float(x)) for m, x in zip(masters, w)])
+                             for j in range(nv))
             s.hold_poles([], links)
         elif not held and extra_rng.random() < 0.33:
             try:
@@ -255,8 +263,9 @@ def run_scene(seed: int, steps: int = STEPS) -> SceneResult:
             p = np.array(s.poles)
             flat = p.reshape(-1, 3)
             # (to rounding: the core's sums are fused multiply-adds)
-            if links and any(np.abs(flat[pole] - w0 * flat[m0] - w1 * flat[m1]).max() > 1e-13 * max(1.0, np.abs(flat).max())
-                             for pole, ((m0, w0), (m1, w1)) in links):
+            if links and any(np.abs(flat[pole] - sum(w * flat[m] for m, w in masters)).max()
+                             > 1e-13 * sum(abs(w) for _, w in masters) * max(1.0, np.abs(flat).max())
+                             for pole, masters in links):
                 res.failure = f"a linked pole left its masters in step {k}"
                 return res
             if mirrored and not np.array_equal(p[::-1] * [-1.0, 1.0, 1.0], p):
