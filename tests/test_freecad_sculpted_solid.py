@@ -15,7 +15,16 @@ import Part
 from freecad_support import DocumentTestCase, run_ocp
 
 import HapticSculpt as hs
-from HapticSculpt.app.face_in_solid import face_edges, nurbs_face
+from HapticSculpt.app.face_in_solid import (
+    SEAM_SAMPLES,
+    _pcurve_points,
+    curvature_jump_pct,
+    face_edges,
+    named_occurrences,
+    normal_curvature,
+    nurbs_face,
+    surface_derivatives,
+)
 from HapticSculpt.app.sculpted_solid import chain_of_solid, sculpted_surface
 
 if "/usr/share/freecad/Mod" not in sys.path:
@@ -145,6 +154,7 @@ class SolidChecks(DocumentTestCase):
         self.assertEqual(sorted(r["edge"] for r in report), sorted(kinds))
         for r in report:
             self.assertLessEqual(r["g0_mm"], 1e-7, r)
+            self.assertTrue(np.isfinite(r["g2_pct"]) and r["g2_pct"] >= 0.0, r)  # (no degenerate edges here)
             if kinds[r["edge"]] in ("G1", "G2", "G3"):
                 self.assertLessEqual(r["g1_deg"], 0.01, r)
             else:
@@ -614,3 +624,177 @@ class TestSculptedSolidDocument(SolidChecks):
             self.assertIn(words, str(caught.exception))
         self.assertEqual(len(self.doc.Objects), count)
         self.assertEqual(json.dumps([o.Name for o in self.doc.Objects]), json.dumps(["Box", "Sheet"]))
+
+
+def edge_on(shape, face, edge, occurrence=0):
+    """The edge's SEAM_SAMPLES points (3D) and the face's (u, v) there, along its curve on the face's
+    exact B-spline form (the parameters the sculpted surface is in); ``occurrence`` 1: a seam's
+    other side."""
+    nface = nurbs_face(shape.getElement(face))
+    occ = [o for n, o in named_occurrences(shape, face, nface) if n == edge][occurrence]
+    uv, ts = _pcurve_points(nface, occ, SEAM_SAMPLES)
+    return nface, uv, np.array([tuple(occ.valueAt(t)) for t in ts])
+
+
+def fd_curvature_across(surface, face, uv, points, h=0.02):
+    """An independent measure of the normal curvature across the edge through ``points``: its
+    tangents by differences of the points, the face's normal from ``surface.normal`` (oriented as
+    the face), the (u, v) line whose 3D direction is normal x tangent (first derivatives by central
+    differences), and kappa = n . C'' / |C'|^2 along it by one-sided second-order differences of
+    ``surface.value`` at 0, h, 2h, 3h mm into the face."""
+    tangents = np.gradient(points, axis=0, edge_order=2)
+    tangents /= np.linalg.norm(tangents, axis=1)[:, None]
+    sign = -1.0 if face.Orientation == "Reversed" else 1.0
+    u0, u1, v0, v1 = face.ParameterRange
+    eu, ev = 1e-6 * (u1 - u0), 1e-6 * (v1 - v0)
+    out = []
+    for (u, v), t in zip(uv, tangents):
+        val = lambda a, b: np.array(tuple(surface.value(a, b)))  # noqa: E731
+        su = (val(u + eu, v) - val(u - eu, v)) / (2 * eu)
+        sv = (val(u, v + ev) - val(u, v - ev)) / (2 * ev)
+        n = sign * np.array(tuple(surface.normal(u, v)))
+        across = np.cross(n, t)
+        a, b = np.linalg.lstsq(np.column_stack([su, sv]), across, rcond=None)[0]
+        if not face.isPartOfDomain(u + 2 * h * a, v + 2 * h * b):
+            a, b = -a, -b  # (into the face)
+        c = [val(u + k * h * a, v + k * h * b) for k in range(4)]
+        second = (2 * c[0] - 5 * c[1] + 4 * c[2] - c[3]) / h ** 2
+        first = (-3 * c[0] + 4 * c[1] - c[2]) / (2 * h)
+        out.append(n.dot(second) / first.dot(first))
+    return np.array(out)
+
+
+def report_entry(obj, edge):
+    return next(r for r in hs.seam_report_of(obj) if r["edge"] == edge)
+
+
+class TestCurvatureAcrossEdges(SolidChecks):
+    """``g2_pct`` in the seam report: the largest jump of the normal curvature across an edge, in
+    percent of the larger |curvature| of its two sides."""
+
+    def test_normal_curvature_on_a_sphere_and_a_cylinder(self):
+        rng = np.random.default_rng(3)
+        r = 7.0
+        sphere = Part.Sphere()
+        sphere.Radius = r
+        uv = np.column_stack([rng.uniform(0, 2 * np.pi, 40), rng.uniform(-1.3, 1.3, 40)])
+        d = surface_derivatives(sphere, uv)
+        normal = np.cross(d[:, 0], d[:, 1])
+        normal /= np.linalg.norm(normal, axis=1)[:, None]
+        points = np.array([tuple(sphere.value(u, v)) for u, v in uv])
+        self.assertTrue(np.all(np.einsum("ij,ij->i", normal, points) > 0), "Su x Sv points outward")
+        # any tangent direction, of any length: -1/r (the sphere bends away from its outward normal)
+        direction = np.cross(normal, rng.normal(size=(40, 3))) * rng.uniform(0.1, 10.0, (40, 1))
+        np.testing.assert_allclose(normal_curvature(d, normal, direction), -1.0 / r, rtol=1e-12)
+        np.testing.assert_allclose(normal_curvature(d, -normal, direction), 1.0 / r, rtol=1e-12)
+        cylinder = Part.Cylinder()
+        cylinder.Radius = r
+        cylinder.Axis = FreeCAD.Vector(1, 2, 2)  # (not along a coordinate axis)
+        axis = np.array([1.0, 2.0, 2.0]) / 3.0
+        uv = np.column_stack([rng.uniform(0, 2 * np.pi, 40), rng.uniform(-50, 50, 40)])
+        d = surface_derivatives(cylinder, uv)
+        normal = np.cross(d[:, 0], d[:, 1])
+        normal /= np.linalg.norm(normal, axis=1)[:, None]
+        around = np.cross(normal, axis)
+        along = np.tile(axis, (40, 1))
+        np.testing.assert_allclose(normal_curvature(d, normal, around) * np.sign(normal_curvature(d, normal, around)),
+                                   1.0 / r, rtol=1e-12)
+        self.assertLess(np.abs(normal_curvature(d, normal, along)).max(), 1e-15)
+        # Euler: at 60 degrees from the axis, sin^2 60 of the curvature around
+        slant = 0.5 * along + np.sqrt(0.75) * around
+        np.testing.assert_allclose(np.abs(normal_curvature(d, normal, slant)), 0.75 / r, rtol=1e-12)
+        with self.assertRaises(ValueError):
+            normal_curvature(d, normal[:3], around)
+        # the jump: flat against curved is 100 %, flat against flat 0 % (the floor), equal 0 %
+        self.assertAlmostEqual(curvature_jump_pct([0.0, 0.0], [1 / 12, 1 / 12], 1e-6), 100.0, places=9)
+        self.assertEqual(curvature_jump_pct([0.0], [0.0], 1e-6), 0.0)
+        self.assertEqual(curvature_jump_pct([0.1, np.nan], [0.1, 0.2], 1e-6), 0.0)  # (NaN: a singular point, left out)
+        self.assertIsNone(curvature_jump_pct([np.nan], [0.1], 1e-6))
+
+    def rounded_block(self):
+        """A 100 x 80 x 30 block whose top meets the front through a 12 mm round."""
+        box = Part.makeBox(100, 80, 30)
+        edge = next(e for e in box.Edges if abs(e.CenterOfMass.z - 30) < 1e-9 and abs(e.CenterOfMass.y) < 1e-9)
+        part = self.part(box.makeFillet(12, [edge]))
+        top = face_named(part.Shape, lambda f: isinstance(f.Surface, Part.Plane) and abs(f.CenterOfMass.z - 30) < 1e-9)
+        round_ = face_named(part.Shape, lambda f: isinstance(f.Surface, Part.Cylinder))
+        seam = next(e.name for e in face_edges(part.Shape, top) if round_ in e.neighbours)
+        return part, top, round_, seam
+
+    def fd_jump(self, shape, face_a, surface_a, face_b, surface_b, edge, base_b=False):
+        """g2_pct by :func:`fd_curvature_across` on both sides; ``base_b``: side b is the base's own
+        face (its own surface, its (u, v) by projecting the points on it)."""
+        nface, uv, points = edge_on(shape, face_a, edge)
+        kappa_a = fd_curvature_across(surface_a, nface, uv, points)
+        if base_b:
+            other = shape.getElement(face_b)
+            uv_b = np.array([tuple(other.Surface.parameter(FreeCAD.Vector(*p)))[:2] for p in points])
+            kappa_b = fd_curvature_across(other.Surface, other, uv_b, points)
+        else:
+            nface_b, uv_b, points_b = edge_on(shape, face_b, edge)
+            self.assertLess(np.abs(points_b - points).max(), 1e-9)
+            kappa_b = fd_curvature_across(surface_b, nface_b, uv_b, points_b)
+        floor = 1.0 / (1000.0 * shape.BoundBox.DiagonalLength)
+        return curvature_jump_pct(kappa_a, kappa_b, floor), kappa_a, kappa_b
+
+    def test_an_outer_edge_beside_a_round_jumps_by_all_of_its_curvature(self):
+        """The top sculpted alone, held G2: beside the round (not sculpted) the top is flat across the
+        edge and the round curves 1/12: 100 %, before and after a stroke (G2 keeps the top's own
+        curvature there); the creases with the flat sides are finite numbers."""
+        part, top, round_, seam = self.rounded_block()
+        obj = hs.sculpt_solid(self.doc, part, [top], boundary="G2", controls=(10, 10))
+        self.assertAlmostEqual(report_entry(obj, seam)["g2_pct"], 100.0, delta=0.01)
+        pull(obj, mass_point_near(obj, 50, 45), (0, 0, 8))
+        self.check_sculpted(obj, part, top)
+        entry = report_entry(obj, seam)
+        self.assertAlmostEqual(entry["g2_pct"], 100.0, delta=0.01)
+        for r in hs.seam_report_of(obj):
+            self.assertTrue(np.isfinite(r["g2_pct"]), r)  # (the creases with the flat sides too)
+        # the independent measure: finite differences of the surfaces' points on both sides
+        fd, kappa_top, kappa_round = self.fd_jump(part.Shape, top, sculpted_surface(obj.Sculpts[0]), round_, None,
+                                                  seam, base_b=True)
+        self.assertLess(np.abs(kappa_top).max(), 1e-4)
+        np.testing.assert_allclose(np.abs(kappa_round), 1.0 / 12.0, rtol=1e-3)
+        self.assertLess(abs(fd - entry["g2_pct"]), 1.0, (fd, entry))
+
+    def test_a_seam_between_sculpted_faces_reports_the_curvature_jump(self):
+        """The top and the round sculpted as one (their seam G1): the base's jump is 100 % and stays
+        about that after a stroke across it (recorded, and checked by finite differences)."""
+        part, top, round_, seam = self.rounded_block()
+        obj = hs.sculpt_solid(self.doc, part, [top, round_])
+        self.assertEqual(hs.boundary_of(obj)[seam], "G1")
+        self.assertAlmostEqual(report_entry(obj, seam)["g2_pct"], 100.0, delta=0.01)
+        pull(obj, mass_point_near(obj, 50, 14), (0, -3, 5))
+        self.check_sculpted(obj, part, [top, round_])
+        entry = report_entry(obj, seam)
+        pieces = chain_of_solid(obj, part.Shape).split(sculpted_surface(obj.Sculpts[0]))
+        fd = self.fd_jump(part.Shape, top, pieces[top], round_, pieces[round_], seam)[0]
+        self.assertLess(abs(fd - entry["g2_pct"]), 1.0, (fd, entry))
+        # (100.3 % measured: the stroke bent the top near the seam a little, against the round's curvature)
+        self.assertGreater(entry["g2_pct"], 90.0, entry)
+
+    def test_a_cylinders_own_seam_is_curvature_continuous(self):
+        """A cylinder's side is one face whose seam runs along it: the same smooth surface on both
+        sides, 0 % before a stroke; held G2 it stays under 1 % after one; held G0 the stroke makes
+        a small jump there, which finite differences confirm."""
+        cyl = self.part(Part.makeCylinder(10, 30), "Cylinder")
+        side = face_named(cyl.Shape, lambda f: isinstance(f.Surface, Part.Cylinder))
+        seam = next(e.name for e in face_edges(cyl.Shape, side) if e.neighbours == (side,))
+        for kind, controls in (("G2", (12, 12)), ("G0", (8, 8))):
+            obj = hs.sculpt_solid(self.doc, cyl, [side], boundary=kind, controls=controls, name="S" + kind)
+            self.assertLess(report_entry(obj, seam)["g2_pct"], 1e-6)
+            pull(obj, (0, 10, 15), (0, 5, 0))
+            self.check_sculpted(obj, cyl, side, min_volume=0.5)
+            entry = report_entry(obj, seam)
+            surface = sculpted_surface(obj.Sculpts[0])
+            nface, uv_a, points = edge_on(cyl.Shape, side, seam)
+            _, uv_b, points_b = edge_on(cyl.Shape, side, seam, occurrence=1)
+            self.assertLess(np.abs(points_b - points).max(), 1e-9)
+            fd = curvature_jump_pct(fd_curvature_across(surface, nface, uv_a, points),
+                                    fd_curvature_across(surface, nface, uv_b, points_b),
+                                    1.0 / (1000.0 * cyl.Shape.BoundBox.DiagonalLength))
+            self.assertLess(abs(fd - entry["g2_pct"]), 1.0, (kind, fd, entry))
+            if kind == "G2":
+                self.assertLess(entry["g2_pct"], 1.0, entry)
+            else:  # (1.38 % measured)
+                self.assertGreater(entry["g2_pct"], 0.01, entry)

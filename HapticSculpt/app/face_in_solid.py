@@ -2,7 +2,8 @@
 as curves in (u, v), the poles that hold them (G0: the surface stays on the edge; G1: its tangent
 planes along it too; G2, G3: its curvature across it and that curvature's rate), the sculpted surface bounded by the face's own wires (outer wire and holes,
 mapped through (u, v): the mass points move, the parameterisation does not), and the solid sewn
-back around it, with a report of how well each seam holds.
+back around it, with a report of how well each seam holds (gap, normal angle, and the jump of the
+normal curvature across each edge).
 
 All of it works on the face's exact B-spline form (``Face.toNurbs``), whose parameter space is the
 one the sculpt surface is made in (see :mod:`source_surface`), so a trim curve in (u, v) is valid on
@@ -245,46 +246,210 @@ def solid_with(shape: Any, replaced: dict[str, Any], tolerance: float = 1e-6) ->
     return solid
 
 
+# --- curvature across an edge (g2_pct) --------------------------------------------------------------
+#: |kappa| below 1 / (CURVATURE_FLOOR * size) (size: the base solid's bounding-box diagonal, mm)
+#: counts as that floor in ``g2_pct``: two flat sides give 0 %, not 0/0.
+CURVATURE_FLOOR = 1000.0
+_SECOND_ORDER = ((1, 0), (0, 1), (2, 0), (1, 1), (0, 2))  # Su, Sv, Suu, Suv, Svv
+
+
+def surface_derivatives(surface: Any, uv: np.ndarray) -> np.ndarray:
+    """Su, Sv, Suu, Suv and Svv of ``surface`` (any Part surface) at the (n, 2) points ``uv``, as an
+    (n, 5, 3) array (``getDN``: FreeCAD evaluates one point at a time)."""
+    uv = np.asarray(uv, float).reshape(-1, 2)
+    dn = surface.getDN
+    flat = np.fromiter((x for u, v in uv.tolist() for a, b in _SECOND_ORDER for d in (dn(u, v, a, b),)
+                        for x in (d.x, d.y, d.z)), float, count=15 * len(uv))  # (a third faster than tuples)
+    return flat.reshape(len(uv), 5, 3)
+
+
+def _unit(vectors: np.ndarray) -> np.ndarray:
+    """Rows scaled to length 1 (NaN where a row is zero: a singular point, left out later)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return vectors / np.linalg.norm(vectors, axis=-1, keepdims=True)
+
+
+def normal_curvature(derivatives: np.ndarray, normal: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """The normal curvature of a surface in the tangent direction ``direction`` at n points:
+    ``direction`` = Su a + Sv b solved for (a, b) by least squares (the curve through the point
+    along the straight (u, v) line (a, b) has that tangent, and second derivative Suu a^2 +
+    2 Suv a b + Svv b^2, Meusnier), then kappa = normal . (Suu a^2 + 2 Suv a b + Svv b^2) /
+    |direction|^2.
+
+    ``derivatives``: (n, 5, 3) Su, Sv, Suu, Suv, Svv (see :func:`surface_derivatives`);
+    ``normal``: (n, 3) unit normals, oriented as the caller wants the sign (a sphere of radius r
+    with its outward normal gives -1/r: the surface bends away from it); ``direction``: (n, 3),
+    not zero. Returns (n,) curvatures (1/mm); NaN where the first derivatives are parallel."""
+    d = np.asarray(derivatives, float)
+    n = np.asarray(normal, float)
+    t = np.asarray(direction, float)
+    if d.ndim != 3 or d.shape[1:] != (5, 3) or n.shape != (len(d), 3) or t.shape != (len(d), 3):
+        raise ValueError(f"normal_curvature: derivatives (n, 5, 3), normal and direction (n, 3); got "
+                         f"{d.shape}, {n.shape}, {t.shape}")
+    su, sv, suu, suv, svv = (d[:, k] for k in range(5))
+    g11, g12, g22 = (np.einsum("ij,ij->i", x, y) for x, y in ((su, su), (su, sv), (sv, sv)))
+    r1, r2 = np.einsum("ij,ij->i", su, t), np.einsum("ij,ij->i", sv, t)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        det = g11 * g22 - g12 * g12  # (the 2 x 2 normal equations, solved in closed form)
+        a = (g22 * r1 - g12 * r2) / det
+        b = (g11 * r2 - g12 * r1) / det
+        second = suu * (a * a)[:, None] + 2.0 * suv * (a * b)[:, None] + svv * (b * b)[:, None]
+        return np.einsum("ij,ij->i", n, second) / np.einsum("ij,ij->i", t, t)
+
+
+def curvature_across(surface: Any, uv: np.ndarray, sign: float, tangents: np.ndarray,
+                     derivatives: np.ndarray | None = None) -> np.ndarray:
+    """The normal curvature of ``surface`` at the (n, 2) points ``uv`` across an edge with the (n, 3)
+    unit ``tangents``: in the direction normal x tangent, the normal oriented by ``sign`` (-1 for a
+    Reversed face). Oriented so, two faces meeting smoothly on a closed solid have the same normal
+    there, hence the same direction across and curvatures of the same sign. ``derivatives``: the
+    surface's at ``uv`` when the caller has them already (see :func:`surface_derivatives`)."""
+    d = surface_derivatives(surface, uv) if derivatives is None else derivatives
+    normal = sign * _unit(np.cross(d[:, 0], d[:, 1]))
+    return normal_curvature(d, normal, np.cross(normal, tangents))
+
+
+def curvature_jump_pct(kappa_a: np.ndarray, kappa_b: np.ndarray, floor: float) -> float | None:
+    """The largest |kappa_a - kappa_b| as a percentage of the larger |kappa| of the two at that
+    point, |kappa| below ``floor`` counting as ``floor``; None when no point could be measured."""
+    ka, kb = np.asarray(kappa_a, float), np.asarray(kappa_b, float)
+    scale = np.maximum(np.maximum(np.abs(ka), np.abs(kb)), floor)
+    jump = 100.0 * np.abs(ka - kb) / scale
+    jump = jump[np.isfinite(jump)]
+    return float(jump.max()) if jump.size else None
+
+
+def _curvature_floor(shape: Any) -> float:
+    return 1.0 / (CURVATURE_FLOOR * max(shape.BoundBox.DiagonalLength, 1e-300))
+
+
+def _edge_samples(occ: Any, ts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(n, 3) points and unit tangents of an edge at its parameters ``ts``."""
+    points = np.array([tuple(occ.valueAt(t)) for t in ts], float)
+    tangents = _unit(np.array([tuple(occ.tangentAt(t)) for t in ts], float))
+    return points, tangents
+
+
+def _other_face(shape: Any, face_name: str, edge: Any) -> Any:
+    """The face of ``shape`` (oriented as in it) on the other side of ``edge`` from ``face_name``;
+    None if there is none."""
+    own = shape.getElement(face_name)
+    return next((f for f in shape.Faces if not f.isSame(own) and any(e.isSame(edge) for e in f.Edges)), None)
+
+
+def _uv_on(face: Any, edge: Any, occ: Any, ts: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(n, 2) points of ``face``'s own (u, v) on ``edge`` where the converted edge ``occ`` is at its
+    parameters ``ts`` (``points``): through the face's pcurve of the edge, at the same parameter when
+    the conversion kept it (lines, B-splines), else at the edge's parameter of each point (a circle
+    converted to a rational B-spline is parameterised differently)."""
+    c2d, a, b = face.curveOnSurface(edge)
+    probe = ts[[0, len(ts) // 2, -1]]
+    kept = np.allclose((a, b), occ.ParameterRange, rtol=0.0, atol=1e-12 * max(1.0, abs(b - a))) and \
+        max((edge.valueAt(t) - occ.valueAt(t)).Length for t in probe) <= 1e-9 * max(1.0, edge.Length)
+    if kept:
+        params = ts
+    else:
+        import FreeCAD
+        curve = edge.Curve
+        params = np.array([curve.parameter(FreeCAD.Vector(*p)) for p in points], float)
+        if curve.isPeriodic():  # (into the edge's own range)
+            params = a + np.mod(params - a, curve.period())
+    points2d = [c2d.value(t) for t in params]
+    return np.array([(q.x, q.y) for q in points2d], float)
+
+
+#: The curvature across an edge of a face that is not sculpted, by the face and the edge's samples:
+#: it is the same after every stroke (the report is remade at each one), so it is computed once.
+_NEIGHBOUR_CURVATURES: dict[tuple[Any, ...], np.ndarray] = {}
+_NEIGHBOUR_CACHE_SIZE = 256
+
+
+def _neighbour_curvature(other: Any, edge: Any, occ: Any, ts: np.ndarray, points: np.ndarray,
+                         tangents: np.ndarray) -> np.ndarray:
+    """The curvature across ``edge`` of the unsculpted face ``other`` at the edge's samples."""
+    key = (other.hashCode(), other.Orientation, points.tobytes(), tangents.tobytes())
+    kappa = _NEIGHBOUR_CURVATURES.get(key)
+    if kappa is None:
+        kappa = curvature_across(other.Surface, _uv_on(other, edge, occ, ts, points),
+                                 -1.0 if other.Orientation == "Reversed" else 1.0, tangents)
+        if len(_NEIGHBOUR_CURVATURES) >= _NEIGHBOUR_CACHE_SIZE:
+            _NEIGHBOUR_CURVATURES.pop(next(iter(_NEIGHBOUR_CURVATURES)))  # (the oldest)
+        _NEIGHBOUR_CURVATURES[key] = kappa
+    return kappa
+
+
 def seam_report(surface: Any, shape: Any, face_name: str, kinds: dict[str, str],
                 skip: frozenset[str] = frozenset()) -> list[dict[str, Any]]:
     """For each edge of ``shape``'s face ``face_name`` sculpted to ``surface``: the largest distance
     (mm) between the sculpted surface along the edge's (u, v) curve and the edge itself (``g0_mm``:
-    the neighbours still meet the edge), and for G1 edges the largest angle (degrees) between the
-    sculpted and the original normal there (``g1_deg``; None for the others), at SEAM_SAMPLES
-    points per edge (per side of a seam). Edges in ``skip`` (seams between sculpted faces, see
-    :func:`seam_between`) are left out."""
+    the neighbours still meet the edge), for G1 edges the largest angle (degrees) between the
+    sculpted and the original normal there (``g1_deg``; None for the others), and for every edge
+    the largest jump of the normal curvature across it between the sculpted face and the face on
+    its other side as the base has it (``g2_pct``: percent of the larger |kappa|, see
+    :func:`curvature_jump_pct`; the face's own seam: the sculpted surface on both sides; None on a
+    degenerate edge), at SEAM_SAMPLES points per edge (per side of a seam). Edges in ``skip``
+    (seams between sculpted faces, see :func:`seam_between`) are left out."""
     nface = nurbs_face(shape.getElement(face_name))
     original = nface.Surface
-    report: dict[str, dict[str, Any]] = {}
+    sign = -1.0 if nface.Orientation == "Reversed" else 1.0
+    floor = _curvature_floor(shape)
+    occurrences: dict[str, list[Any]] = {}
     for name, occ in named_occurrences(shape, face_name, nface):
-        if name in skip:
-            continue
-        uv, ts = _pcurve_points(nface, occ, SEAM_SAMPLES)
-        gap = max((surface.value(u, v) - occ.valueAt(t)).Length for (u, v), t in zip(uv, ts))
-        entry = report.setdefault(name, {"edge": name, "g0_mm": 0.0, "g1_deg": None})
-        entry["g0_mm"] = max(entry["g0_mm"], float(gap))
-        if kinds.get(name) in TANGENT:
-            cosines = [surface.normal(u, v).dot(original.normal(u, v)) for u, v in uv]
-            angle = float(np.degrees(np.arccos(max(-1.0, min(1.0, min(cosines))))))
-            entry["g1_deg"] = max(entry["g1_deg"] or 0.0, angle)
-    return sorted(report.values(), key=lambda r: int(r["edge"][4:]))
+        if name not in skip:
+            occurrences.setdefault(name, []).append(occ)
+    report = []
+    for name, occs in occurrences.items():
+        entry: dict[str, Any] = {"edge": name, "g0_mm": 0.0, "g1_deg": None, "g2_pct": None}
+        sampled = []
+        for occ in occs:
+            uv, ts = _pcurve_points(nface, occ, SEAM_SAMPLES)
+            points, tangents = _edge_samples(occ, ts)
+            values = np.array([tuple(surface.value(u, v)) for u, v in uv], float)
+            entry["g0_mm"] = max(entry["g0_mm"], float(np.linalg.norm(values - points, axis=1).max()))
+            derivatives = surface_derivatives(surface, uv)  # (its normals for G1, its curvature for g2_pct)
+            if kinds.get(name) in TANGENT:
+                normals = _unit(np.cross(derivatives[:, 0], derivatives[:, 1]))
+                was = np.array([tuple(original.normal(u, v)) for u, v in uv], float)
+                cosine = float(np.nanmin(np.einsum("ij,ij->i", normals, was)))
+                angle = float(np.degrees(np.arccos(max(-1.0, min(1.0, cosine)))))
+                entry["g1_deg"] = max(entry["g1_deg"] or 0.0, angle)
+            sampled.append((occ, uv, ts, points, tangents, derivatives))
+        edge = shape.getElement(name)
+        if not edge.Degenerated:
+            occ, uv, ts, points, tangents, derivatives = sampled[0]
+            here = curvature_across(surface, uv, sign, tangents, derivatives)
+            if len(sampled) == 2:  # the face's own seam: the sculpted surface on both sides
+                there = curvature_across(surface, sampled[1][1], sign, tangents, sampled[1][5])
+                entry["g2_pct"] = curvature_jump_pct(here, there, floor)
+            else:
+                other = _other_face(shape, face_name, edge)
+                if other is not None:
+                    there = _neighbour_curvature(other, edge, occ, ts, points, tangents)
+                    entry["g2_pct"] = curvature_jump_pct(here, there, floor)
+        report.append(entry)
+    return sorted(report, key=lambda r: int(r["edge"][4:]))
 
 
 def seam_between(surfaces: dict[str, Any], shape: Any, faces: tuple[str, str], edge: str, kind: str) -> dict[str, Any]:
     """The seam ``edge`` between two sculpted faces (``surfaces``: face name to its sculpted surface
-    in its own parameters): the largest distance between the two surfaces along it (``g0_mm``)
-    and, for G1, the largest angle (degrees) between their normals there (``g1_deg``), at
-    SEAM_SAMPLES points (the edge's pcurves on both faces share its parameter)."""
-    sides, originals = [], []
+    in its own parameters): the largest distance between the two surfaces along it (``g0_mm``),
+    for G1 the largest angle (degrees) between their normals there (``g1_deg``), and the largest
+    jump of the normal curvature across it between them (``g2_pct``, see :func:`curvature_jump_pct`),
+    at SEAM_SAMPLES points (the edge's pcurves on both faces share its parameter)."""
+    sides, originals, kappas = [], [], []
+    tangents = None
     for f in faces:
         nface = nurbs_face(shape.getElement(f))
         occ = next(o for n, o in named_occurrences(shape, f, nface) if n == edge)
         uv, ts = _pcurve_points(nface, occ, SEAM_SAMPLES)
         sign = -1.0 if nface.Orientation == "Reversed" else 1.0
         surface = surfaces[f]
+        points, along = _edge_samples(occ, ts)
+        tangents = along if tangents is None else tangents  # (one tangent for both: the same direction across)
         sides.append([(surface.value(u, v), surface.normal(u, v) * sign) for u, v in uv])
-        originals.append([occ.valueAt(t) for t in ts])
-    drift = max((a - b).Length for a, b in zip(*originals))
+        originals.append(points)
+        kappas.append(curvature_across(surface, uv, sign, tangents))
+    drift = float(np.linalg.norm(originals[0] - originals[1], axis=1).max())
     if drift > 1e-7:  # (both faces' conversions keep the edge's parameter; this says if one did not)
         raise RuntimeError(f"{edge}: the two faces' curves of it are parameterised differently ({drift:.3g} mm apart)")
     gap = max((a[0] - b[0]).Length for a, b in zip(*sides))
@@ -292,4 +457,5 @@ def seam_between(surfaces: dict[str, Any], shape: Any, faces: tuple[str, str], e
     if kind in TANGENT:
         cosines = [a[1].dot(b[1]) for a, b in zip(*sides)]
         angle = float(np.degrees(np.arccos(max(-1.0, min(1.0, min(cosines))))))
-    return {"edge": edge, "g0_mm": float(gap), "g1_deg": angle}
+    return {"edge": edge, "g0_mm": float(gap), "g1_deg": angle,
+            "g2_pct": curvature_jump_pct(kappas[0], kappas[1], _curvature_floor(shape))}

@@ -35,8 +35,10 @@ def ensure_properties(obj: Any) -> None:
             ("App::PropertyStringList", "SculptFaces", "The faces of the base that are sculpted (FaceN)", 1),
             ("App::PropertyString", "Boundary", "How each edge of those faces is held: free, G0, G1, G2 or G3 (JSON)", 1),
             ("App::PropertyLinkList", "Sculpts", "The sculpts of those faces (hidden)", 1),
-            ("App::PropertyString", "SeamReport", "Per edge: the largest gap (mm) and, for G1 edges, the largest "
-                                                  "normal angle (degrees) between the sculpted face and the seam (JSON)", 1),
+            ("App::PropertyString", "SeamReport", "Per edge: the largest gap (mm), for G1 edges the largest "
+                                                  "normal angle (degrees) between the sculpted face and the seam, and "
+                                                  "the largest jump of the normal curvature across it (g2_pct: percent "
+                                                  "of the larger |curvature| of the two sides) (JSON)", 1),
             ("App::PropertyString", "RebuildError", "Why the solid could not be rebuilt (empty when it could)", 1),
             ("App::PropertyString", "Symmetry", "The mirror plane the sculpt stays symmetric in: null, or its point, "
                                                 "normal and the parameter direction it reverses (JSON)", 1),
