@@ -109,6 +109,12 @@ wheel: deps $(WHEEL_VENV)/.installed
 	PATH=$(CURDIR)/$(WHEEL_VENV)/bin:$$PATH $(WHEEL_VENV)/bin/auditwheel repair -w $(BUILD)/wheel/dist $(BUILD)/wheel/raw/*.whl
 	@ls $(BUILD)/wheel/dist/*.whl
 
+# The other Debians' FreeCADs (tools/debian-root): on Debian 12 (FreeCAD 0.20.2, Python 3.11) those
+# are Debian 13's and forky's, on Debian 13 Debian 12's and forky's. (Defined before the first rule
+# that lists them: make expands prerequisites as it reads them.)
+HOST_SUITE  := $(shell . /etc/os-release 2>/dev/null; echo $$VERSION_CODENAME)
+OTHER_SUITES := $(filter-out $(HOST_SUITE),$(if $(filter trixie,$(HOST_SUITE)),bookworm,trixie) forky)
+
 # A wheel for every FreeCAD Python here, in $(BUILD)/wheels: this machine's and the other Debians'
 # (cp311 for FreeCAD 0.20.2, cp313 for 1.0, cp314 for 1.1.3), each built and repaired by auditwheel in
 # its own Debian, then installed into its own FreeCAD, which loads it and sculpts a stroke with it
@@ -152,8 +158,6 @@ test: test-cpp test-asan test-tsan test-python test-addon demo test-other-debian
 # checkout (tools/debian-root; rebuilt when the package list changes). Its builds, virtual
 # environments and demo go to build/<suite>/. The sanitizers run on the host only (the same code;
 # ASan and TSan builds are the slowest part), so that make test fits in an hour.
-HOST_SUITE  := $(shell . /etc/os-release 2>/dev/null; echo $$VERSION_CODENAME)
-OTHER_SUITES := $(filter-out $(HOST_SUITE),$(if $(filter trixie,$(HOST_SUITE)),bookworm,trixie) forky)
 ROOT_PACKAGES := $(APT_PACKAGES) make ca-certificates
 IN_ROOT = tools/debian-root $(1) run env HS_STRESS_SEEDS=$(STRESS_SEEDS_$(1)) make BUILD=build/$(1) DEMO_OUT=build/$(1)/demo
 # The stress test's seeds in each root: the host runs 0..9999, each root 2,000 of its own (the same

@@ -104,9 +104,10 @@ def conditions(poles: np.ndarray, weights: np.ndarray | None, knots_u: np.ndarra
 
 
 def jump_share(poles: np.ndarray, weights: np.ndarray | None, knots_u: np.ndarray, p: int, row: int, u: float,
-               edge: str, floor: float) -> float:
-    """The largest jump of the normal curvature across the seam over the columns of poles, as a
-    share of the larger of the two curvatures there (at least ``floor``, 1/length)."""
+               edge: str, floor: float, columns: np.ndarray | None = None) -> float:
+    """The largest jump of the normal curvature across the seam over the columns of poles (or the
+    ``columns`` given), as a share of the larger of the two curvatures there (at least ``floor``,
+    1/length)."""
     nu = poles.shape[0]
     a = _row_weights(weights, nu, np.arange(max(row - p - 1, 0), min(row + p + 2, nu)), edge)
     c1L, c1R, c2L, c2R = across_coefficients(knots_u, p, u, a)
@@ -116,7 +117,8 @@ def jump_share(poles: np.ndarray, weights: np.ndarray | None, knots_u: np.ndarra
     normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
     kL = np.einsum("jk,jk->j", d2L, normal) / np.einsum("jk,jk->j", d1L, d1L)
     kR = np.einsum("jk,jk->j", d2R, normal) / np.einsum("jk,jk->j", d1R, d1R)
-    return float(np.max(np.abs(kR - kL) / np.maximum(np.maximum(np.abs(kL), np.abs(kR)), floor)))
+    share = np.abs(kR - kL) / np.maximum(np.maximum(np.abs(kL), np.abs(kR)), floor)
+    return float(np.max(share if columns is None else share[columns]))
 
 
 def _slaves(held_rows: set[int], row: int, nu: int) -> tuple[int, int] | None:
