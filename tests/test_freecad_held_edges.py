@@ -15,29 +15,28 @@ from test_freecad_layer import stroke
 import HapticSculpt as hs
 
 
+def edge_lines(face, n):
+    """(u, v) at n points along each of the face's four edges, by edge."""
+    (u0, u1, v0, v1) = face.ParameterRange
+    return {"u0": [(u0, v0 + (v1 - v0) * k / (n - 1)) for k in range(n)],
+            "u1": [(u1, v0 + (v1 - v0) * k / (n - 1)) for k in range(n)],
+            "v0": [(u0 + (u1 - u0) * k / (n - 1), v0) for k in range(n)],
+            "v1": [(u0 + (u1 - u0) * k / (n - 1), v1) for k in range(n)]}
+
+
 def edge_samples(face, n=100):
     """Points and unit normals at n points along each of the face's four edges, by edge."""
-    (u0, u1, v0, v1) = face.ParameterRange
-    lines = {"u0": [(u0, v0 + (v1 - v0) * k / (n - 1)) for k in range(n)],
-             "u1": [(u1, v0 + (v1 - v0) * k / (n - 1)) for k in range(n)],
-             "v0": [(u0 + (u1 - u0) * k / (n - 1), v0) for k in range(n)],
-             "v1": [(u0 + (u1 - u0) * k / (n - 1), v1) for k in range(n)]}
     surface = face.Surface
     return {edge: (np.array([tuple(surface.value(u, v)) for u, v in uvs]),
-                   np.array([tuple(surface.normal(u, v)) for u, v in uvs])) for edge, uvs in lines.items()}
+                   np.array([tuple(surface.normal(u, v)) for u, v in uvs])) for edge, uvs in edge_lines(face, n).items()}
 
 
 def edge_derivatives(face, order, n=60):
     """(edge, k) -> the derivatives of order k (every d^k/du^a dv^b, a + b = k) at n points along
     each of the face's four edges, from the B-spline itself (getDN)."""
-    (u0, u1, v0, v1) = face.ParameterRange
-    lines = {"u0": [(u0, v0 + (v1 - v0) * k / (n - 1)) for k in range(n)],
-             "u1": [(u1, v0 + (v1 - v0) * k / (n - 1)) for k in range(n)],
-             "v0": [(u0 + (u1 - u0) * k / (n - 1), v0) for k in range(n)],
-             "v1": [(u0 + (u1 - u0) * k / (n - 1), v1) for k in range(n)]}
     surface = face.Surface
     out = {}
-    for edge, uvs in lines.items():
+    for edge, uvs in edge_lines(face, n).items():
         for k in range(order + 1):
             if k == 0:
                 out[edge, 0] = np.array([tuple(surface.value(u, v)) for u, v in uvs])

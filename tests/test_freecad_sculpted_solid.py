@@ -115,6 +115,17 @@ class SolidChecks(DocumentTestCase):
         self.doc.recompute()
         return obj
 
+    def filleted_box(self, size=(40, 30, 10), radius=4):
+        """A box whose top meets its front (y = 0) through a round of ``radius`` (the issue's block:
+        (100, 80, 30), 12): the part, its top, the round, and the edge between them."""
+        box = Part.makeBox(*size)
+        edge = next(e for e in box.Edges if abs(e.CenterOfMass.z - size[2]) < 1e-9 and abs(e.CenterOfMass.y) < 1e-9)
+        part = self.part(box.makeFillet(radius, [edge]))
+        top = face_named(part.Shape, lambda f: isinstance(f.Surface, Part.Plane) and abs(f.CenterOfMass.z - size[2]) < 1e-9)
+        round_ = face_named(part.Shape, lambda f: isinstance(f.Surface, Part.Cylinder))
+        seam = next(e.name for e in face_edges(part.Shape, top) if round_ in e.neighbours)
+        return part, top, round_, seam
+
     def reopened(self, obj, file_name):
         """``obj`` as the document saved to ``file_name``, closed and opened again, has it."""
         path, name = os.path.join(self.tmp, file_name), obj.Name
@@ -245,11 +256,7 @@ class TestSculptedSolid(SolidChecks):
         self.check_sculpted(obj, pocket, top)
 
     def test_face_next_to_a_fillet(self):
-        box = Part.makeBox(40, 30, 10)
-        edge = next(e for e in box.Edges if abs(e.CenterOfMass.z - 10) < 1e-9 and abs(e.CenterOfMass.y) < 1e-9)
-        part = self.part(box.makeFillet(4, [edge]))
-        top = face_named(part.Shape, lambda f: isinstance(f.Surface, Part.Plane) and abs(f.CenterOfMass.z - 10) < 1e-9)
-        fillet = face_named(part.Shape, lambda f: isinstance(f.Surface, Part.Cylinder))
+        part, top, fillet, _ = self.filleted_box()
         obj = hs.sculpt_solid(self.doc, part, [top], boundary="G1")
         shared = [r["edge"] for r in hs.seam_report_of(obj)
                   if part.Shape.getElement(r["edge"]).isSame(
@@ -329,16 +336,8 @@ def displaced_by_face(obj, base, names):
 
 
 class TestSeveralFaces(SolidChecks):
-    def filleted_box(self):
-        box = Part.makeBox(40, 30, 10)
-        edge = next(e for e in box.Edges if abs(e.CenterOfMass.z - 10) < 1e-9 and abs(e.CenterOfMass.y) < 1e-9)
-        part = self.part(box.makeFillet(4, [edge]))
-        top = face_named(part.Shape, lambda f: isinstance(f.Surface, Part.Plane) and abs(f.CenterOfMass.z - 10) < 1e-9)
-        fillet = face_named(part.Shape, lambda f: isinstance(f.Surface, Part.Cylinder))
-        return part, top, fillet
-
     def test_a_top_and_its_fillet_sculpted_as_one_stay_tangent_across_the_seam(self):
-        part, top, fillet = self.filleted_box()
+        part, top, fillet, _ = self.filleted_box()
         obj = hs.sculpt_solid(self.doc, part, [top, fillet], boundary="G1")
         seam = next(e.name for e in face_edges(part.Shape, top) if fillet in e.neighbours)
         self.assertEqual(hs.boundary_of(obj)[seam], "G1")  # they meet tangentially
@@ -371,7 +370,7 @@ class TestSeveralFaces(SolidChecks):
         sides) the sculpted top has the base's derivatives up to the second (its curvature across
         the edge: the round and the sides meet it as they met the base, to second order); G3 up to
         the third. (Seams between faces sculpted together: test_freecad_g2_seams.py.)"""
-        part, top, fillet = self.filleted_box()
+        part, top, fillet, _ = self.filleted_box()
         obj = hs.sculpt_solid(self.doc, part, [top], boundary="G2", controls=(10, 10))
         self.assertEqual(set(hs.boundary_of(obj).values()), {"G2"})
         base = reference = nurbs_face(part.Shape.getElement(top)).Surface
@@ -439,7 +438,7 @@ class TestSeveralFaces(SolidChecks):
         self.assertAlmostEqual(after / before, 1.5, delta=0.03)
 
     def test_faces_that_cannot_be_joined_are_refused(self):
-        part, top, fillet = self.filleted_box()
+        part, top, fillet, _ = self.filleted_box()
         bottom = face_named(part.Shape, lambda f: abs(f.CenterOfMass.z) < 1e-9)
         ends = [f"Face{k + 1}" for k, f in enumerate(part.Shape.Faces) if abs(f.CenterOfMass.x) < 1e-9
                 or abs(f.CenterOfMass.x - 40) < 1e-9]
@@ -711,16 +710,6 @@ class TestCurvatureAcrossEdges(SolidChecks):
         self.assertEqual(curvature_jump_pct([0.1, np.nan], [0.1, 0.2], 1e-6), 0.0)  # (NaN: a singular point, left out)
         self.assertIsNone(curvature_jump_pct([np.nan], [0.1], 1e-6))
 
-    def rounded_block(self):
-        """A 100 x 80 x 30 block whose top meets the front through a 12 mm round."""
-        box = Part.makeBox(100, 80, 30)
-        edge = next(e for e in box.Edges if abs(e.CenterOfMass.z - 30) < 1e-9 and abs(e.CenterOfMass.y) < 1e-9)
-        part = self.part(box.makeFillet(12, [edge]))
-        top = face_named(part.Shape, lambda f: isinstance(f.Surface, Part.Plane) and abs(f.CenterOfMass.z - 30) < 1e-9)
-        round_ = face_named(part.Shape, lambda f: isinstance(f.Surface, Part.Cylinder))
-        seam = next(e.name for e in face_edges(part.Shape, top) if round_ in e.neighbours)
-        return part, top, round_, seam
-
     def fd_jump(self, shape, face_a, surface_a, face_b, surface_b, edge, base_b=False):
         """g2_pct by :func:`fd_curvature_across` on both sides; ``base_b``: side b is the base's own
         face (its own surface, its (u, v) by projecting the points on it)."""
@@ -741,7 +730,7 @@ class TestCurvatureAcrossEdges(SolidChecks):
         """The top sculpted alone, held G2: beside the round (not sculpted) the top is flat across the
         edge and the round curves 1/12: 100 %, before and after a stroke (G2 keeps the top's own
         curvature there); the creases with the flat sides are finite numbers."""
-        part, top, round_, seam = self.rounded_block()
+        part, top, round_, seam = self.filleted_box((100, 80, 30), 12)
         obj = hs.sculpt_solid(self.doc, part, [top], boundary="G2", controls=(10, 10))
         self.assertAlmostEqual(report_entry(obj, seam)["g2_pct"], 100.0, delta=0.01)
         pull(obj, mass_point_near(obj, 50, 45), (0, 0, 8))
@@ -760,7 +749,7 @@ class TestCurvatureAcrossEdges(SolidChecks):
     def test_a_seam_between_sculpted_faces_reports_the_curvature_jump(self):
         """The top and the round sculpted as one (their seam G1): the base's jump is 100 % and stays
         about that after a stroke across it (recorded, and checked by finite differences)."""
-        part, top, round_, seam = self.rounded_block()
+        part, top, round_, seam = self.filleted_box((100, 80, 30), 12)
         obj = hs.sculpt_solid(self.doc, part, [top, round_])
         self.assertEqual(hs.boundary_of(obj)[seam], "G1")
         self.assertAlmostEqual(report_entry(obj, seam)["g2_pct"], 100.0, delta=0.01)

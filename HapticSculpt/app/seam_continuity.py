@@ -76,14 +76,20 @@ def _row_weights(weights: np.ndarray | None, nu: int, rows: np.ndarray, edge: st
     return a
 
 
+def _coefficients(poles: np.ndarray, weights: np.ndarray | None, knots_u: np.ndarray, p: int, row: int, u: float,
+                  edge: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """across_coefficients for the net's seam at ``row`` (its row weights checked around it)."""
+    nu = poles.shape[0]
+    a = _row_weights(weights, nu, np.arange(max(row - p - 1, 0), min(row + p + 2, nu)), edge)
+    return across_coefficients(knots_u, p, u, a)
+
+
 def conditions(poles: np.ndarray, weights: np.ndarray | None, knots_u: np.ndarray, p: int, row: int, u: float,
                edge: str) -> tuple[np.ndarray, np.ndarray, float]:
     """The G1 and G2 conditions of every column as coefficient rows over the net's rows: (g1 of
     shape (nu,), g2 of shape (nv, nu): its beta differs per column), and alpha. ValueError when
     the faces do not meet tangentially with one ratio of speeds (G1 is the least G2 needs)."""
-    nu, nv = poles.shape[:2]
-    a = _row_weights(weights, nu, np.arange(max(row - p - 1, 0), min(row + p + 2, nu)), edge)
-    c1L, c1R, c2L, c2R = across_coefficients(knots_u, p, u, a)
+    c1L, c1R, c2L, c2R = _coefficients(poles, weights, knots_u, p, row, u, edge)
     d1L, d1R = np.einsum("i,ijk->jk", c1L, poles), np.einsum("i,ijk->jk", c1R, poles)
     nL, nR = np.linalg.norm(d1L, axis=1), np.linalg.norm(d1R, axis=1)
     if np.any(nL <= 0) or np.any(nR <= 0):
@@ -108,9 +114,7 @@ def jump_share(poles: np.ndarray, weights: np.ndarray | None, knots_u: np.ndarra
     """The largest jump of the normal curvature across the seam over the columns of poles (or the
     ``columns`` given), as a share of the larger of the two curvatures there (at least ``floor``,
     1/length)."""
-    nu = poles.shape[0]
-    a = _row_weights(weights, nu, np.arange(max(row - p - 1, 0), min(row + p + 2, nu)), edge)
-    c1L, c1R, c2L, c2R = across_coefficients(knots_u, p, u, a)
+    c1L, c1R, c2L, c2R = _coefficients(poles, weights, knots_u, p, row, u, edge)
     d1L, d1R = np.einsum("i,ijk->jk", c1L, poles), np.einsum("i,ijk->jk", c1R, poles)
     d2L, d2R = np.einsum("i,ijk->jk", c2L, poles), np.einsum("i,ijk->jk", c2R, poles)
     normal = np.cross(d1L, np.gradient(poles[row], axis=0))
