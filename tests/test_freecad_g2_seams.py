@@ -163,7 +163,7 @@ class TestG2Seams(SolidChecks):
             mesh = np.array(s.mesh)
             start = mesh[mesh.shape[0] // 2, mesh.shape[1] // 2].copy()
             nv = poles.shape[1]
-            linked = sorted({pole % nv for pole, _ in s.linked_poles})  # (the end columns are held)
+            linked = sorted({pole % nv for pole, *_ in s.linked_poles})  # (the end columns are held)
             worst = 0.0
             for k in range(1000):
                 s.set_cursor(list(start + [0.0, 0.0, min(6.0, 0.02 * k)]), grab=True)

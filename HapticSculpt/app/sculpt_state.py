@@ -126,10 +126,27 @@ def capture(surface: core.DynamicSurface) -> SculptState:
         "tool": tool_settings(surface),
         "constraints": constraints,
         "held_poles": list(surface.held_poles),
-        "linked_poles": [[pole, [[m, w] for m, w in masters]] for pole, masters in surface.linked_poles],
+        "linked_poles": [_link_settings(link) for link in surface.linked_poles],
         "symmetry": _symmetry_settings(surface),
     }
     return SculptState(arrays, settings)
+
+
+def _link_settings(link: Any) -> list[Any]:
+    """[pole, [[master, weight], ...]] and the offset where it is not zero (a curve's conditions)."""
+    pole, masters, offset = link
+    out = [pole, [[m, w] for m, w in masters]]
+    if any(offset):
+        out.append(list(offset))
+    return out
+
+
+def _link_from_settings(link: Any) -> tuple[Any, ...]:
+    """(pole, [(master, weight), ...][, offset]) from its JSON form (files before curves have no offset)."""
+    if not isinstance(link, list) or len(link) not in (2, 3):
+        raise ValueError(f"not a link: {link!r}")
+    made = (int(link[0]), [(int(m), float(w)) for m, w in link[1]])
+    return made + (tuple(float(x) for x in link[2]),) if len(link) == 3 else made
 
 
 def _symmetry_settings(surface: core.DynamicSurface) -> dict[str, Any] | None:
@@ -216,9 +233,9 @@ def restore(state: SculptState) -> core.DynamicSurface:
         raise ValueError(f"SculptSettings.held_poles: expected a list of pole indices, got {held!r}")
     links = s.get("linked_poles", [])
     try:
-        links = [(int(pole), [(int(m), float(w)) for m, w in masters]) for pole, masters in links]
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"SculptSettings.linked_poles: expected [[pole, [[master, weight], ...]], ...], "
+        links = [_link_from_settings(link) for link in links]
+    except (TypeError, ValueError, IndexError) as exc:
+        raise ValueError(f"SculptSettings.linked_poles: expected [[pole, [[master, weight], ...], offset?], ...], "
                          f"got {links!r}") from exc
     try:
         surface.hold_poles(held, links)

@@ -100,22 +100,29 @@ void bindDynamicSurface(py::module_& m) {
         .def("set_velocities", [](DynamicSurface& s, DoubleArray v) {
             s.setVelocities(pointsFrom(v, s.poles().rows(), "velocities"));
         }, py::arg("velocities"))
-        .def("hold_poles", [](DynamicSurface& s, const std::vector<int>& indices,
-                              const std::vector<std::pair<int, std::vector<std::pair<int, double>>>>& links) {
+        .def("hold_poles", [](DynamicSurface& s, const std::vector<int>& indices, const py::list& links) {
             std::vector<PoleLink> made;
             made.reserve(links.size());
-            for (const auto& [pole, masters] : links) made.push_back({pole, masters});
+            for (const py::handle item : links) {
+                const auto parts = item.cast<py::sequence>();
+                if (parts.size() != 2 && parts.size() != 3)
+                    throw py::value_error("links: each link is (pole, [(master, weight), ...]) or (pole, masters, offset)");
+                PoleLink l{parts[0].cast<int>(), parts[1].cast<std::vector<std::pair<int, double>>>()};
+                if (parts.size() == 3) l.offset = vec3(parts[2].cast<std::vector<double>>(), "link offset");
+                made.push_back(std::move(l));
+            }
             s.holdPoles(indices, made);
-        }, py::arg("indices"), py::arg("links") = std::vector<std::pair<int, std::vector<std::pair<int, double>>>>{},
+        }, py::arg("indices"), py::arg("links") = py::list(),
              "Hard constraints: these poles (index i*nv + j for pole (i, j)) stay exactly where they are, "
-             "the others move as if they were walls; each link (pole, [(master, weight), ...]) keeps a pole at "
-             "that combination of its masters (put there at once). Replaces both; [] frees them all.")
+             "the others move as if they were walls; each link (pole, [(master, weight), ...][, offset]) keeps a "
+             "pole at offset + that combination of its masters (put there at once). Replaces both; [] frees them all.")
         .def_property_readonly("held_poles", &DynamicSurface::heldPoles, "Indices of the held poles, ascending.")
         .def_property_readonly("linked_poles", [](const DynamicSurface& s) {
-            std::vector<std::pair<int, std::vector<std::pair<int, double>>>> out;
-            for (const PoleLink& l : s.linkedPoles()) out.emplace_back(l.pole, l.masters);
+            py::list out;
+            for (const PoleLink& l : s.linkedPoles())
+                out.append(py::make_tuple(l.pole, l.masters, py::make_tuple(l.offset.x(), l.offset.y(), l.offset.z())));
             return out;
-        }, "The linked poles: [(pole, [(master, weight), ...]), ...]")
+        }, "The linked poles: [(pole, [(master, weight), ...], (ox, oy, oz)), ...]")
         .def("set_symmetry", [](DynamicSurface& s, int direction, const std::vector<double>& point, const std::vector<double>& normal) {
             s.setSymmetry(direction, vec3(point, "symmetry point"), vec3(normal, "symmetry normal"));
         }, py::arg("direction"), py::arg("point"), py::arg("normal"),

@@ -23,6 +23,7 @@ void HeldPoles::set(const std::vector<int>& indices, const std::vector<PoleLink>
         if (mask[static_cast<std::size_t>(l.pole)] == 1) throw std::invalid_argument(name(l.pole) + " is held");
         if (mask[static_cast<std::size_t>(l.pole)] == 2) throw std::invalid_argument(name(l.pole) + " is linked twice");
         if (l.masters.empty()) throw std::invalid_argument(name(l.pole) + " has no masters");
+        if (!l.offset.allFinite()) throw std::invalid_argument(name(l.pole) + ": offset must be finite");
         mask[static_cast<std::size_t>(l.pole)] = 2;
     }
     for (const PoleLink& l : links)
@@ -45,7 +46,7 @@ void HeldPoles::set(const std::vector<int>& indices, const std::vector<PoleLink>
         t_.resize(n, n);
         t_.setFromTriplets(t.begin(), t.end());
         for (const PoleLink& l : links_) {
-            Vec3 p = Vec3::Zero();
+            Vec3 p = l.offset;
             for (const auto& [m, w] : l.masters) p += w * poles.row(m).transpose();
             poles.row(l.pole) = p.transpose();
         }
@@ -113,7 +114,7 @@ bool HeldPoles::snap(Points& poles, Points& velocities) const {
         velocities.row(i).setZero();
     }
     for (const PoleLink& l : links_) {
-        Vec3 p = Vec3::Zero(), v = Vec3::Zero();
+        Vec3 p = l.offset, v = Vec3::Zero();
         for (const auto& [m, w] : l.masters) {
             p += w * poles.row(m).transpose();
             v += w * velocities.row(m).transpose();

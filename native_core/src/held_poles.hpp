@@ -2,7 +2,9 @@
 // others. A face sculpted in place keeps its boundary (G0: the poles on it) and its tangent planes
 // there (G1: the next row too), so its neighbours still meet it to the last bit, which no penalty
 // achieves. Faces sculpted as one surface keep their tangent planes across their seam: each pole
-// on the seam stays an affine combination of its neighbours across it (P_s = sum w_k P_k).
+// on the seam stays an affine combination of its neighbours across it (P_s = sum w_k P_k). A surface
+// that must pass through a curve keeps exact linear conditions A P = B on its poles: some poles
+// follow the others plus a constant (P_s = o + sum w_k P_k).
 #pragma once
 #include <Eigen/Sparse>
 #include <cstdint>
@@ -13,10 +15,11 @@
 
 namespace hs {
 
-/// A pole that follows others: P_pole = sum of weight * P_master.
+/// A pole that follows others: P_pole = offset + sum of weight * P_master.
 struct PoleLink {
     int pole = -1;
     std::vector<std::pair<int, double>> masters;
+    Vec3 offset = Vec3::Zero();
 };
 
 /// The control-space systems are solved in the free poles z, with P = T z (+ the held positions):
@@ -36,7 +39,7 @@ public:
     /// Holds the poles at `indices` (any order, repeats allowed; each in 0..poles-1, else
     /// std::invalid_argument naming "indices") at their positions in `poles`, and links `links`
     /// (std::invalid_argument naming "links" for a pole out of range, held, linked twice, or a
-    /// master that is itself linked, no masters, a weight not finite); empty lists free all. The
+    /// master that is itself linked, no masters, a weight or offset not finite); empty lists free all. The
     /// linked poles are put onto their masters at once (`poles` is updated).
     void set(const std::vector<int>& indices, const std::vector<PoleLink>& links, Points& poles);
     /// Takes the held poles' positions from `poles` again (after the whole net was replaced: undo,

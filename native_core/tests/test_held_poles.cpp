@@ -286,6 +286,35 @@ TEST_P(HeldPolesTest, LinkedPolesKeepTheTangentPlaneAcrossASeam) {
     }
 }
 
+// A curve the surface must pass through is an affine condition A P = B: linked poles with an offset.
+TEST_P(HeldPolesTest, LinkedPolesWithAnOffsetKeepTheirConditionExactly) {
+    const Scheme setup = GetParam();
+    auto made = twoPatches();
+    DynamicSurface& s = *made;
+    configure(s, setup);
+    std::vector<PoleLink> links = seamLinks();
+    for (PoleLink& l : links) l.offset = Vec3(0.0, 0.25, 2.0);
+    s.holdPoles(outerRing(), links);
+    for (const PoleLink& l : links)  // put there at once
+        EXPECT_NEAR(s.poles()(l.pole, 2), 0.5 * (s.poles()(l.pole - 8, 2) + s.poles()(l.pole + 8, 2)) + 2.0, 1e-12);
+    Cursor c;
+    c.position = Vec3(-20, 0, 0);
+    c.grab = true;
+    for (int k = 0; k < 1000; ++k) {
+        c.position.z() = std::min(15.0, 0.1 * k);
+        s.setCursor(c);
+        const StepReport r = s.step(setup.dt);
+        ASSERT_FALSE(r.refused) << setup.name << ": " << r.reason;
+        ASSERT_TRUE(s.poles().allFinite()) << setup.name;
+    }
+    for (const PoleLink& l : links) {
+        Vec3 p = l.offset;
+        for (const auto& [m, w] : l.masters) p += w * s.poles().row(m).transpose();
+        EXPECT_EQ(s.poles().row(l.pole), p.transpose()) << setup.name;
+    }
+    EXPECT_GT(s.poles()(3 * 8 + 4, 2), 3.0) << setup.name << ": the linked poles moved with the stroke";
+}
+
 TEST_P(HeldPolesTest, SteppingWithLinkedPolesDoesNotAllocate) {
     const Scheme setup = GetParam();
     auto made = twoPatches();
@@ -306,6 +335,7 @@ TEST(HeldPoles, BadLinksAreRefusedByName) {
         {{{26, {{26, 1.0}}}}, "master 26 is not another pole"},
         {{{26, {{27, 1.0}}}, {27, {{28, 1.0}}}}, "master 27 is linked itself"},
         {{{26, {{27, std::nan("")}}}}, "weights must be finite"},
+        {{{26, {{27, 1.0}}, Vec3(0, std::nan(""), 0)}}, "offset must be finite"},
     };
     for (const auto& [links, text] : cases) {
         try {
