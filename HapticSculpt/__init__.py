@@ -31,6 +31,7 @@ from .app.api import (
                       thicken,
                       to_cadquery,
 )
+from .app.curve_api import add_curve_constraint, curve_constraints_of
 from .app.sculpted_solid import boundary_of, seam_report_of
 from .app.solid_api import sculpt_solid, set_boundary
 from .runtime.replay_device import CursorSample, ReplayDevice
@@ -39,7 +40,8 @@ from .version import __version__
 
 legacy_paths.install()
 
-__all__ = ["make_sculpt", "fair", "sculpt_solid", "set_boundary", "boundary_of", "seam_report_of", "run", "add_constraint", "remove_constraint", "hold_boundary", "held_boundary",
+__all__ = ["make_sculpt", "fair", "sculpt_solid", "set_boundary", "boundary_of", "seam_report_of", "run", "add_constraint", "add_curve_constraint",
+           "curve_constraints_of", "remove_constraint", "hold_boundary", "held_boundary",
            "set_material", "material_of", "keep_shape",
            "set_tool", "set_uniform", "set_curvature_target", "paint", "record_state", "replay_stroke",
            "export_step", "thicken", "make_thickness",

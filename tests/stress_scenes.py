@@ -22,6 +22,7 @@ import math
 import numpy as np
 
 from HapticSculpt import core
+from HapticSculpt.app import curve_constraint
 
 # Energy bound: semi-implicit Euler and the linearised implicit step exchange energy between kinetic
 # and potential at O(w dt), and work is accumulated with forces held over a step, so the bound has a
@@ -230,6 +231,22 @@ def run_scene(seed: int, steps: int = STEPS) -> SceneResult:
                 mirrored = True
             except ValueError:
                 pass  # (a shape that is not symmetric: refused, as it must be)
+        # A curve the surface must follow (G0 or G1: links with offsets from a least-squares
+        # elimination) in a third of the scenes left, from a stream of its own; refused with a
+        # reason where the net cannot follow it.
+        curve_rng = np.random.default_rng([seed, 4])
+        if not held and not links and not mirrored and curve_rng.random() < 0.33:
+            corners = curve_rng.uniform(-45, 45, (int(curve_rng.integers(2, 5)), 2))
+            points = np.column_stack([corners, np.zeros(len(corners))])
+            try:
+                _, moved, links = curve_constraint.make(s, points, ("G0", "G1")[int(curve_rng.integers(0, 2))], None,
+                                                        curve_constraint.FIRST_ID, [], [])
+                s.set_poles(moved.reshape(np.array(s.poles).shape))
+                s.hold_poles([], links)
+            except ValueError as exc:
+                if "curve" not in str(exc):
+                    res.failure = f"a curve constraint refused without saying why: {exc}"
+                    return res
         energy0 = _energy(s)
         work_in = 0.0
         last_work = s.work_done
@@ -263,9 +280,10 @@ def run_scene(seed: int, steps: int = STEPS) -> SceneResult:
             p = np.array(s.poles)
             flat = p.reshape(-1, 3)
             # (to rounding: the core's sums are fused multiply-adds)
-            if links and any(np.abs(flat[pole] - sum(w * flat[m] for m, w in masters)).max()
-                             > 1e-13 * sum(abs(w) for _, w in masters) * max(1.0, np.abs(flat).max())
-                             for pole, masters in links):
+            if links and any(np.abs(flat[link[0]] - sum(w * flat[m] for m, w in link[1])
+                                    - (link[2] if len(link) > 2 else 0.0)).max()
+                             > 1e-13 * (sum(abs(w) for _, w in link[1]) + 1) * max(1.0, np.abs(flat).max())
+                             for link in links):
                 res.failure = f"a linked pole left its masters in step {k}"
                 return res
             if mirrored and not np.array_equal(p[::-1] * [-1.0, 1.0, 1.0], p):

@@ -15,7 +15,7 @@ from typing import Any, Callable, Iterable, Protocol, Sequence
 import numpy as np
 
 from .. import core
-from . import recorded_state, sculpt_state, stroke_log
+from . import curve_api, recorded_state, sculpt_state, stroke_log
 from .sculpt_feature import SculptFeature, attach_view_provider, is_sculpt
 from .sculpt_properties import face_of, read_state
 from .sculpted_solid import is_sculpted_solid, sculpt_of
@@ -497,8 +497,11 @@ def add_constraint(obj: Any, kind: str, uv: tuple[float, float] | None = None,
 
 
 def remove_constraint(obj: Any, cid: int) -> None:
-    """Removes constraint ``cid`` (one undo transaction)."""
+    """Removes constraint ``cid``, a penalty constraint or a curve constraint (one undo transaction)."""
     obj = _sculpt(obj, solids=True)
+    if curve_api.is_curve_id(cid):
+        curve_api.remove_curve_constraint(obj, cid)
+        return
     obj.Proxy.live.edit(lambda s: s.remove_constraint(cid), "Remove constraint")
 
 
@@ -553,11 +556,26 @@ def hold_boundary(obj: Any, boundary: Any = "G0") -> list[int]:
     curvature across it too (a face beside it met as it does now, to second order), "G3" that
     curvature's rate too, "free" lets it move. ``boundary`` is one of those for all four edges, or a dict from edge ("u0", "u1", "v0",
     "v1": the sides of the parameter domain) to one of them, the others free. Replaces what was held
-    before. One undo transaction (also during a session); returns the held pole indices."""
+    before; curve constraints hold on top of it (ValueError naming one that cannot). One undo
+    transaction (also during a session, unless the sculpt follows curves); returns the held pole indices."""
     _sculpt(obj)
-    controls = tuple(obj.Proxy.live.snapshot().surface.controls)
-    held = boundary_poles(controls, boundary)  # validated before the document changes
-    obj.Proxy.live.edit(lambda s: s.hold_poles(held, s.linked_poles), "Hold edges")  # (links kept)
+    live = obj.Proxy.live
+    snapshot = live.snapshot()
+    held = boundary_poles(tuple(snapshot.surface.controls), boundary)  # validated before the document changes
+    if not curve_api.records_of(obj):
+        live.edit(lambda s: s.hold_poles(held, s.linked_poles), "Hold edges")  # (links kept)
+        return held
+    if live.session is not None:
+        raise RuntimeError(f"{obj.Label}: stop the sculpting session before holding the edges of a sculpt that "
+                           "follows curves")
+    poles = np.asarray(snapshot.poles, float).reshape(-1, 3)
+    moved, links, write = curve_api.rehold(obj, snapshot, held, curve_api.base_links(obj, snapshot), poles)
+
+    def change(s: core.DynamicSurface) -> None:
+        if not np.array_equal(moved, poles):
+            s.set_poles(moved.reshape(np.asarray(s.poles).shape))
+        s.hold_poles(held, links)
+    live.edit(change, "Hold edges", inside=write)  # (the curves held again on top of the edges)
     return held
 
 

@@ -19,6 +19,7 @@ import numpy as np
 from .. import core
 from . import face_in_solid, sculpt_state
 from .face_chain import FaceChain, chain_of
+from .curve_constraint import PROPERTY, records_of
 from .face_net import face_held, face_source, mirror_of, seam_links
 from .sculpt_properties import face_of, read_state, write_state
 
@@ -100,7 +101,7 @@ def follow_base(obj: Any, shape: Any) -> bool:
     arrays = dict(old.arrays, Poles=moved.arrays["Poles"], Velocities=np.zeros_like(moved.arrays["Poles"]),
                   KnotsU=moved.arrays["KnotsU"], KnotsV=moved.arrays["KnotsV"], Weights=moved.arrays["Weights"],
                   RestLengths=rest)
-    dropped = len(old.settings.get("constraints", []))
+    dropped = len(old.settings.get("constraints", [])) + len(records_of(sculpt))
     settings = dict(old.settings, controls=list(new_source.controls), held_poles=held, constraints=[],
                     linked_poles=[[p, [list(m) for m in masters]] for p, masters in links],
                     reference=moved.settings["reference"])
@@ -110,6 +111,8 @@ def follow_base(obj: Any, shape: Any) -> bool:
     live.writing = True
     try:
         write_state(sculpt, state)
+        if getattr(sculpt, PROPERTY, ""):
+            setattr(sculpt, PROPERTY, "")  # (its curves' conditions were on the old net)
         sculpt.Shape = face_of(state)
     finally:
         live.writing = False

@@ -30,6 +30,8 @@ def ensure_properties(obj: Any) -> bool:
              for name in sculpt_state.ARRAY_NAMES]
     added.append(_add_property(obj, "App::PropertyString", "SculptSettings", "Sculpt state: sampling, maps, "
                                "constraints, tool and integrator settings (JSON)", 2))
+    added.append(_add_property(obj, "App::PropertyString", "CurveConstraints", "Curves the surface must follow: "
+                               "their conditions (JSON; the links that hold them are in SculptSettings)", 2))
     added.append(_add_property(obj, "App::PropertyString", "SourceDescription", "What the surface was made from", 1))
     added.append(_add_property(obj, "App::PropertyString", "ConversionMethod", "plane, exact or approximated", 1))
     added.append(_add_property(obj, "App::PropertyFloat", "ConversionError",

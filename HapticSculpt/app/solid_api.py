@@ -9,7 +9,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from .. import core
-from . import face_chain, face_in_solid, face_symmetry, sculpt_state
+from . import curve_api, face_chain, face_in_solid, face_symmetry, sculpt_state
 from .api import _add_sculpt, _checked_resolution, _document, _material, _sculpt_state
 from .source_surface import SourceSurface
 from .face_net import TRIM_SPANS, Mirror, face_held, face_source, g2_net, mirror_of, seam_kinds, seam_links
@@ -204,10 +204,15 @@ def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
     if live.session is not None:
         raise RuntimeError(f"{obj.Label}: stop the sculpting session before changing how its edges are held")
     surface = live.surface
+    shape = np.asarray(made.surface.poles).shape
+    # (a G2 seam made so: the least move; the curves it follows held again on top: ValueError first)
+    poles, links, write_curves = curve_api.rehold(sculpt, surface, held, links,
+                                                  np.asarray(made.surface.poles, float).reshape(-1, 3))
     with transaction(obj.Document, "Hold edges"):
-        surface.set_poles(np.asarray(made.surface.poles))  # (a G2 seam made so: the least move)
+        surface.set_poles(poles.reshape(shape))
         surface.hold_poles(held, links)
         live.write(sculpt_state.capture(surface))
+        write_curves()
         obj.Boundary = json.dumps(kinds)
         rebuild(obj)
     return kinds

@@ -1,0 +1,561 @@
+"""Curves a sculpt must follow: exact linear conditions on its poles, held like held poles.
+
+A curve is bound to the surface along its preimage ``(u_k, v_k)``, k = 1..K, the parameters of its
+samples' closest points when it is added. With the weights fixed (the core never changes them) the
+surface at a fixed parameter is linear in the poles, ``S(u_k, v_k) = a_k . P``, and so is its
+derivative in a fixed direction ``S_d = d_k . P``. The constraint is then ``A P = B``:
+
+- **G0**: ``a_k . P = C_k``, the curve's samples;
+- **G1**: also ``d_k . P = D_k``, with ``d_k`` the parameter direction whose derivative is
+  perpendicular to the curve in the tangent plane, and ``D_k`` that derivative turned into the
+  plane perpendicular to the normal asked for. The whole cross derivative is held, so the normal
+  along the curve stays what it is (a designer's G1 edge holds its second row the same way).
+
+Adding one moves the poles as little as possible (least squares, minimal norm over the free poles)
+so the conditions hold. Then ``r = rank(A)`` of the free poles near the curve follow the others:
+``P_s = o + sum w P_m`` (:class:`core.DynamicSurface` links with an offset), chosen by column
+pivoting among the poles that no other link depends on, so every stroke keeps the conditions
+exactly, in every integrator. Held poles and other links are substituted first. With more samples
+than the surface has freedom along the curve (at least degree_u + degree_v + 1 per knot cell it
+crosses), the surface keeps the whole curve, not only the samples, where the curve's restriction
+is in its space (a line of the domain), and within the check's tolerance elsewhere.
+
+Plain numpy, no FreeCAD but for reading a curve from a shape or a document object.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .. import core
+
+CONTINUITIES = ("G0", "G1")
+#: The Sculpt's document property that holds its curve constraints (JSON).
+PROPERTY = "CurveConstraints"
+#: Curve constraint ids start here (penalty constraints count from 0 in the core).
+FIRST_ID = 1_000_000
+#: Points along the curve the surface is checked at (and the fewest conditions).
+SAMPLES = 200
+#: A curve farther than this share of the surface's size is refused rather than pulled onto.
+MAX_DISTANCE_SHARE = 0.25
+#: G0 holds when the surface passes within this share of its size of the curve.
+G0_SHARE = 1e-6
+#: G1 holds when the normal along the curve is within this angle of the one asked for (degrees).
+G1_DEGREES = 0.01
+#: Link weights below this are rounding (dropped; the offsets absorb them).
+_WEIGHT_FLOOR = 1e-12
+
+
+@dataclass
+class CurveConstraint:
+    """One curve constraint as the document stores it (JSON): its conditions and the poles that
+    follow (``slaves``)."""
+
+    id: int
+    continuity: str
+    label: str
+    uv: np.ndarray                 # (K, 2) the preimage
+    points: np.ndarray             # (K, 3) where the surface passes there
+    across: np.ndarray | None = None       # (K, 2) G1: the parameter direction across the curve
+    derivatives: np.ndarray | None = None  # (K, 3) G1: the derivative held there
+    normal: list[float] | None = None      # G1: the normal asked for (None: the surface's own)
+    slaves: list[int] = field(default_factory=list)
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON form (floats round-trip exactly)."""
+        out: dict[str, Any] = {"id": self.id, "continuity": self.continuity, "label": self.label,
+                               "uv": self.uv.tolist(), "points": self.points.tolist(), "slaves": list(self.slaves)}
+        if self.continuity == "G1":
+            out.update(across=self.across.tolist(), derivatives=self.derivatives.tolist(), normal=self.normal)
+        return out
+
+    @classmethod
+    def from_json(cls, item: dict[str, Any]) -> "CurveConstraint":
+        """From :meth:`to_json`'s form; ValueError naming what is malformed."""
+        try:
+            made = cls(int(item["id"]), str(item["continuity"]), str(item.get("label", "")),
+                       _array(item["uv"], 2), _array(item["points"], 3), slaves=[int(i) for i in item["slaves"]])
+            if made.continuity == "G1":
+                made.across, made.derivatives = _array(item["across"], 2), _array(item["derivatives"], 3)
+                made.normal = None if item.get("normal") is None else [float(x) for x in item["normal"]]
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ValueError(f"CurveConstraints: malformed curve constraint: {exc}") from exc
+        if made.continuity not in CONTINUITIES or len(made.uv) != len(made.points):
+            raise ValueError(f"CurveConstraints: malformed curve constraint {made.id}")
+        return made
+
+
+def _array(values: Any, width: int) -> np.ndarray:
+    a = np.asarray(values, dtype=float)
+    if a.ndim != 2 or a.shape[1] != width or not np.all(np.isfinite(a)):
+        raise ValueError(f"expected finite rows of {width} numbers")
+    return a
+
+
+def records_from_json(text: str) -> list[CurveConstraint]:
+    """The curve constraints stored in a ``CurveConstraints`` property ("" or a JSON list)."""
+    if not text:
+        return []
+    try:
+        items = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"CurveConstraints: malformed JSON ({exc})") from exc
+    if not isinstance(items, list):
+        raise ValueError("CurveConstraints: expected a JSON list")
+    return [CurveConstraint.from_json(item) for item in items]
+
+
+def records_of(sculpt: Any) -> list[CurveConstraint]:
+    """The curve constraints a Sculpt holds (none for files from before them)."""
+    return records_from_json(getattr(sculpt, PROPERTY, ""))
+
+
+def records_to_json(records: list[CurveConstraint]) -> str:
+    """The ``CurveConstraints`` property's text."""
+    return json.dumps([r.to_json() for r in records], allow_nan=False) if records else ""
+
+
+# --- the curve ----------------------------------------------------------------------------------
+
+def curve_points(curve: Any, count: int) -> tuple[np.ndarray, str]:
+    """``count`` points evenly along ``curve`` (by length) and a label for it. ``curve`` is a
+    document object with one edge or one wire (a Sketch, a Part feature, a Draft wire), a
+    ``Part.Edge`` or ``Part.Wire``, or a list of points (the smooth curve through them)."""
+    label = ""
+    if hasattr(curve, "Shape") and hasattr(curve, "Document"):
+        label = str(curve.Label)
+        curve = curve.Shape
+    if hasattr(curve, "ShapeType"):  # a Part shape
+        shape = curve
+        if shape.ShapeType not in ("Edge", "Wire"):
+            wires, edges = list(getattr(shape, "Wires", [])), list(getattr(shape, "Edges", []))
+            if len(wires) == 1 and len(wires[0].Edges) == len(edges):
+                shape = wires[0]
+            elif len(edges) == 1:
+                shape = edges[0]
+            else:
+                raise ValueError(f"curve: {label or 'the shape'} has {len(edges)} edges in {len(wires)} wires; "
+                                 "give one edge or one connected wire")
+        if shape.Length <= 0:
+            raise ValueError(f"curve: {label or 'the shape'} has no length")
+        points = np.array([[p.x, p.y, p.z] for p in shape.discretize(Number=count)], dtype=float)
+        return points, label or shape.ShapeType
+    try:
+        points = np.asarray(curve, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise TypeError("curve: expected a document object with one edge or wire, a Part.Edge or Part.Wire, "
+                        f"or a list of points, not {type(curve).__name__}") from exc
+    if points.ndim != 2 or points.shape[1] != 3 or len(points) < 2:
+        raise ValueError(f"curve: expected at least two points (x, y, z), got an array of shape {points.shape}")
+    if not np.all(np.isfinite(points)):
+        raise ValueError("curve: the points contain NaN or Inf")
+    step = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    points = points[np.concatenate([[True], step > 0])]  # (repeated points say nothing)
+    if len(points) < 2:
+        raise ValueError("curve: the points are all the same; a curve needs length")
+    return _spline_through(points, count), "points"
+
+
+def _spline_through(points: np.ndarray, count: int) -> np.ndarray:
+    """``count`` points along the natural cubic spline through ``points`` by chord length (a
+    polyline's kinks are nothing a smooth surface could pass through), evenly in chord length."""
+    t = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    n = len(points)
+    second = np.zeros((n, 3))
+    if n > 2:  # M_i: h_{i-1} M_{i-1} + 2 (h_{i-1} + h_i) M_i + h_i M_{i+1} = 6 (slope_i - slope_{i-1})
+        h = np.diff(t)
+        slope = np.diff(points, axis=0) / h[:, None]
+        system = np.diag(2 * (h[:-1] + h[1:])) + np.diag(h[1:-1], 1) + np.diag(h[1:-1], -1)
+        second[1:-1] = np.linalg.solve(system, 6 * np.diff(slope, axis=0))
+    at = np.linspace(0.0, t[-1], count)
+    k = np.clip(np.searchsorted(t, at, side="right") - 1, 0, n - 2)
+    h = (t[k + 1] - t[k])[:, None]
+    a, b = ((t[k + 1] - at)[:, None] / h), ((at - t[k])[:, None] / h)
+    return (a * points[k] + b * points[k + 1]
+            + ((a ** 3 - a) * second[k] + (b ** 3 - b) * second[k + 1]) * h ** 2 / 6)
+
+
+# --- the surface at given parameters ------------------------------------------------------------
+
+def _basis(knots: np.ndarray, p: int, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For each parameter in x: its knot span k and the values and first derivatives of the p + 1
+    basis functions N_{k-p..k} there, (K,), (K, p+1), (K, p+1) (Cox-de Boor, vectorised)."""
+    n = len(knots) - p - 1
+    x = np.clip(np.asarray(x, float), knots[p], knots[n])
+    span = np.clip(np.searchsorted(knots, x, side="right") - 1, p, n - 1)
+    count = len(x)
+    values = np.zeros((count, p + 1))
+    values[:, 0] = 1.0
+    lower = values[:, :1].copy()
+    for j in range(1, p + 1):
+        if j == p:
+            lower = values[:, :p].copy()  # degree p - 1, for the derivatives
+        left = [x - knots[span + 1 - j + r] for r in range(j)]          # x - u_{k+1-j+r}
+        right = [knots[span + 1 + r] - x for r in range(j)]             # u_{k+1+r} - x
+        new = np.zeros((count, p + 1))
+        saved = np.zeros(count)
+        for r in range(j):
+            denom = right[r] + left[r]
+            temp = np.divide(values[:, r], denom, out=np.zeros(count), where=denom != 0)
+            new[:, r] = saved + right[r] * temp
+            saved = left[r] * temp
+        new[:, j] = saved
+        values = new
+    ders = np.zeros((count, p + 1))
+    for r in range(p + 1):
+        i = span - p + r
+        if r >= 1:
+            d = knots[i + p] - knots[i]
+            ders[:, r] += p * np.divide(lower[:, r - 1], d, out=np.zeros(count), where=d != 0)
+        if r <= p - 1:
+            d = knots[i + p + 1] - knots[i + 1]
+            ders[:, r] -= p * np.divide(lower[:, r], d, out=np.zeros(count), where=d != 0)
+    return span, values, ders
+
+
+@dataclass
+class Rows:
+    """The surface and its first derivatives at K parameters as combinations of the poles: pole
+    indices (K, m) and their coefficients for S, S_u and S_v (each (K, m))."""
+
+    index: np.ndarray
+    s: np.ndarray
+    su: np.ndarray
+    sv: np.ndarray
+
+    def dense(self, coefficients: np.ndarray, poles: int) -> np.ndarray:
+        """One of s, su, sv (or a combination) as a dense (K, poles) matrix."""
+        out = np.zeros((len(coefficients), poles))
+        np.add.at(out, (np.arange(len(coefficients))[:, None], self.index), coefficients)
+        return out
+
+    def apply(self, coefficients: np.ndarray, poles: np.ndarray) -> np.ndarray:
+        """The combination of ``poles`` ((n, 3)) each row gives, (K, 3)."""
+        return np.einsum("km,kmc->kc", coefficients, poles[self.index])
+
+
+def rows(surface: Any, uv: np.ndarray) -> Rows:
+    """:class:`Rows` of the B-spline ``surface`` (a ``core.BSplineSurface``) at parameters uv (K, 2),
+    rational with its fixed weights: S = A / W, S_u = (A_u - W_u S) / W."""
+    p, q = surface.degree
+    nu, nv = surface.controls
+    su_, nu_, du_ = _basis(np.asarray(surface.knots_u, float), p, uv[:, 0])
+    sv_, nv_, dv_ = _basis(np.asarray(surface.knots_v, float), q, uv[:, 1])
+    iu = su_[:, None] - p + np.arange(p + 1)[None, :]
+    iv = sv_[:, None] - q + np.arange(q + 1)[None, :]
+    index = (iu[:, :, None] * nv + iv[:, None, :]).reshape(len(uv), -1)
+    weights = surface.weights
+    w = np.ones((len(uv), (p + 1) * (q + 1))) if weights is None else np.asarray(weights, float).ravel()[index]
+    a = (nu_[:, :, None] * nv_[:, None, :]).reshape(len(uv), -1) * w
+    au = (du_[:, :, None] * nv_[:, None, :]).reshape(len(uv), -1) * w
+    av = (nu_[:, :, None] * dv_[:, None, :]).reshape(len(uv), -1) * w
+    total, total_u, total_v = (x.sum(axis=1, keepdims=True) for x in (a, au, av))
+    s = a / total
+    return Rows(index, s, (au - total_u * s) / total, (av - total_v * s) / total)
+
+
+def nearest_mesh_parameters(dynamic: core.DynamicSurface, points: np.ndarray) -> np.ndarray:
+    """The parameters of the mesh points nearest ``points`` (K, 3): where closest points start."""
+    flat = np.asarray(dynamic.mesh, float).reshape(-1, 3)
+    us, vs = np.asarray(dynamic.mesh_parameters_u), np.asarray(dynamic.mesh_parameters_v)
+    nearest = np.array([int(np.argmin(((flat - x) ** 2).sum(axis=1))) for x in points])
+    return np.column_stack([us[nearest // len(vs)], vs[nearest % len(vs)]])
+
+
+def closest_parameters(surface: Any, poles: np.ndarray, points: np.ndarray, start: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """The parameters of the surface's closest points to ``points`` (K, 3) and their distances:
+    Gauss-Newton steps on |S(u, v) - x|^2 from ``start`` (K, 2), kept inside the domain."""
+    uv = np.array(start, dtype=float)
+    (u0, u1), (v0, v1) = surface.domain
+    for _ in range(50):
+        r = rows(surface, uv)
+        s, su, sv = (r.apply(c, poles) for c in (r.s, r.su, r.sv))
+        e = points - s
+        g = np.stack([(su * su).sum(1), (su * sv).sum(1), (sv * sv).sum(1)], axis=1)
+        b = np.stack([(su * e).sum(1), (sv * e).sum(1)], axis=1)
+        det = g[:, 0] * g[:, 2] - g[:, 1] ** 2
+        det = np.where(np.abs(det) > 0, det, 1.0)
+        step = np.column_stack([(g[:, 2] * b[:, 0] - g[:, 1] * b[:, 1]) / det,
+                                (g[:, 0] * b[:, 1] - g[:, 1] * b[:, 0]) / det])
+        new = np.column_stack([np.clip(uv[:, 0] + step[:, 0], u0, u1), np.clip(uv[:, 1] + step[:, 1], v0, v1)])
+        done = np.abs(new - uv).max() <= 1e-15
+        uv = new
+        if done:
+            break
+    r = rows(surface, uv)
+    return uv, np.linalg.norm(points - r.apply(r.s, poles), axis=1)
+
+
+def _unit(vectors: np.ndarray, what: str) -> np.ndarray:
+    """The vectors scaled to length 1; ValueError saying ``what`` is missing where one is (next to)
+    zero: a degenerate surface or curve there."""
+    length = np.linalg.norm(vectors, axis=1, keepdims=True)
+    if not np.all(np.isfinite(length)) or length.min() <= 1e-12 * max(float(length.max()), 1e-300):
+        raise ValueError(f"curve: {what}")
+    return vectors / length
+
+
+def normals(surface: Any, poles: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """Unit normals S_u x S_v at uv (K, 2); ValueError where the surface has none (degenerate)."""
+    r = rows(surface, uv)
+    su, sv = r.apply(r.su, poles), r.apply(r.sv, poles)
+    n = np.cross(su, sv)
+    scale = np.linalg.norm(su, axis=1) * np.linalg.norm(sv, axis=1)
+    if not np.all(np.linalg.norm(n, axis=1) > 1e-9 * scale):  # (S_u and S_v parallel, or one of them zero)
+        raise ValueError("curve: the surface has no tangent plane somewhere along the curve (it is degenerate there)")
+    return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+# --- conditions, the least move and the links ---------------------------------------------------
+
+def conditions(surface: Any, record: CurveConstraint) -> tuple[np.ndarray, np.ndarray]:
+    """The record's conditions A P = B over all poles: A (m, n), B (m, 3), each row scaled to unit
+    norm (so a rank is a rank whatever the units)."""
+    n = surface.controls[0] * surface.controls[1]
+    r = rows(surface, record.uv)
+    a, b = [r.dense(r.s, n)], [record.points]
+    if record.continuity == "G1":
+        d = record.across
+        a.append(r.dense(d[:, :1] * r.su + d[:, 1:] * r.sv, n))
+        b.append(record.derivatives)
+    a_all, b_all = np.vstack(a), np.vstack(b)
+    scale = np.linalg.norm(a_all, axis=1, keepdims=True)
+    scale[scale == 0] = 1.0
+    return a_all / scale, b_all / scale
+
+
+def _substituted(a: np.ndarray, b: np.ndarray, poles: np.ndarray, held: list[int],
+                 links: list[tuple[Any, ...]]) -> tuple[np.ndarray, np.ndarray]:
+    """A and B over the free poles alone: a linked pole's column added onto its free masters (its
+    offset and held masters into B), held poles' columns into B."""
+    a, b = a.copy(), b.copy()
+    held_set = set(held)
+    for link in links:
+        pole, masters = link[0], link[1]
+        column = a[:, pole].copy()
+        if not column.any():
+            continue
+        constant = np.asarray(link[2], float) if len(link) > 2 else np.zeros(3)
+        for m, w in masters:
+            if m in held_set:
+                constant = constant + w * poles[m]
+            else:
+                a[:, m] += w * column
+        b -= np.outer(column, constant)
+        a[:, pole] = 0.0
+    for h in held:
+        if a[:, h].any():
+            b -= np.outer(a[:, h], poles[h])
+            a[:, h] = 0.0
+    return a, b
+
+
+def _pivots(a: np.ndarray, tolerance: float) -> list[int]:
+    """Columns of a that span its column space, the largest remaining first (Gram-Schmidt with
+    column pivoting)."""
+    m = a.copy()
+    norms = (m * m).sum(axis=0)
+    chosen: list[int] = []
+    while True:
+        j = int(np.argmax(norms)) if norms.size else 0
+        if not norms.size or norms[j] <= tolerance ** 2:
+            return chosen
+        q = m[:, j] / math.sqrt(norms[j])
+        m -= np.outer(q, q @ m)
+        norms = (m * m).sum(axis=0)
+        norms[chosen + [j]] = 0.0
+        chosen.append(j)
+
+
+def fit(dynamic: core.DynamicSurface, records: list[CurveConstraint], held: list[int],
+        links: list[tuple[Any, ...]], poles: np.ndarray) -> tuple[np.ndarray, list[tuple[Any, ...]]]:
+    """Holds ``records``, together, on top of ``held`` and ``links``: the poles moved as little as
+    possible so they hold (check with :func:`misses`) and the links that keep them ((pole,
+    masters, offset), slaves among the free poles no other link depends on). Curves that cross
+    share their conditions there, so they are solved as one system. ValueError where the slaves
+    cannot be found (the poles there are held or linked)."""
+    surface = dynamic.surface
+    if not records:
+        return poles, []
+    stacked = [conditions(surface, r) for r in records]
+    a, b = np.vstack([x for x, _ in stacked]), np.vstack([y for _, y in stacked])
+    a, b = _substituted(a, b, poles, held, links)
+    free = np.flatnonzero(np.abs(a).max(axis=0) > 0)
+    if not free.size:
+        return poles, []
+    af = a[:, free]
+    gap = b - af @ poles[free]
+    gap[:, np.abs(gap).max(axis=0) <= 1e-12 * dynamic.size] = 0.0  # (rounding: a coordinate that holds stays)
+    moved = poles.copy()
+    if gap.any():
+        moved[free] += np.linalg.lstsq(af, gap, rcond=1e-12)[0]
+    # The conditions' row space, orthonormal (Q = V_r^T): slaves picked among its columns keep the
+    # link weights bounded however weakly a pole far from the curve takes part (A itself is
+    # ill-conditioned: its singular values fall gradually to 1e-11 before the null space).
+    _, singular, vt = np.linalg.svd(af, full_matrices=False)
+    rank = int((singular > 1e-12 * singular[0]).sum())
+    basis = vt[:rank]
+    masters = {m for link in links for m, _ in link[1]}
+    eligible = np.array([i for i, pole in enumerate(free) if int(pole) not in masters], dtype=int)
+    chosen = eligible[_pivots(basis[:, eligible], 1e-6)] if eligible.size else eligible
+    if len(chosen) < rank:
+        raise ValueError(f"curve: the surface cannot follow '{records[-1].label}' there: {rank} conditions need {rank} "
+                         f"free poles near it and only {len(chosen)} are not held or linked already "
+                         "(free the edges near it, or use more controls)")
+    chosen = chosen[:rank]
+    rest = np.setdiff1d(np.arange(len(free)), chosen)
+    # the slaves from the masters: Q_S P_S = c - Q_M P_M
+    solved = np.linalg.solve(basis[:, chosen], basis[:, rest])
+    weights = -solved
+    weights[np.abs(weights) < _WEIGHT_FLOOR] = 0.0
+    slaves = {int(free[c]) for c in chosen}
+    linked = {link[0] for link in links}
+    # a pole its conditions fix alone follows nothing but its offset: its link names some free pole
+    # with weight 0 (a link needs a master)
+    spare = next((i for i in range(len(poles)) if i not in slaves and i not in linked and i not in set(held)), None)
+    made = []
+    for k, c in enumerate(chosen):
+        nonzero = np.flatnonzero(weights[k])
+        pole = int(free[c])
+        master_poles = free[rest[nonzero]]
+        offset = moved[pole] - weights[k, nonzero] @ moved[master_poles]
+        masters = [(int(m), float(w)) for m, w in zip(master_poles, weights[k, nonzero])]
+        if not masters:
+            if spare is None:
+                raise ValueError(f"curve: the surface cannot follow '{records[-1].label}': no pole is left free")
+            masters = [(spare, 0.0)]
+        made.append((pole, masters, tuple(float(x) for x in offset)))
+    return moved, made
+
+
+def tangents(points: np.ndarray) -> np.ndarray:
+    """Unit tangents of the sampled curve (central differences)."""
+    t = np.gradient(points, axis=0)
+    return t / np.maximum(np.linalg.norm(t, axis=1, keepdims=True), 1e-300)
+
+
+def misses(surface: Any, record: CurveConstraint, poles: np.ndarray) -> tuple[float, float]:
+    """How far the surface with ``poles`` is from holding ``record`` at its samples: the largest
+    distance (mm) and, G1, the largest angle (degrees) between its normal and the one held."""
+    r = rows(surface, record.uv)
+    distance = float(np.linalg.norm(r.apply(r.s, poles) - record.points, axis=1).max())
+    if record.continuity != "G1":
+        return distance, 0.0
+    held = np.cross(tangents(record.points), record.derivatives)
+    held /= np.linalg.norm(held, axis=1, keepdims=True)
+    cosine = np.abs((normals(surface, poles, record.uv) * held).sum(axis=1))
+    return distance, float(np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0))).max())
+
+
+def relink(dynamic: core.DynamicSurface, records: list[CurveConstraint], held: list[int],
+           links: list[tuple[Any, ...]], poles: np.ndarray) -> tuple[np.ndarray, list[tuple[Any, ...]]]:
+    """Holds every record on top of ``held`` and ``links`` (the links that are not the curves'),
+    after those changed or a record was removed: the poles (moved as little as possible where a
+    record no longer held) and all links, ``links`` first. The records' ``slaves`` are updated.
+    ValueError naming a curve that cannot hold."""
+    moved, made = fit(dynamic, records, held, links, poles)
+    size = dynamic.size
+    for record in records:
+        distance, degrees = misses(dynamic.surface, record, moved)
+        if distance > G0_SHARE * size or degrees > G1_DEGREES:
+            raise ValueError(f"curve: '{record.label}' (constraint {record.id}) cannot hold there: the surface would "
+                             f"miss it by {distance:.3g} mm, {degrees:.3g} degrees (free the poles near it)")
+    slaves = [link[0] for link in made]
+    for record in records:
+        record.slaves = slaves  # (the curves' links together: removing one relinks the rest)
+    return moved, list(links) + made
+
+
+def make(dynamic: core.DynamicSurface, curve: Any, continuity: str, normal: Any, cid: int, held: list[int],
+         links: list[tuple[Any, ...]], records: list[CurveConstraint] = ()
+         ) -> tuple[CurveConstraint, np.ndarray, list[tuple[Any, ...]]]:
+    """A new curve constraint on ``dynamic``, on top of ``held``, ``links`` (those that are not the
+    curves') and the curves ``records`` it holds already: the record, the poles moved onto the curve
+    and all links. ValueError saying why where it cannot hold."""
+    if continuity not in CONTINUITIES:
+        raise ValueError(f"continuity: one of {', '.join(CONTINUITIES)}, not {continuity!r}")
+    if normal is not None:
+        if continuity != "G1":
+            raise ValueError("normal: only a G1 curve constraint holds a normal")
+        normal = np.asarray(normal, dtype=float).ravel()
+        if normal.shape != (3,) or not np.all(np.isfinite(normal)) or np.linalg.norm(normal) == 0:
+            raise ValueError(f"normal: expected a non-zero vector (x, y, z), got {normal.tolist()}")
+        normal = normal / np.linalg.norm(normal)
+    if dynamic.symmetry is not None:
+        raise ValueError("curve: a mirrored sculpt cannot follow a curve yet (its links would have to be mirrored "
+                         "too); remove the symmetry first")
+    surface = dynamic.surface
+    poles = np.asarray(dynamic.poles, float).reshape(-1, 3)
+    size = dynamic.size
+    if np.ptp(poles, axis=0).max() <= 1e-9 * size:
+        raise ValueError("curve: the surface has collapsed to a point; nothing can follow a curve")
+    points, label = curve_points(curve, SAMPLES)
+    uv, distance = closest_parameters(surface, poles, points, nearest_mesh_parameters(dynamic, points))
+    if distance.max() > MAX_DISTANCE_SHARE * size:
+        raise ValueError(f"curve: '{label}' runs up to {distance.max():.3g} mm from the surface, more than a quarter "
+                         f"of its size ({size:.3g} mm); move it closer, or sculpt toward it first")
+    p, q = surface.degree
+    cells = len({(a, b) for a, b in zip(_basis(np.asarray(surface.knots_u, float), p, uv[:, 0])[0],
+                                        _basis(np.asarray(surface.knots_v, float), q, uv[:, 1])[0])})
+    count = max(SAMPLES, 2 * (p + q + 1) * cells) | 1  # (odd: a sample in the middle, to know the curve by)
+    # the check's points halfway between the conditions' samples too
+    dense, _ = curve_points(curve, 2 * count - 1)
+    points = dense[::2]
+    uv, _ = closest_parameters(surface, poles, points, nearest_mesh_parameters(dynamic, points))
+    record = CurveConstraint(cid, continuity, label, uv, points, normal=None if normal is None else normal.tolist())
+    if continuity == "G1":
+        record.across, record.derivatives = _cross_derivatives(surface, poles, uv, points, normal)
+    records = list(records) + [record]
+    moved, made = fit(dynamic, records, held, links, poles)
+    for r in records:
+        r.slaves = [link[0] for link in made]
+    _, gap = closest_parameters(surface, moved, dense, np.repeat(uv, 2, axis=0)[: len(dense)])
+    distance, degrees = misses(surface, record, moved)
+    distance = max(distance, float(gap.max()))
+    for other in records[:-1]:
+        d, g = misses(surface, other, moved)
+        if d > G0_SHARE * size or g > G1_DEGREES:
+            raise ValueError(f"curve: '{label}' and '{other.label}' (constraint {other.id}) cannot both hold: where they "
+                             f"meet they ask the surface for different places or normals")
+    if distance > G0_SHARE * size or degrees > G1_DEGREES:
+        nu, nv = surface.controls
+        raise ValueError(f"curve: the surface cannot follow '{label}' {continuity}: with {nu} x {nv} controls it comes "
+                         f"no closer than {distance:.3g} mm (tolerance {G0_SHARE * size:.3g} mm)"
+                         + (f" and {degrees:.3g} degrees off the normal" if continuity == "G1" else "")
+                         + "; use more controls, or a curve nearer the surface or smoother")
+    return record, moved, list(links) + made
+
+
+def _cross_derivatives(surface: Any, poles: np.ndarray, uv: np.ndarray, points: np.ndarray,
+                       normal: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """G1: per sample the parameter direction across the curve and the derivative to hold in it
+    (perpendicular to the curve, in the plane perpendicular to the normal held, as long as the
+    surface's now). ValueError where the curve leaves the plane perpendicular to ``normal``."""
+    t = tangents(points)
+    current = normals(surface, poles, uv)
+    if normal is None:
+        n = current - (current * t).sum(axis=1, keepdims=True) * t  # (the nearest normal the curve allows)
+    else:
+        off = np.degrees(np.arcsin(np.clip(np.abs(t @ normal), 0.0, 1.0)))
+        if off.max() > G1_DEGREES:
+            k = int(np.argmax(off))
+            raise ValueError(f"normal: the curve leaves the plane perpendicular to it by {off[k]:.3g} degrees at "
+                             f"({', '.join(f'{x:.4g}' for x in points[k])}), so no surface along it can have that normal")
+        n = np.tile(normal, (len(points), 1))
+    n = _unit(n, "the curve runs along the surface's normal somewhere (it leaves the surface there)")
+    n *= np.sign((n * current).sum(axis=1, keepdims=True) + 1e-300)
+    r = rows(surface, uv)
+    su, sv = r.apply(r.su, poles), r.apply(r.sv, poles)
+    want = np.cross(n, t)
+    g = np.stack([(su * su).sum(1), (su * sv).sum(1), (sv * sv).sum(1)], axis=1)
+    b = np.stack([(su * want).sum(1), (sv * want).sum(1)], axis=1)
+    det = g[:, 0] * g[:, 2] - g[:, 1] ** 2  # (> 0: the normals exist)
+    across = _unit(np.column_stack([g[:, 2] * b[:, 0] - g[:, 1] * b[:, 1], g[:, 0] * b[:, 1] - g[:, 1] * b[:, 0]])
+                   / det[:, None], "the curve has no direction somewhere (a cusp or a point repeated)")
+    now = across[:, :1] * su + across[:, 1:] * sv
+    return across, want * np.linalg.norm(now, axis=1, keepdims=True)

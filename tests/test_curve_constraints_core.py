@@ -1,0 +1,83 @@
+"""Curve constraints at the core (no FreeCAD): the conditions a curve puts on the poles hold to
+1e-9 of the surface's size through 1,000 steps of a stroke in every integrator, G0 and G1, with
+held poles, on a rational net; the least move; the link weights stay bounded."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from HapticSculpt import core
+from HapticSculpt.app import curve_constraint as cc
+
+DIAGONAL = [(-40.0, -30.0, 0.0), (40.0, 30.0, 0.0)]
+ARC = [(30 * np.cos(t), 30 * np.sin(t) - 10, 0.0) for t in np.linspace(0.2, 2.9, 7)]
+
+
+def stroke(s, at=(10.0, -25.0), steps=1000, lift=15.0):
+    """A rope grabbed at ``at``, pulled up ``lift`` mm over the first half, held."""
+    for k in range(steps):
+        s.set_cursor([at[0], at[1], min(lift, 2 * lift * k / steps)], grab=True)
+        r = s.step(1e-3)
+        assert not r.refused, r.reason
+
+
+@pytest.mark.parametrize("integrator", core.INTEGRATORS)
+@pytest.mark.parametrize("continuity,curve", [("G0", DIAGONAL), ("G1", ARC)])
+def test_every_integrator_holds_the_conditions_through_1000_steps(integrator, continuity, curve):
+    s = core.patch((12, 12), mesh=(36, 36))
+    s.integrator = integrator
+    s.hold_poles([0, 11, 132, 143])  # (corners: the curve holds on top of them)
+    record, moved, links = cc.make(s, curve, continuity, None, cc.FIRST_ID, list(s.held_poles), [])
+    s.set_poles(moved.reshape(12, 12, 3))
+    s.hold_poles(list(s.held_poles), links)
+    stroke(s)
+    poles = np.asarray(s.poles, float).reshape(-1, 3)
+    assert np.all(np.isfinite(poles))
+    assert poles[:, 2].max() > 3.0, "the stroke moved the surface"
+    distance, degrees = cc.misses(s.surface, record, poles)
+    assert distance <= 1e-9 * s.size
+    assert degrees <= 1e-7
+    # the same stroke without the constraint moves the curve: the check can fail
+    free = core.patch((12, 12), mesh=(36, 36))
+    free.integrator = integrator
+    free.hold_poles([0, 11, 132, 143])
+    stroke(free)
+    assert cc.misses(free.surface, record, np.asarray(free.poles, float).reshape(-1, 3))[0] > 0.1
+
+
+def test_a_curve_on_the_surface_moves_nothing_and_one_above_it_moves_the_least():
+    s = core.patch((12, 12), mesh=(36, 36))
+    poles = np.asarray(s.poles, float).reshape(-1, 3)
+    _, moved, _ = cc.make(s, DIAGONAL, "G0", None, 1, [], [])
+    assert np.array_equal(moved, poles)
+    lifted = [(x, y, z + 5.0) for x, y, z in DIAGONAL]
+    record, moved, _ = cc.make(s, lifted, "G0", None, 1, [], [])
+    assert cc.misses(s.surface, record, moved)[0] <= 1e-6 * s.size
+    change = moved - poles
+    assert np.abs(change[:, :2]).max() < 1e-9  # only up
+    assert 5.0 - 1e-6 < change[:, 2].max() < 7.0  # (least squares: a pole beside the curve overshoots a little)
+    assert np.count_nonzero(np.abs(change[:, 2]) > 1e-9) < 0.6 * len(poles)  # far from it nothing moves
+
+
+def test_a_rational_net_and_link_weights_that_stay_bounded():
+    """Weights not all 1 (fixed: the conditions stay linear); the elimination picks slaves among the
+    conditions' orthonormal row space, so no link weight is large however weakly a pole takes part."""
+    base = core.patch((10, 10))
+    weights = np.ones((10, 10))
+    weights[3:7, 3:7] = 2.5
+    bs = core.BSplineSurface(np.asarray(base.poles), (3, 3), list(base.surface.knots_u), list(base.surface.knots_v),
+                             weights)
+    s = core.DynamicSurface(bs, (30, 30))
+    record, moved, links = cc.make(s, ARC, "G1", None, 1, [], [])
+    assert max(abs(w) for link in links for _, w in link[1]) < 50.0
+    s.set_poles(moved.reshape(10, 10, 3))
+    s.hold_poles([], links)
+    stroke(s, at=(30.0, 30.0))
+    distance, degrees = cc.misses(s.surface, record, np.asarray(s.poles, float).reshape(-1, 3))
+    assert distance <= 1e-9 * s.size and degrees <= 1e-7
+    # the rows agree with the core's own evaluation of the rational surface
+    uv = record.uv[::37]
+    rows = cc.rows(s.surface, uv)
+    got = rows.apply(rows.s, np.asarray(s.poles, float).reshape(-1, 3))
+    want = np.array([s.surface.evaluate(u, v)["point"] for u, v in uv])
+    assert np.abs(got - want).max() < 1e-12 * s.size
