@@ -129,6 +129,24 @@ class TestCurveConstraints(SolidChecks):
         self.assertEqual(info["normal"], list(np.array(tuple(normal)) / normal.Length))
         self.assertLessEqual(info["normal_deg"], 1e-4)
 
+    def test_g1_along_a_sketch_with_a_corner_after_a_stroke(self):
+        """A line meeting a half circle at a right angle, followed G0, stroked, then made G1 in one
+        step: the corner is one of the samples, the normal held on both sides of it."""
+        obj = hs.make_sculpt(self.doc, controls=(12, 12), mesh=(36, 36), material="clay")
+        curve = self.arc_and_line(z=5.0)
+        cid = hs.add_curve_constraint(obj, curve)
+        pull(obj, (0.0, 30.0, 0.0), (0.0, 0.0, 20.0))
+        n = self.doc.UndoCount
+        normals = normal_angle(obj.Shape.Faces[0], curve.Shape)[1]
+        hs.add_curve_constraint(obj, curve, "G1", replace=cid)
+        self.assertEqual(self.doc.UndoCount, n + 1)
+        [info] = hs.curve_constraints_of(obj)
+        self.assertEqual(info["continuity"], "G1")
+        pull(obj, (30.0, 30.0, 0.0), (0.0, 0.0, 15.0))
+        face = obj.Shape.Faces[0]
+        self.assertLessEqual(curve_distance(face, curve.Shape), 1e-6 * obj.Proxy.surface.size)
+        self.assertLessEqual(normal_angle(face, curve.Shape, normals)[0], 0.01)
+
     def test_every_kind_of_curve(self):
         """A Part feature's edge, a Part.Edge, a Part.Wire, a list of points, a Draft-like wire
         (a Part::Feature holding a polyline wire)."""

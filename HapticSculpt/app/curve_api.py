@@ -116,13 +116,18 @@ def curve_points_on(obj: Any) -> list[np.ndarray]:
 
 def constraint_along(obj: Any, curve: Any) -> dict[str, Any] | None:
     """The curve constraint (as :func:`curve_constraints_of` gives it) that follows ``curve``
-    already, by where it runs (its ends and middle within 1e-4 of the size, either way), or None."""
+    already, by where it runs (its ends within 1e-4 of the size, either way, and its length within
+    0.1 %), or None."""
     sculpt = _sculpt(obj)
-    points, _ = cc.curve_points(curve, 3)
+    points, _ = cc.curve_points(curve, cc.SAMPLES)
     size = sculpt.Proxy.live.snapshot().size
+
+    def length(p: np.ndarray) -> float:
+        return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
     for r in records_of(sculpt):
-        ends = r.points[[0, len(r.points) // 2, -1]]
-        if min(np.abs(ends - points).max(), np.abs(ends[::-1] - points).max()) <= 1e-4 * size:
+        ends, mine = r.points[[0, -1]], points[[0, -1]]
+        if min(np.abs(ends - mine).max(), np.abs(ends[::-1] - mine).max()) <= 1e-4 * size and \
+                abs(length(r.points) - length(points)) <= 1e-3 * length(points):
             return next(c for c in curve_constraints_of(sculpt) if c["id"] == r.id)
     return None
 

@@ -6,10 +6,10 @@ surface at a fixed parameter is linear in the poles, ``S(u_k, v_k) = a_k . P``, 
 derivative in a fixed direction ``S_d = d_k . P``. The constraint is then ``A P = B``:
 
 - **G0**: ``a_k . P = C_k``, the curve's samples;
-- **G1**: also ``d_k . P = D_k``, with ``d_k`` the parameter direction whose derivative is
-  perpendicular to the curve in the tangent plane, and ``D_k`` that derivative turned into the
-  plane perpendicular to the normal asked for. The whole cross derivative is held, so the normal
-  along the curve stays what it is (a designer's G1 edge holds its second row the same way).
+- **G1**: also ``S_u = D_u`` and ``S_v = D_v`` there, the surface's derivatives turned into the
+  plane perpendicular to the normal asked for. The whole first derivative is held (not only its
+  normal part, which would tie x, y and z together), so the normal along the curve stays what it
+  is, at a corner of the curve too (a designer's G1 edge holds its second row the same way).
 
 Adding one moves the poles as little as possible (least squares, minimal norm over the free poles)
 so the conditions hold. Then ``r = rank(A)`` of the free poles near the curve follow the others:
@@ -60,8 +60,7 @@ class CurveConstraint:
     label: str
     uv: np.ndarray                 # (K, 2) the preimage
     points: np.ndarray             # (K, 3) where the surface passes there
-    across: np.ndarray | None = None       # (K, 2) G1: the parameter direction across the curve
-    derivatives: np.ndarray | None = None  # (K, 3) G1: the derivative held there
+    derivatives: np.ndarray | None = None  # (K, 6) G1: S_u and S_v held there
     normal: list[float] | None = None      # G1: the normal asked for (None: the surface's own)
     slaves: list[int] = field(default_factory=list)
 
@@ -70,7 +69,7 @@ class CurveConstraint:
         out: dict[str, Any] = {"id": self.id, "continuity": self.continuity, "label": self.label,
                                "uv": self.uv.tolist(), "points": self.points.tolist(), "slaves": list(self.slaves)}
         if self.continuity == "G1":
-            out.update(across=self.across.tolist(), derivatives=self.derivatives.tolist(), normal=self.normal)
+            out.update(derivatives=self.derivatives.tolist(), normal=self.normal)
         return out
 
     @classmethod
@@ -80,7 +79,7 @@ class CurveConstraint:
             made = cls(int(item["id"]), str(item["continuity"]), str(item.get("label", "")),
                        _array(item["uv"], 2), _array(item["points"], 3), slaves=[int(i) for i in item["slaves"]])
             if made.continuity == "G1":
-                made.across, made.derivatives = _array(item["across"], 2), _array(item["derivatives"], 3)
+                made.derivatives = _array(item["derivatives"], 6)
                 made.normal = None if item.get("normal") is None else [float(x) for x in item["normal"]]
         except (KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"CurveConstraints: malformed curve constraint: {exc}") from exc
@@ -142,8 +141,7 @@ def curve_points(curve: Any, count: int) -> tuple[np.ndarray, str]:
                                  "give one edge or one connected wire")
         if shape.Length <= 0:
             raise ValueError(f"curve: {label or 'the shape'} has no length")
-        points = np.array([[p.x, p.y, p.z] for p in shape.discretize(Number=count)], dtype=float)
-        return points, label or shape.ShapeType
+        return _shape_points(shape, count), label or shape.ShapeType
     try:
         points = np.asarray(curve, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -158,6 +156,24 @@ def curve_points(curve: Any, count: int) -> tuple[np.ndarray, str]:
     if len(points) < 2:
         raise ValueError("curve: the points are all the same; a curve needs length")
     return _spline_through(points, count), "points"
+
+
+def _shape_points(shape: Any, count: int) -> np.ndarray:
+    """About ``count`` points along an edge or a wire, each edge evenly by length and its ends
+    among them: a corner between two edges is a point the surface passes through."""
+    edges = list(shape.OrderedEdges) if shape.ShapeType == "Wire" else [shape]
+    total = sum(e.Length for e in edges)
+    out: list[np.ndarray] = []
+    for e in edges:
+        n = max(2, int(round((count - 1) * e.Length / total)) + 1)
+        pts = np.array([[p.x, p.y, p.z] for p in e.discretize(Number=n)], dtype=float)
+        if out:
+            last = out[-1][-1]
+            if np.linalg.norm(pts[-1] - last) < np.linalg.norm(pts[0] - last):
+                pts = pts[::-1]  # (an edge the wire runs through backwards)
+            pts = pts[1:]
+        out.append(pts)
+    return np.vstack(out)
 
 
 def _spline_through(points: np.ndarray, count: int) -> np.ndarray:
@@ -320,9 +336,8 @@ def conditions(surface: Any, record: CurveConstraint) -> tuple[np.ndarray, np.nd
     r = rows(surface, record.uv)
     a, b = [r.dense(r.s, n)], [record.points]
     if record.continuity == "G1":
-        d = record.across
-        a.append(r.dense(d[:, :1] * r.su + d[:, 1:] * r.sv, n))
-        b.append(record.derivatives)
+        a += [r.dense(r.su, n), r.dense(r.sv, n)]
+        b += [record.derivatives[:, :3], record.derivatives[:, 3:]]
     a_all, b_all = np.vstack(a), np.vstack(b)
     scale = np.linalg.norm(a_all, axis=1, keepdims=True)
     scale[scale == 0] = 1.0
@@ -446,7 +461,7 @@ def misses(surface: Any, record: CurveConstraint, poles: np.ndarray) -> tuple[fl
     distance = float(np.linalg.norm(r.apply(r.s, poles) - record.points, axis=1).max())
     if record.continuity != "G1":
         return distance, 0.0
-    held = np.cross(tangents(record.points), record.derivatives)
+    held = np.cross(record.derivatives[:, :3], record.derivatives[:, 3:])
     held /= np.linalg.norm(held, axis=1, keepdims=True)
     cosine = np.abs((normals(surface, poles, record.uv) * held).sum(axis=1))
     return distance, float(np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0))).max())
@@ -502,19 +517,19 @@ def make(dynamic: core.DynamicSurface, curve: Any, continuity: str, normal: Any,
     p, q = surface.degree
     cells = len({(a, b) for a, b in zip(_basis(np.asarray(surface.knots_u, float), p, uv[:, 0])[0],
                                         _basis(np.asarray(surface.knots_v, float), q, uv[:, 1])[0])})
-    count = max(SAMPLES, 2 * (p + q + 1) * cells) | 1  # (odd: a sample in the middle, to know the curve by)
-    # the check's points halfway between the conditions' samples too
-    dense, _ = curve_points(curve, 2 * count - 1)
-    points = dense[::2]
+    count = max(SAMPLES, 2 * (p + q + 1) * cells)
+    points, _ = curve_points(curve, count)
     uv, _ = closest_parameters(surface, poles, points, nearest_mesh_parameters(dynamic, points))
+    dense, _ = curve_points(curve, 3 * count)  # (the check's points, between the conditions' samples too)
     record = CurveConstraint(cid, continuity, label, uv, points, normal=None if normal is None else normal.tolist())
     if continuity == "G1":
-        record.across, record.derivatives = _cross_derivatives(surface, poles, uv, points, normal)
+        record.derivatives = _held_derivatives(surface, poles, uv, points, normal)
     records = list(records) + [record]
     moved, made = fit(dynamic, records, held, links, poles)
     for r in records:
         r.slaves = [link[0] for link in made]
-    _, gap = closest_parameters(surface, moved, dense, np.repeat(uv, 2, axis=0)[: len(dense)])
+    start = uv[np.clip(np.searchsorted(np.linspace(0, 1, len(uv)), np.linspace(0, 1, len(dense))), 0, len(uv) - 1)]
+    _, gap = closest_parameters(surface, moved, dense, start)
     distance, degrees = misses(surface, record, moved)
     distance = max(distance, float(gap.max()))
     for other in records[:-1]:
@@ -531,15 +546,17 @@ def make(dynamic: core.DynamicSurface, curve: Any, continuity: str, normal: Any,
     return record, moved, list(links) + made
 
 
-def _cross_derivatives(surface: Any, poles: np.ndarray, uv: np.ndarray, points: np.ndarray,
-                       normal: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-    """G1: per sample the parameter direction across the curve and the derivative to hold in it
-    (perpendicular to the curve, in the plane perpendicular to the normal held, as long as the
-    surface's now). ValueError where the curve leaves the plane perpendicular to ``normal``."""
+def _held_derivatives(surface: Any, poles: np.ndarray, uv: np.ndarray, points: np.ndarray,
+                      normal: np.ndarray | None) -> np.ndarray:
+    """G1: per sample the derivatives S_u, S_v to hold (K, 6): the surface's, turned into the plane
+    perpendicular to the normal held (``normal``, or the surface's own turned perpendicular to the
+    curve, the nearest normal a surface through the curve can have). ValueError where the curve
+    leaves the plane perpendicular to ``normal``."""
     t = tangents(points)
     current = normals(surface, poles, uv)
-    if normal is None:
-        n = current - (current * t).sum(axis=1, keepdims=True) * t  # (the nearest normal the curve allows)
+    if normal is None:  # (where the curve runs in the tangent plane already the normal stays as it is)
+        along = (current * t).sum(axis=1, keepdims=True)
+        n = current - np.where(np.abs(along) > 1e-7, along, 0.0) * t
     else:
         off = np.degrees(np.arcsin(np.clip(np.abs(t @ normal), 0.0, 1.0)))
         if off.max() > G1_DEGREES:
@@ -548,14 +565,10 @@ def _cross_derivatives(surface: Any, poles: np.ndarray, uv: np.ndarray, points: 
                              f"({', '.join(f'{x:.4g}' for x in points[k])}), so no surface along it can have that normal")
         n = np.tile(normal, (len(points), 1))
     n = _unit(n, "the curve runs along the surface's normal somewhere (it leaves the surface there)")
-    n *= np.sign((n * current).sum(axis=1, keepdims=True) + 1e-300)
     r = rows(surface, uv)
     su, sv = r.apply(r.su, poles), r.apply(r.sv, poles)
-    want = np.cross(n, t)
-    g = np.stack([(su * su).sum(1), (su * sv).sum(1), (sv * sv).sum(1)], axis=1)
-    b = np.stack([(su * want).sum(1), (sv * want).sum(1)], axis=1)
-    det = g[:, 0] * g[:, 2] - g[:, 1] ** 2  # (> 0: the normals exist)
-    across = _unit(np.column_stack([g[:, 2] * b[:, 0] - g[:, 1] * b[:, 1], g[:, 0] * b[:, 1] - g[:, 1] * b[:, 0]])
-                   / det[:, None], "the curve has no direction somewhere (a cusp or a point repeated)")
-    now = across[:, :1] * su + across[:, 1:] * sv
-    return across, want * np.linalg.norm(now, axis=1, keepdims=True)
+    du = su - (su * n).sum(axis=1, keepdims=True) * n
+    dv = sv - (sv * n).sum(axis=1, keepdims=True) * n
+    if not np.all(np.linalg.norm(np.cross(du, dv), axis=1) > 1e-9 * np.linalg.norm(du, axis=1) * np.linalg.norm(dv, axis=1)):
+        raise ValueError("normal: the surface would have to turn edge-on to it somewhere along the curve")
+    return np.hstack([du, dv])

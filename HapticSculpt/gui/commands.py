@@ -25,9 +25,9 @@ GROUPS = {
                                     "HapticSculpt_PaintMass", "HapticSculpt_PaintDamping",
                                     "HapticSculpt_PaintStiffness", "HapticSculpt_PaintBending", "HapticSculpt_Panel"],
                                    0),
-    "HapticSculpt_ConstraintGroup": ("Constraints and edges", "Hold the edges (free / G0 / G1), or toggle a point, "
-                                     "normal or curvature constraint at the cursor",
-                                     ["HapticSculpt_HoldEdges", "HapticSculpt_PointConstraint",
+    "HapticSculpt_ConstraintGroup": ("Constraints and edges", "Hold the edges (free / G0 to G3), follow a curve "
+                                     "(G0 / G1), or toggle a point, normal or curvature constraint at the cursor",
+                                     ["HapticSculpt_HoldEdges", "HapticSculpt_FollowCurve", "HapticSculpt_PointConstraint",
                                       "HapticSculpt_NormalConstraint", "HapticSculpt_CurvatureConstraint"], 0),
     "HapticSculpt_DisplayGroup": ("Displays", "Analysis displays: material map, curvature, combs, zebra stripes "
                                   "and their settings",
@@ -327,6 +327,77 @@ class HoldEdges(_SculptCommand):
         run_echoed(f"HapticSculpt.hold_boundary({ref(obj)}, {following!r})")
 
 
+def _curve_selection() -> tuple[Any, str, Any] | None:
+    """(the sculpt, how a script names the curve, the curve) when the selection is one curve (a
+    sketch or a wire, whole wherever it was clicked, or an edge of a part) and at most one sculpt or
+    sculpted solid (else the one under the mouse or the document's only one); else None."""
+    from ..app.sculpt_feature import is_sculpt
+    from ..app.sculpted_solid import is_sculpted_solid, sculpt_for
+    from .echo import ref
+    sel = Gui.Selection.getSelectionEx()
+    sculpts = [s.Object for s in sel if is_sculpt(s.Object) or is_sculpted_solid(s.Object)]
+    others = [s for s in sel if s.Object not in sculpts]
+    if len(sculpts) > 1 or len(others) != 1:
+        return None
+    pick = others[0]
+    edges = [n for n in pick.SubElementNames if n.startswith("Edge")]
+    shape = getattr(pick.Object, "Shape", None)
+    if shape is None or shape.isNull() or not shape.Edges or (pick.SubElementNames and len(edges) != 1):
+        return None
+    whole = not shape.Faces and (len(shape.Wires) == 1 and len(shape.Wires[0].Edges) == len(shape.Edges)
+                                 or len(shape.Edges) == 1)
+    if whole:  # a sketch or a wire: the whole curve, wherever on it the designer clicked
+        code, curve = ref(pick.Object), pick.Object
+    elif edges:  # an edge of a part (or of a sketch of several wires)
+        code, curve = f"{ref(pick.Object)}.Shape.{edges[0]}", getattr(shape, edges[0])
+    else:
+        return None
+    target = sculpts[0] if sculpts else _ctl().active_sculpt()
+    if target is None or sculpt_for(target) is None:
+        return None
+    return target, code, curve
+
+
+class FollowCurve:
+    """The sculpt follows the selected curve exactly: each press on the same curve goes G0 (through
+    it), G1 (along it with the normal it has), off."""
+
+    def GetResources(self) -> dict[str, str]:
+        return {"Pixmap": icon("FollowCurve"), "MenuText": "Follow curve: G0 / G1 / off",
+                "ToolTip": "Select a sketch, a wire or an edge (and the sculpt): the surface passes exactly through "
+                           "it from now on (G0; pulled onto it if it is near), through every stroke; press again "
+                           "with the same curve for G1 (its normal along the curve kept too), again to free it"}
+
+    def IsActive(self) -> bool:
+        return _curve_selection() is not None
+
+    def Activated(self) -> None:
+        from ..app.curve_api import constraint_along
+        from ..app.sculpted_solid import sculpt_for
+        from .echo import ref, run_echoed
+        picked = _curve_selection()
+        if picked is None:
+            return
+        target, code, curve = picked
+        now = constraint_along(target, curve)
+        if now is None:
+            call = f"HapticSculpt.add_curve_constraint({ref(target)}, {code})"
+        elif now["continuity"] == "G0":
+            call = f"HapticSculpt.add_curve_constraint({ref(target)}, {code}, 'G1', replace={now['id']})"
+        else:
+            call = f"HapticSculpt.remove_constraint({ref(target)}, {now['id']})"
+        try:
+            run_echoed(call)
+        except Exception as exc:  # noqa: BLE001 - doCommand raises what the call raised, as its own type
+            FreeCAD.Console.PrintWarning(f"HapticSculpt: {target.Label} cannot follow it: {exc}\n")
+            return
+        _ctl().refresh(sculpt_for(target))  # (the curve drawn on the surface)
+        after = constraint_along(target, curve)
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: {target.Label} follows {after['label']} {after['continuity']} "
+                                     f"(within {after['distance_mm']:.2g} mm)\n" if after else
+                                     f"HapticSculpt: {target.Label} no longer follows it\n")
+
+
 class _Tool(_SculptCommand):
     tool = "rope"
 
@@ -561,7 +632,7 @@ class Group:
 COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_NewClampedPatch": NewClampedPatch,
             "HapticSculpt_SculptFace": SculptFace, "HapticSculpt_Session": Session,
             "HapticSculpt_Material": Material, "HapticSculpt_KeepShape": KeepShape,
-            "HapticSculpt_HoldEdges": HoldEdges, "HapticSculpt_Fair": Fair,
+            "HapticSculpt_HoldEdges": HoldEdges, "HapticSculpt_FollowCurve": FollowCurve, "HapticSculpt_Fair": Fair,
             "HapticSculpt_ToolRope": ToolRope, "HapticSculpt_ToolMagnet": ToolMagnet,
             "HapticSculpt_MagnetFalloff": MagnetFalloff, "HapticSculpt_ToolOrientation": ToolOrientation,
             "HapticSculpt_ToolSmooth": ToolSmooth, "HapticSculpt_PointConstraint": PointConstraint,

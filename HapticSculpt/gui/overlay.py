@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from .. import core
-from ..app import analysis
+from ..app import analysis, curve_constraint
 from . import coin_shapes as shapes
 from . import stripes as stripe_shading
 from .hud import Hud
@@ -31,6 +31,8 @@ from .panel import SLIDERS, SliderPanel
 MAPS = ("mass", "damping", "stiffness", "bending")
 DISPLAYS = ("shading", *MAPS, "curvature", "mean", "gauss", "zebra")
 JACK_COLOURS = {"point": (1.0, 0.0, 0.0), "tangent": (1.0, 0.5, 0.0), "normal": (0.0, 0.3, 1.0), "curvature": (1.0, 1.0, 1.0)}
+#: Curves the surface follows, drawn on it: G0 (through) and G1 (with its normal).
+CURVE_COLOURS = {"G0": (0.0, 0.9, 1.0), "G1": (1.0, 0.6, 0.0)}
 
 
 class Overlay:
@@ -60,6 +62,7 @@ class Overlay:
         self.per_pixel = True  # zebra per pixel where the driver runs GLSL (False: per mesh vertex)
         self._sampled: tuple[bytes, np.ndarray, tuple[bytes, bytes], int] | None = None  # poles, points, texture, size
         self._trims: dict[tuple[int, int], list[int] | None] = {}  # grid size -> cells on the trimmed face
+        self._curve_rows: tuple[str, list[tuple[str, Any]]] = ("", [])  # CurveConstraints text -> (kind, rows)
         self.hud: Hud | None = None  # the screen-space layer, made when the overlay first draws
         self._root = coin.SoSeparator()
         self._root.setName("HapticSculptOverlay")
@@ -80,7 +83,7 @@ class Overlay:
     def shown(self) -> bool:
         """True while anything is to be drawn at all: what runs each frame, and the constraint jacks,
         which show whenever the sculpt does (drawn once per change, no timer)."""
-        return self.needed or bool(self._visible() and self.snapshot().constraints)
+        return self.needed or bool(self._visible() and (self.snapshot().constraints or self._curves_text()))
 
     def _visible(self) -> bool:
         """The surface shows: the sculpt itself, or a shown SculptedSolid it is a face of."""
@@ -204,7 +207,9 @@ class Overlay:
             decor.addChild(shapes.lines(segments, (1.0, 0.0, 1.0), 1.0))
         if seen:
             decor.addChild(self._jacks(s, mesh))
-        self.surface_drawn = seen and (display != "shading" or (self.combs or bool(s.constraints)))
+            decor.addChild(self._curves(s))
+        self.surface_drawn = seen and (display != "shading" or (self.combs or bool(s.constraints)
+                                                                 or bool(self._curves_text())))
         self.cursor_shown = self.cursor is not None and self.needed  # (the jacks alone are not redrawn as the mouse moves)
         if self.cursor_shown:
             pickable = coin.SoPickStyle()  # (as it always was: a mouse grab that picks the cursor, not
@@ -345,6 +350,24 @@ class Overlay:
             else:
                 i, j = divmod(c["index"], h)
                 sep.addChild(shapes.circle(p, shapes.frame(*shapes.tangents(mesh, i, j))[:, 2], r, colour))
+        return sep
+
+    def _curves_text(self) -> str:
+        return getattr(self.obj, curve_constraint.PROPERTY, "")
+
+    def _curves(self, s: core.DynamicSurface) -> Any:
+        """The curves the surface follows, where they run on it now (their rows are kept while the
+        constraints do not change: each frame only applies them to the newest poles)."""
+        from pivy import coin
+        sep = coin.SoSeparator()
+        text = self._curves_text()
+        if self._curve_rows[0] != text:
+            self._curve_rows = (text, [(r.continuity, curve_constraint.rows(s.surface, r.uv))
+                                       for r in curve_constraint.records_from_json(text)])
+        poles = np.asarray(s.poles, float).reshape(-1, 3)
+        for kind, rows in self._curve_rows[1]:
+            points = rows.apply(rows.s, poles)
+            sep.addChild(shapes.lines(np.stack([points[:-1], points[1:]], axis=1), CURVE_COLOURS[kind], 4.0))
         return sep
 
     def _cursor(self, s: core.DynamicSurface, mesh: np.ndarray) -> Any:

@@ -44,6 +44,13 @@ class SculptViewProvider(_Stateless):
             for ov in ctl.overlays_of(vobj.Object) if ctl.inputs else []:
                 ov.refresh()
 
+    def updateData(self, obj: Any, prop: str) -> None:
+        if prop == "CurveConstraints":  # the curves it follows show at once, however they were added
+            from .workbench import controller
+            ctl = controller()
+            if ctl.inputs:
+                ctl.refresh(obj)
+
     def getIcon(self) -> str:
         return icon("HapticSculpt")
 

@@ -36,8 +36,16 @@ def _sculpts(doc):
                     "device": o.Proxy.live.session.device_name
                     if getattr(o.Proxy, "live", None) and o.Proxy.live.session else "",
                     "selected": o in Gui.Selection.getSelection(), "screen": _on_screen(o), "digest": digest(o),
-                    "drawn_poles": _drawn_poles(o)})
+                    "drawn_poles": _drawn_poles(o), "curves": _curves(o)})
     return out
+
+
+def _curves(o):
+    """The curves the sculpt follows: [continuity, distance (mm), normal angle (degrees)] each."""
+    try:
+        return [[c["continuity"], c["distance_mm"], c["normal_deg"]] for c in HapticSculpt.curve_constraints_of(o)]
+    except Exception:  # noqa: BLE001 - a stored state being read
+        return []
 
 
 def _held_edges(o):
@@ -150,6 +158,25 @@ def _on_screen(o):
         pts += [FreeCAD.Vector(bb.Center.x + fx * bb.XLength / 2, bb.Center.y + fy * bb.YLength / 2, bb.ZMax)
                 for fx, fy in ((0.5, 0), (-0.5, 0), (0, 0.5), (0, -0.5))]
         return [list(view.getPointOnScreen(p)) for p in pts]
+    except Exception:  # noqa: BLE001 - no active 3D view
+        return []
+
+
+def _preselection():
+    """What the mouse highlights: [object name, sub-element] or None."""
+    pre = Gui.Selection.getPreselection()
+    return [pre.ObjectName, pre.SubElementNames[0] if pre.SubElementNames else ""] if pre.ObjectName else None
+
+
+def _edge_points(o):
+    """Where the middle of each edge of a curve object (a sketch, a wire: edges and no faces) is in
+    the active 3D view's viewport, to click it."""
+    try:
+        if o.Shape.Faces or not o.Shape.Edges:
+            return []
+        view = Gui.ActiveDocument.ActiveView
+        return [list(view.getPointOnScreen(e.valueAt(0.5 * (e.FirstParameter + e.LastParameter))))
+                for e in o.Shape.Edges]
     except Exception:  # noqa: BLE001 - no active 3D view
         return []
 
@@ -330,7 +357,8 @@ def write(*_):
              "task_dialog": bool(Gui.Control.activeDialog()), "tree": _tree_items(),
              "task_buttons": _task_buttons(), "toolbars": _toolbars(), "console": _widget_rect("Gui::PythonConsole"),
              "focus": _focus(), "selection": [[o.ObjectName, list(o.SubElementNames)]
-                                              for o in Gui.Selection.getSelectionEx()]}
+                                              for o in Gui.Selection.getSelectionEx()],
+             "preselection": _preselection()}
     state["overlay_panels"], state["message_buttons"] = _panels_and_questions()
     for name, doc in FreeCAD.listDocuments().items():
         state["docs"][name] = {"undo": list(doc.UndoNames), "redo": list(doc.RedoNames), "file": doc.FileName,
@@ -338,7 +366,8 @@ def write(*_):
                                "gui_modified": bool(getattr(Gui.getDocument(name), "Modified", False)),
                                "sculpts": _sculpts(doc), "objects": [o.Name for o in doc.Objects],
                                "solids": _solids(doc), "features": _features(doc),
-                               "screen": {o.Name: _on_screen(o) for o in doc.Objects if hasattr(o, "Shape")}}
+                               "screen": {o.Name: _on_screen(o) for o in doc.Objects if hasattr(o, "Shape")},
+                               "edge_points": {o.Name: _edge_points(o) for o in doc.Objects if hasattr(o, "Shape")}}
     try:
         import HapticSculpt.gui.workbench as hg
         ctl = hg.controller()

@@ -1,0 +1,141 @@
+"""Follow curve as a designer does it in FreeCAD's GUI, with real X events: a clay patch and a
+sketch 5 mm above it (a line running into a half circle) opened from a file; the sketch and the
+patch clicked in the tree, Follow curve: the patch is pulled onto the sketch in one undo step and
+the curve is drawn on it; a mouse stroke beside it leaves it passing through the curve; Undo and
+Redo; the sketch alone selected, Follow curve again: G1; again: free. Screenshots in
+build/screenshots/real_follow_*.png (look at them)."""
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+import pytest
+from freecad_support import run_freecad_gui
+from test_gui_real_input import NEEDS, SHOTS, Desktop, sculpt, undo
+
+from HapticSculpt.gui.overlay import CURVE_COLOURS
+
+#: A patch and a sketch above it, saved by FreeCAD's GUI (a file saved by freecadcmd has no view data).
+SCENE = """
+import json, math, os
+import FreeCAD, FreeCADGui, Part
+import HapticSculpt as hs
+V = FreeCAD.Vector
+doc = FreeCAD.newDocument("Curves")
+obj = hs.make_sculpt(doc, controls=(12, 12), mesh=(36, 36), material="clay")
+sketch = doc.addObject("Sketcher::SketchObject", "Sketch")
+sketch.Placement = FreeCAD.Placement(V(0, 0, 5), FreeCAD.Rotation())
+sketch.addGeometry(Part.LineSegment(V(-40, -20, 0), V(0, -20, 0)), False)
+sketch.addGeometry(Part.ArcOfCircle(Part.Circle(V(20, -20, 0), V(0, 0, 1), 20), math.pi, 2 * math.pi), False)
+doc.recompute()
+doc.saveAs(PATH)
+json.dump({"size": obj.Proxy.surface.size}, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+def curves(s: dict) -> list:
+    return sculpt(s)["curves"]
+
+
+def click_in_view(d: Desktop, points: list[list[float]], name: str, add: bool = False) -> None:
+    """Moves the mouse over object ``name`` in the 3D view, trying viewport pixels ``points`` and
+    a few pixels around each until FreeCAD highlights it, and clicks (ctrl+click: adds to the
+    selection), as a designer hovers until the line lights up."""
+    for at in points:
+        x0, y0 = d.to_screen(at)
+        # (FreeCAD 0.20's getPointOnScreen is some pixels off the view's own event coordinates)
+        for dx, dy in [(0, 0)] + [(dx, dy) for dy in range(-24, 25, 2) for dx in (0, 3)]:
+            d.xdo("mousemove", str(x0 + dx), str(y0 + dy))
+            try:
+                d.wait(lambda s: (s["preselection"] or [None])[0] == name, f"{name} highlighted", 0.4, shot=False)
+            except AssertionError:
+                continue
+            d.xdo(*(["keydown", "ctrl", "click", "1", "keyup", "ctrl"] if add else ["click", "1"]))
+            return
+    raise AssertionError(f"the mouse found no point of {name} to click")
+
+
+def wait_for_colour(d: Desktop, name: str, colour: tuple[float, float, float], what: str, timeout: float = 10.0) -> None:
+    """Screenshots until a curve's worth of pixels (0.05 % of the screen) has ``colour``."""
+    end = time.monotonic() + timeout
+    share = 0.0
+    while time.monotonic() < end:
+        share = float(np.mean(np.all(np.abs(d.shot(name) - colour) < 0.1, axis=2)))
+        if share > 5e-4:
+            return
+    raise AssertionError(f"{what}: {share:.4%} of the screen has that colour")
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_follow_curve_pulls_the_patch_onto_a_sketch_keeps_it_through_a_stroke_g1_and_off(tmp_path):
+    os.makedirs(SHOTS, exist_ok=True)
+    path = str(tmp_path / "curves.FCStd")
+    size = run_freecad_gui(f"PATH = {path!r}\n" + SCENE, str(tmp_path))["size"]
+    tolerance = 1e-6 * size
+    d = Desktop(str(tmp_path), "CAD", open_file=path)
+    try:
+        s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["sculpts"] and sculpt(s)["screen"], "the file")
+        d.xdo("mousemove", "640", "500", "key", "0")  # isometric
+        d.xdo("key", "--delay", "150", "v", "f")  # fit all
+        d.calibrate()
+        before = d.shot("follow_before")
+        # the patch clicked, then the sketch's line ctrl+clicked (5 mm above the patch)
+        s = d.state()
+        click_in_view(d, [sculpt(s)["screen"][3]], "Sculpt")
+        d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sculpt"], "the patch selected")
+        click_in_view(d, s["docs"][s["active"]]["edge_points"]["Sketch"], "Sketch", add=True)
+        d.wait(lambda s: sorted(o for o, _ in s["selection"]) == ["Sculpt", "Sketch"], "the sketch selected too")
+        s = d.press_button("FollowCurve", lambda s: curves(s), "the sculpt following the sketch")
+        [(kind, distance, _)] = curves(s)
+        assert kind == "G0" and distance <= tolerance, curves(s)
+        assert undo(s)[0] == "Follow curve", undo(s)[:3]
+        poles = np.array(sculpt(s)["poles"]).reshape(-1, 3)
+        assert 5.0 - 1e-6 < poles[:, 2].max() < 8.0, "pulled up onto the sketch 5 mm above"
+        assert np.array_equal(np.array(sculpt(s)["shape_poles"]).ravel(), np.array(sculpt(s)["poles"])), "the face shows it"
+        s = d.wait(lambda s: any(o["object"] == "Sculpt" and o["surface_drawn"] for o in s["overlays"]),
+                   "the curve drawn on the surface")
+        pulled = d.shot_changed("follow_g0", before, "Follow curve")
+        wait_for_colour(d, "follow_g0", CURVE_COLOURS["G0"], "the curve drawn G0 (cyan)")
+        # a stroke with the mouse on the north side of the patch, away from the curve (south)
+        d.calibrate()
+        north = d.to_screen(sculpt(s)["screen"][3])
+        strokes = sculpt(s)["strokes"]
+        d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
+        d.drag([north] + [(north[0], north[1] - 10 * k) for k in range(1, 9)], seconds=0.8)
+        d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
+        d.click_button("Session")
+        s = d.wait(lambda s: not sculpt(s)["session"], "the session to stop")
+        assert sculpt(s)["strokes"] > strokes
+        stroked = np.array(sculpt(s)["poles"]).reshape(-1, 3)
+        assert np.abs(stroked - poles).max() > 1.0, "the stroke moved the patch"
+        [(kind, distance, _)] = curves(s)
+        assert kind == "G0" and distance <= tolerance, curves(s)
+        d.shot_changed("follow_stroked", pulled, "the stroke")
+        # Undo the stroke and the curve, Redo both
+        d.xdo("key", "ctrl+z")
+        s = d.wait(lambda s: undo(s)[0] == "Follow curve", "Undo of the stroke")
+        d.xdo("key", "ctrl+z")
+        s = d.wait(lambda s: not curves(s) and np.abs(np.array(sculpt(s)["poles"])[2::3]).max() < 1e-9,
+                   "Undo of Follow curve: flat, following nothing")
+        d.shot_changed("follow_undone", pulled, "Undo of Follow curve", level=0.02)
+        d.xdo("key", "ctrl+shift+z")
+        d.wait(lambda s: curves(s) and undo(s)[0] == "Follow curve", "Redo of Follow curve")
+        d.xdo("key", "ctrl+shift+z")
+        s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke" and curves(s)[0][1] <= tolerance, "Redo of the stroke")
+        # the same two still selected: Follow curve again makes it G1, then frees it
+        assert sorted(o for o, _ in s["selection"]) == ["Sculpt", "Sketch"], s["selection"]
+        redone = d.shot("follow_redone")
+        s = d.press_button("FollowCurve", lambda s: curves(s) and curves(s)[0][0] == "G1", "G1")
+        [(kind, distance, angle)] = curves(s)
+        assert distance <= tolerance and angle <= 0.01, curves(s)
+        assert undo(s)[:2] == ["Follow curve", "Sculpt stroke"], undo(s)[:3]  # (one step: G0 replaced)
+        wait_for_colour(d, "follow_g1", CURVE_COLOURS["G1"], "the curve drawn G1 (orange)")
+        s = d.press_button("FollowCurve", lambda s: not curves(s), "the curve freed")
+        assert undo(s)[0] == "Remove curve constraint", undo(s)[:3]
+        s = d.wait(lambda s: not any(o["object"] == "Sculpt" and o["surface_drawn"] for o in s["overlays"]),
+                   "the curve no longer drawn")
+        d.shot("follow_off")
+    finally:
+        d.close()
