@@ -17,6 +17,10 @@ Scenes (8x8 controls, 24x24 mesh, a 100 mm dome-shaped patch relaxed as its rest
   dome as two patches joined along u = 0.5 by a knot of full multiplicity, the seam's poles linked
   to their neighbours across it so it stays tangent (G1; the core's linked poles), grabbed beside
   the seam. The coupling must not cost the default its lead.
+- two_faces_g2: the same with the seam curvature-continuous (G2: two linked poles per column, the
+  seam's and the one two rows past it, from seam_continuity).
+- curve: the rope scene on the dome following a curve G0 (a line of it across it at v = 0.35:
+  linked poles with offsets from curve_constraint), grabbed at the centre beside it.
 Rope and oscillation references: the explicit scheme at 1 ms / 1024 and 1 ms / 2048, Richardson-
 extrapolated (first order); their difference says how good the reference is (printed).
 
@@ -169,11 +173,41 @@ def two_faces_play(s: core.DynamicSurface, dt: float) -> list[np.ndarray]:
     return rope_play(s, dt, at=(9, 12))  # beside the seam (mesh column 11.5)
 
 
+def two_faces_g2_build() -> core.DynamicSurface:
+    """The two faces with their seam curvature-continuous (G2): per column the seam pole and the
+    one two rows past it follow the others (seam_continuity), after the least move that makes it so."""
+    from HapticSculpt.app import seam_continuity
+    s = two_faces_build()
+    s.hold_poles([], [])
+    poles = np.array(s.poles)
+    knots = np.array(s.surface.knots_u)
+    made = seam_continuity.project(poles, None, knots, 3, 3, 0.5, set(), "seam")
+    s.set_poles(made)
+    s.hold_poles([], seam_continuity.links(made, None, knots, 3, 3, 0.5, set(), "seam"))
+    s.relax()
+    return s
+
+
+def curve_build() -> core.DynamicSurface:
+    """The rope dome following a curve G0: a line of the dome across it at v = 0.35 (the poles do
+    not move), held through the stroke by linked poles with offsets (curve_constraint)."""
+    from HapticSculpt.app import curve_constraint
+    s = rope_build()
+    line = [s.surface.evaluate(u, 0.35)["point"] for u in np.linspace(0.1, 0.9, 401)]  # (on the dome)
+    _, moved, links = curve_constraint.make(s, line, "G0", None, curve_constraint.FIRST_ID, [], [])
+    s.set_poles(moved.reshape(np.array(s.poles).shape))
+    s.hold_poles([], links)
+    s.relax()
+    return s
+
+
 # name: (build, play, simulated seconds, (shortest, longest) time step)
 SCENES = {"rope": (rope_build, rope_play, 0.3, (MS / 1024, MS)),
           "equilibrium": (equilibrium_build, equilibrium_play, 1.5, (MS / 16, 8 * MS)),
           "oscillation": (oscillation_build, oscillation_play, 0.2, (MS / 1024, 8 * MS)),
-          "two_faces": (two_faces_build, two_faces_play, 0.3, (MS / 1024, MS))}
+          "two_faces": (two_faces_build, two_faces_play, 0.3, (MS / 1024, MS)),
+          "two_faces_g2": (two_faces_g2_build, two_faces_play, 0.3, (MS / 1024, MS)),
+          "curve": (curve_build, rope_play, 0.3, (MS / 1024, MS))}
 
 
 def shortest_step(label: str, settings: dict) -> float:

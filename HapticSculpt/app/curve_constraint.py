@@ -6,10 +6,12 @@ surface at a fixed parameter is linear in the poles, ``S(u_k, v_k) = a_k . P``, 
 derivative in a fixed direction ``S_d = d_k . P``. The constraint is then ``A P = B``:
 
 - **G0**: ``a_k . P = C_k``, the curve's samples;
-- **G1**: also ``S_u = D_u`` and ``S_v = D_v`` there, the surface's derivatives turned into the
-  plane perpendicular to the normal asked for. The whole first derivative is held (not only its
-  normal part, which would tie x, y and z together), so the normal along the curve stays what it
-  is, at a corner of the curve too (a designer's G1 edge holds its second row the same way).
+- **G1**: also ``S_d = D`` there, ``d`` the parameter direction across the curve and ``D`` the
+  surface's derivative in it turned into the plane perpendicular to the normal asked for. The whole
+  cross derivative is held (not only its normal part, which would tie x, y and z together), so the
+  normal along the curve stays what it is (a designer's G1 edge holds its second row the same way).
+  The derivative along the curve is left to G0: a curve a little off the surface's tangent does
+  not conflict with it.
 
 Adding one moves the poles as little as possible (least squares, minimal norm over the free poles)
 so the conditions hold. Then ``r = rank(A)`` of the free poles near the curve follow the others:
@@ -60,7 +62,9 @@ class CurveConstraint:
     label: str
     uv: np.ndarray                 # (K, 2) the preimage
     points: np.ndarray             # (K, 3) where the surface passes there
-    derivatives: np.ndarray | None = None  # (K, 6) G1: S_u and S_v held there
+    tangents: np.ndarray | None = None     # (K, 3) G1: the curve's unit tangents there
+    across: np.ndarray | None = None       # (K, 2) G1: the parameter direction across the curve
+    derivatives: np.ndarray | None = None  # (K, 3) G1: the derivative held in it
     normal: list[float] | None = None      # G1: the normal asked for (None: the surface's own)
     slaves: list[int] = field(default_factory=list)
 
@@ -69,7 +73,8 @@ class CurveConstraint:
         out: dict[str, Any] = {"id": self.id, "continuity": self.continuity, "label": self.label,
                                "uv": self.uv.tolist(), "points": self.points.tolist(), "slaves": list(self.slaves)}
         if self.continuity == "G1":
-            out.update(derivatives=self.derivatives.tolist(), normal=self.normal)
+            out.update(tangents=self.tangents.tolist(), across=self.across.tolist(),
+                       derivatives=self.derivatives.tolist(), normal=self.normal)
         return out
 
     @classmethod
@@ -79,7 +84,8 @@ class CurveConstraint:
             made = cls(int(item["id"]), str(item["continuity"]), str(item.get("label", "")),
                        _array(item["uv"], 2), _array(item["points"], 3), slaves=[int(i) for i in item["slaves"]])
             if made.continuity == "G1":
-                made.derivatives = _array(item["derivatives"], 6)
+                made.tangents, made.across = _array(item["tangents"], 3), _array(item["across"], 2)
+                made.derivatives = _array(item["derivatives"], 3)
                 made.normal = None if item.get("normal") is None else [float(x) for x in item["normal"]]
         except (KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"CurveConstraints: malformed curve constraint: {exc}") from exc
@@ -121,9 +127,16 @@ def records_to_json(records: list[CurveConstraint]) -> str:
 # --- the curve ----------------------------------------------------------------------------------
 
 def curve_points(curve: Any, count: int) -> tuple[np.ndarray, str]:
-    """``count`` points evenly along ``curve`` (by length) and a label for it. ``curve`` is a
-    document object with one edge or one wire (a Sketch, a Part feature, a Draft wire), a
-    ``Part.Edge`` or ``Part.Wire``, or a list of points (the smooth curve through them)."""
+    """``count`` points along ``curve`` and a label for it (see :func:`curve_samples`)."""
+    points, _, label = curve_samples(curve, count)
+    return points, label
+
+
+def curve_samples(curve: Any, count: int) -> tuple[np.ndarray, np.ndarray, str]:
+    """About ``count`` points along ``curve`` (by length), its unit tangents there (exact: from the
+    curve, not from the points) and a label for it. ``curve`` is a document object with one edge or
+    one wire (a Sketch, a Part feature, a Draft wire), a ``Part.Edge`` or ``Part.Wire``, or a list
+    of points (the smooth curve through them)."""
     label = ""
     if hasattr(curve, "Shape") and hasattr(curve, "Document"):
         label = str(curve.Label)
@@ -141,7 +154,8 @@ def curve_points(curve: Any, count: int) -> tuple[np.ndarray, str]:
                                  "give one edge or one connected wire")
         if shape.Length <= 0:
             raise ValueError(f"curve: {label or 'the shape'} has no length")
-        return _shape_points(shape, count), label or shape.ShapeType
+        points, tangents = _shape_samples(shape, count)
+        return points, tangents, label or shape.ShapeType
     try:
         points = np.asarray(curve, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -155,30 +169,40 @@ def curve_points(curve: Any, count: int) -> tuple[np.ndarray, str]:
     points = points[np.concatenate([[True], step > 0])]  # (repeated points say nothing)
     if len(points) < 2:
         raise ValueError("curve: the points are all the same; a curve needs length")
-    return _spline_through(points, count), "points"
+    return (*_spline_through(points, count), "points")
 
 
-def _shape_points(shape: Any, count: int) -> np.ndarray:
-    """About ``count`` points along an edge or a wire, each edge evenly by length and its ends
-    among them: a corner between two edges is a point the surface passes through."""
+def _shape_samples(shape: Any, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """About ``count`` points along an edge or a wire and the unit tangents there, each edge evenly
+    by length and its ends among them: a corner between two edges is a point the surface passes
+    through (its tangent there: the two sides' mean)."""
     edges = list(shape.OrderedEdges) if shape.ShapeType == "Wire" else [shape]
     total = sum(e.Length for e in edges)
-    out: list[np.ndarray] = []
+    points: list[np.ndarray] = []
+    tangents: list[np.ndarray] = []
     for e in edges:
         n = max(2, int(round((count - 1) * e.Length / total)) + 1)
-        pts = np.array([[p.x, p.y, p.z] for p in e.discretize(Number=n)], dtype=float)
-        if out:
-            last = out[-1][-1]
+        params = [e.FirstParameter] + [e.getParameterByLength(e.Length * k / (n - 1)) for k in range(1, n - 1)] \
+            + [e.LastParameter]
+        pts = np.array([tuple(e.valueAt(t)) for t in params], dtype=float)
+        tan = np.array([tuple(e.tangentAt(t)) for t in params], dtype=float)
+        if points:
+            last = points[-1][-1]
             if np.linalg.norm(pts[-1] - last) < np.linalg.norm(pts[0] - last):
-                pts = pts[::-1]  # (an edge the wire runs through backwards)
-            pts = pts[1:]
-        out.append(pts)
-    return np.vstack(out)
+                pts, tan = pts[::-1], -tan[::-1]  # (an edge the wire runs through backwards)
+            corner = tangents[-1][-1] + tan[0]
+            tangents[-1][-1] = corner / max(float(np.linalg.norm(corner)), 1e-300)
+            pts, tan = pts[1:], tan[1:]
+        points.append(pts)
+        tangents.append(tan)
+    t = np.vstack(tangents)
+    return np.vstack(points), t / np.maximum(np.linalg.norm(t, axis=1, keepdims=True), 1e-300)
 
 
-def _spline_through(points: np.ndarray, count: int) -> np.ndarray:
+def _spline_through(points: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
     """``count`` points along the natural cubic spline through ``points`` by chord length (a
-    polyline's kinks are nothing a smooth surface could pass through), evenly in chord length."""
+    polyline's kinks are nothing a smooth surface could pass through), evenly in chord length, and
+    its unit tangents there."""
     t = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
     n = len(points)
     second = np.zeros((n, 3))
@@ -191,8 +215,11 @@ def _spline_through(points: np.ndarray, count: int) -> np.ndarray:
     k = np.clip(np.searchsorted(t, at, side="right") - 1, 0, n - 2)
     h = (t[k + 1] - t[k])[:, None]
     a, b = ((t[k + 1] - at)[:, None] / h), ((at - t[k])[:, None] / h)
-    return (a * points[k] + b * points[k + 1]
-            + ((a ** 3 - a) * second[k] + (b ** 3 - b) * second[k + 1]) * h ** 2 / 6)
+    values = (a * points[k] + b * points[k + 1]
+              + ((a ** 3 - a) * second[k] + (b ** 3 - b) * second[k + 1]) * h ** 2 / 6)
+    slopes = ((points[k + 1] - points[k]) / h
+              + (-(3 * a ** 2 - 1) * second[k] + (3 * b ** 2 - 1) * second[k + 1]) * h / 6)
+    return values, slopes / np.linalg.norm(slopes, axis=1, keepdims=True)
 
 
 # --- the surface at given parameters ------------------------------------------------------------
@@ -336,8 +363,9 @@ def conditions(surface: Any, record: CurveConstraint) -> tuple[np.ndarray, np.nd
     r = rows(surface, record.uv)
     a, b = [r.dense(r.s, n)], [record.points]
     if record.continuity == "G1":
-        a += [r.dense(r.su, n), r.dense(r.sv, n)]
-        b += [record.derivatives[:, :3], record.derivatives[:, 3:]]
+        d = record.across
+        a.append(r.dense(d[:, :1] * r.su + d[:, 1:] * r.sv, n))
+        b.append(record.derivatives)
     a_all, b_all = np.vstack(a), np.vstack(b)
     scale = np.linalg.norm(a_all, axis=1, keepdims=True)
     scale[scale == 0] = 1.0
@@ -387,6 +415,21 @@ def _pivots(a: np.ndarray, tolerance: float) -> list[int]:
         chosen.append(j)
 
 
+def _least_move(a: np.ndarray, gap: np.ndarray, tolerance: float) -> np.ndarray:
+    """The smallest pole move x with a x = gap to ``tolerance`` (largest row), leaving out the
+    directions the conditions barely see (singular values below 1e-4, then 1e-6 ... 1e-12 of the
+    largest, the first that reaches it): with the conditions as ill-conditioned as they are, a
+    tiny gap along those (a curve a micrometre off the surface) would throw far poles by metres."""
+    u, singular, vt = np.linalg.svd(a, full_matrices=False)
+    projected = u.T @ gap
+    for cut in (1e-4, 1e-6, 1e-8, 1e-10, 1e-12):
+        keep = singular > cut * singular[0]
+        move = vt[keep].T @ (projected[keep] / singular[keep, None])
+        if np.abs(a @ move - gap).max() <= tolerance:
+            break
+    return move
+
+
 def fit(dynamic: core.DynamicSurface, records: list[CurveConstraint], held: list[int],
         links: list[tuple[Any, ...]], poles: np.ndarray) -> tuple[np.ndarray, list[tuple[Any, ...]]]:
     """Holds ``records``, together, on top of ``held`` and ``links``: the poles moved as little as
@@ -408,7 +451,7 @@ def fit(dynamic: core.DynamicSurface, records: list[CurveConstraint], held: list
     gap[:, np.abs(gap).max(axis=0) <= 1e-12 * dynamic.size] = 0.0  # (rounding: a coordinate that holds stays)
     moved = poles.copy()
     if gap.any():
-        moved[free] += np.linalg.lstsq(af, gap, rcond=1e-12)[0]
+        moved[free] += _least_move(af, gap, 1e-2 * G0_SHARE * dynamic.size)
     # The conditions' row space, orthonormal (Q = V_r^T): slaves picked among its columns keep the
     # link weights bounded however weakly a pole far from the curve takes part (A itself is
     # ill-conditioned: its singular values fall gradually to 1e-11 before the null space).
@@ -448,12 +491,6 @@ def fit(dynamic: core.DynamicSurface, records: list[CurveConstraint], held: list
     return moved, made
 
 
-def tangents(points: np.ndarray) -> np.ndarray:
-    """Unit tangents of the sampled curve (central differences)."""
-    t = np.gradient(points, axis=0)
-    return t / np.maximum(np.linalg.norm(t, axis=1, keepdims=True), 1e-300)
-
-
 def misses(surface: Any, record: CurveConstraint, poles: np.ndarray) -> tuple[float, float]:
     """How far the surface with ``poles`` is from holding ``record`` at its samples: the largest
     distance (mm) and, G1, the largest angle (degrees) between its normal and the one held."""
@@ -461,7 +498,7 @@ def misses(surface: Any, record: CurveConstraint, poles: np.ndarray) -> tuple[fl
     distance = float(np.linalg.norm(r.apply(r.s, poles) - record.points, axis=1).max())
     if record.continuity != "G1":
         return distance, 0.0
-    held = np.cross(record.derivatives[:, :3], record.derivatives[:, 3:])
+    held = np.cross(record.tangents, record.derivatives)
     held /= np.linalg.norm(held, axis=1, keepdims=True)
     cosine = np.abs((normals(surface, poles, record.uv) * held).sum(axis=1))
     return distance, float(np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0))).max())
@@ -518,12 +555,13 @@ def make(dynamic: core.DynamicSurface, curve: Any, continuity: str, normal: Any,
     cells = len({(a, b) for a, b in zip(_basis(np.asarray(surface.knots_u, float), p, uv[:, 0])[0],
                                         _basis(np.asarray(surface.knots_v, float), q, uv[:, 1])[0])})
     count = max(SAMPLES, 2 * (p + q + 1) * cells)
-    points, _ = curve_points(curve, count)
+    points, along, _ = curve_samples(curve, count)
     uv, _ = closest_parameters(surface, poles, points, nearest_mesh_parameters(dynamic, points))
     dense, _ = curve_points(curve, 3 * count)  # (the check's points, between the conditions' samples too)
     record = CurveConstraint(cid, continuity, label, uv, points, normal=None if normal is None else normal.tolist())
     if continuity == "G1":
-        record.derivatives = _held_derivatives(surface, poles, uv, points, normal)
+        record.tangents = along
+        record.across, record.derivatives = _held_derivatives(surface, poles, uv, points, along, normal)
     records = list(records) + [record]
     moved, made = fit(dynamic, records, held, links, poles)
     for r in records:
@@ -546,13 +584,13 @@ def make(dynamic: core.DynamicSurface, curve: Any, continuity: str, normal: Any,
     return record, moved, list(links) + made
 
 
-def _held_derivatives(surface: Any, poles: np.ndarray, uv: np.ndarray, points: np.ndarray,
-                      normal: np.ndarray | None) -> np.ndarray:
-    """G1: per sample the derivatives S_u, S_v to hold (K, 6): the surface's, turned into the plane
-    perpendicular to the normal held (``normal``, or the surface's own turned perpendicular to the
-    curve, the nearest normal a surface through the curve can have). ValueError where the curve
-    leaves the plane perpendicular to ``normal``."""
-    t = tangents(points)
+def _held_derivatives(surface: Any, poles: np.ndarray, uv: np.ndarray, points: np.ndarray, t: np.ndarray,
+                      normal: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """G1: per sample the parameter direction across the curve (K, 2) and the derivative to hold
+    in it (K, 3): the surface's, turned into the plane perpendicular to the normal held (``normal``,
+    or the surface's own, turned perpendicular to the curve where the curve leaves its tangent
+    plane: the nearest normal a surface through the curve can have). ValueError where the curve
+    leaves the plane perpendicular to ``normal``. ``t``: the curve's unit tangents."""
     current = normals(surface, poles, uv)
     if normal is None:  # (where the curve runs in the tangent plane already the normal stays as it is)
         along = (current * t).sum(axis=1, keepdims=True)
@@ -565,10 +603,14 @@ def _held_derivatives(surface: Any, poles: np.ndarray, uv: np.ndarray, points: n
                              f"({', '.join(f'{x:.4g}' for x in points[k])}), so no surface along it can have that normal")
         n = np.tile(normal, (len(points), 1))
     n = _unit(n, "the curve runs along the surface's normal somewhere (it leaves the surface there)")
+    n *= np.sign((n * current).sum(axis=1, keepdims=True) + 1e-300)
     r = rows(surface, uv)
     su, sv = r.apply(r.su, poles), r.apply(r.sv, poles)
-    du = su - (su * n).sum(axis=1, keepdims=True) * n
-    dv = sv - (sv * n).sum(axis=1, keepdims=True) * n
-    if not np.all(np.linalg.norm(np.cross(du, dv), axis=1) > 1e-9 * np.linalg.norm(du, axis=1) * np.linalg.norm(dv, axis=1)):
-        raise ValueError("normal: the surface would have to turn edge-on to it somewhere along the curve")
-    return np.hstack([du, dv])
+    want = np.cross(n, t)  # (across the curve in the plane held)
+    g = np.stack([(su * su).sum(1), (su * sv).sum(1), (sv * sv).sum(1)], axis=1)
+    b = np.stack([(su * want).sum(1), (sv * want).sum(1)], axis=1)
+    det = g[:, 0] * g[:, 2] - g[:, 1] ** 2  # (> 0: the normals exist)
+    across = _unit(np.column_stack([g[:, 2] * b[:, 0] - g[:, 1] * b[:, 1], g[:, 0] * b[:, 1] - g[:, 1] * b[:, 0]])
+                   / det[:, None], "the curve has no direction somewhere (a cusp or a point repeated)")
+    now = across[:, :1] * su + across[:, 1:] * sv
+    return across, now - (now * n).sum(axis=1, keepdims=True) * n

@@ -364,18 +364,45 @@ _NEIGHBOUR_CURVATURES: dict[tuple[Any, ...], np.ndarray] = {}
 _NEIGHBOUR_CACHE_SIZE = 256
 
 
-def _neighbour_curvature(other: Any, edge: Any, occ: Any, ts: np.ndarray, points: np.ndarray,
-                         tangents: np.ndarray) -> np.ndarray:
-    """The curvature across ``edge`` of the unsculpted face ``other`` at the edge's samples."""
+def _neighbour_side(other: Any, edge: Any, occ: Any, ts: np.ndarray, points: np.ndarray,
+                    tangents: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The unit normals and the curvature across ``edge`` of the unsculpted face ``other`` at the
+    edge's samples."""
     key = (other.hashCode(), other.Orientation, points.tobytes(), tangents.tobytes())
-    kappa = _NEIGHBOUR_CURVATURES.get(key)
-    if kappa is None:
-        kappa = curvature_across(other.Surface, _uv_on(other, edge, occ, ts, points),
-                                 -1.0 if other.Orientation == "Reversed" else 1.0, tangents)
+    side = _NEIGHBOUR_CURVATURES.get(key)
+    if side is None:
+        uv = _uv_on(other, edge, occ, ts, points)
+        sign = -1.0 if other.Orientation == "Reversed" else 1.0
+        d = surface_derivatives(other.Surface, uv)
+        side = (sign * _unit(np.cross(d[:, 0], d[:, 1])), curvature_across(other.Surface, uv, sign, tangents, d))
         if len(_NEIGHBOUR_CURVATURES) >= _NEIGHBOUR_CACHE_SIZE:
             _NEIGHBOUR_CURVATURES.pop(next(iter(_NEIGHBOUR_CURVATURES)))  # (the oldest)
-        _NEIGHBOUR_CURVATURES[key] = kappa
-    return kappa
+        _NEIGHBOUR_CURVATURES[key] = side
+    return side
+
+
+@dataclass
+class EdgeProfile:
+    """An edge of a sculpted face as the continuity check draws it: its points (on the sculpted
+    side), and per side of it (one, or two where another face meets it) the unit normals, oriented
+    alike on a closed solid, and the normal curvature across it; the report's numbers and
+    ``g1_deg_sides``, the largest angle between the sides' normals (None with one side); ``held``:
+    what an edge with one side holds by construction (a held edge, a curve followed), else None."""
+
+    edge: str
+    points: np.ndarray
+    sides: list[tuple[np.ndarray, np.ndarray]]
+    g0_mm: float
+    g1_deg: float | None
+    g2_pct: float | None
+    g1_deg_sides: float | None = None
+    held: str | None = None
+
+
+def _angle_between(a: np.ndarray, b: np.ndarray) -> float:
+    cosine = np.einsum("ij,ij->i", a, b)
+    cosine = cosine[np.isfinite(cosine)]
+    return float(np.degrees(np.arccos(np.clip(cosine.min(), -1.0, 1.0)))) if cosine.size else 0.0
 
 
 def seam_report(surface: Any, shape: Any, face_name: str, kinds: dict[str, str],
@@ -389,6 +416,13 @@ def seam_report(surface: Any, shape: Any, face_name: str, kinds: dict[str, str],
     :func:`curvature_jump_pct`; the face's own seam: the sculpted surface on both sides; None on a
     degenerate edge), at SEAM_SAMPLES points per edge (per side of a seam). Edges in ``skip``
     (seams between sculpted faces, see :func:`seam_between`) are left out."""
+    return [{"edge": p.edge, "g0_mm": p.g0_mm, "g1_deg": p.g1_deg, "g2_pct": p.g2_pct}
+            for p in edge_profiles(surface, shape, face_name, kinds, skip)]
+
+
+def edge_profiles(surface: Any, shape: Any, face_name: str, kinds: dict[str, str],
+                  skip: frozenset[str] = frozenset()) -> list[EdgeProfile]:
+    """What :func:`seam_report` measures, with the samples it measures at (:class:`EdgeProfile`)."""
     nface = nurbs_face(shape.getElement(face_name))
     original = nface.Surface
     sign = -1.0 if nface.Orientation == "Reversed" else 1.0
@@ -397,37 +431,39 @@ def seam_report(surface: Any, shape: Any, face_name: str, kinds: dict[str, str],
     for name, occ in named_occurrences(shape, face_name, nface):
         if name not in skip:
             occurrences.setdefault(name, []).append(occ)
-    report = []
+    profiles = []
     for name, occs in occurrences.items():
-        entry: dict[str, Any] = {"edge": name, "g0_mm": 0.0, "g1_deg": None, "g2_pct": None}
+        g0, g1 = 0.0, None
         sampled = []
         for occ in occs:
             uv, ts = _pcurve_points(nface, occ, SEAM_SAMPLES)
             points, tangents = _edge_samples(occ, ts)
             values = np.array([tuple(surface.value(u, v)) for u, v in uv], float)
-            entry["g0_mm"] = max(entry["g0_mm"], float(np.linalg.norm(values - points, axis=1).max()))
+            g0 = max(g0, float(np.linalg.norm(values - points, axis=1).max()))
             derivatives = surface_derivatives(surface, uv)  # (its normals for G1, its curvature for g2_pct)
+            normals = sign * _unit(np.cross(derivatives[:, 0], derivatives[:, 1]))
             if kinds.get(name) in TANGENT:
-                normals = _unit(np.cross(derivatives[:, 0], derivatives[:, 1]))
-                was = np.array([tuple(original.normal(u, v)) for u, v in uv], float)
-                cosine = float(np.nanmin(np.einsum("ij,ij->i", normals, was)))
-                angle = float(np.degrees(np.arccos(max(-1.0, min(1.0, cosine)))))
-                entry["g1_deg"] = max(entry["g1_deg"] or 0.0, angle)
-            sampled.append((occ, uv, ts, points, tangents, derivatives))
+                was = sign * np.array([tuple(original.normal(u, v)) for u, v in uv], float)
+                g1 = max(g1 or 0.0, _angle_between(normals, was))
+            sampled.append((occ, uv, ts, points, tangents, derivatives, normals, values))
+        profile = EdgeProfile(name, sampled[0][7], [], g0, g1, None)
         edge = shape.getElement(name)
         if not edge.Degenerated:
-            occ, uv, ts, points, tangents, derivatives = sampled[0]
+            occ, uv, ts, points, tangents, derivatives, normals, _ = sampled[0]
             here = curvature_across(surface, uv, sign, tangents, derivatives)
+            profile.sides.append((normals, here))
             if len(sampled) == 2:  # the face's own seam: the sculpted surface on both sides
                 there = curvature_across(surface, sampled[1][1], sign, tangents, sampled[1][5])
-                entry["g2_pct"] = curvature_jump_pct(here, there, floor)
+                profile.sides.append((sampled[1][6], there))
             else:
                 other = _other_face(shape, face_name, edge)
                 if other is not None:
-                    there = _neighbour_curvature(other, edge, occ, ts, points, tangents)
-                    entry["g2_pct"] = curvature_jump_pct(here, there, floor)
-        report.append(entry)
-    return sorted(report, key=lambda r: int(r["edge"][4:]))
+                    profile.sides.append(_neighbour_side(other, edge, occ, ts, points, tangents))
+            if len(profile.sides) == 2:
+                profile.g2_pct = curvature_jump_pct(profile.sides[0][1], profile.sides[1][1], floor)
+                profile.g1_deg_sides = _angle_between(profile.sides[0][0], profile.sides[1][0])
+        profiles.append(profile)
+    return sorted(profiles, key=lambda p: int(p.edge[4:]))
 
 
 def seam_between(surfaces: dict[str, Any], shape: Any, faces: tuple[str, str], edge: str, kind: str) -> dict[str, Any]:
@@ -436,7 +472,13 @@ def seam_between(surfaces: dict[str, Any], shape: Any, faces: tuple[str, str], e
     for G1 the largest angle (degrees) between their normals there (``g1_deg``), and the largest
     jump of the normal curvature across it between them (``g2_pct``, see :func:`curvature_jump_pct`),
     at SEAM_SAMPLES points (the edge's pcurves on both faces share its parameter)."""
-    sides, originals, kappas = [], [], []
+    p = seam_profile(surfaces, shape, faces, edge, kind)
+    return {"edge": p.edge, "g0_mm": p.g0_mm, "g1_deg": p.g1_deg, "g2_pct": p.g2_pct}
+
+
+def seam_profile(surfaces: dict[str, Any], shape: Any, faces: tuple[str, str], edge: str, kind: str) -> EdgeProfile:
+    """What :func:`seam_between` measures, with the samples it measures at (:class:`EdgeProfile`)."""
+    values, sides, originals = [], [], []
     tangents = None
     for f in faces:
         nface = nurbs_face(shape.getElement(f))
@@ -446,16 +488,14 @@ def seam_between(surfaces: dict[str, Any], shape: Any, faces: tuple[str, str], e
         surface = surfaces[f]
         points, along = _edge_samples(occ, ts)
         tangents = along if tangents is None else tangents  # (one tangent for both: the same direction across)
-        sides.append([(surface.value(u, v), surface.normal(u, v) * sign) for u, v in uv])
+        d = surface_derivatives(surface, uv)
+        values.append(np.array([tuple(surface.value(u, v)) for u, v in uv], float))
+        sides.append((sign * _unit(np.cross(d[:, 0], d[:, 1])), curvature_across(surface, uv, sign, tangents, d)))
         originals.append(points)
-        kappas.append(curvature_across(surface, uv, sign, tangents))
     drift = float(np.linalg.norm(originals[0] - originals[1], axis=1).max())
     if drift > 1e-7:  # (both faces' conversions keep the edge's parameter; this says if one did not)
         raise RuntimeError(f"{edge}: the two faces' curves of it are parameterised differently ({drift:.3g} mm apart)")
-    gap = max((a[0] - b[0]).Length for a, b in zip(*sides))
-    angle = None
-    if kind in TANGENT:
-        cosines = [a[1].dot(b[1]) for a, b in zip(*sides)]
-        angle = float(np.degrees(np.arccos(max(-1.0, min(1.0, min(cosines))))))
-    return {"edge": edge, "g0_mm": float(gap), "g1_deg": angle,
-            "g2_pct": curvature_jump_pct(kappas[0], kappas[1], _curvature_floor(shape))}
+    gap = float(np.linalg.norm(values[0] - values[1], axis=1).max())
+    between = _angle_between(sides[0][0], sides[1][0])
+    return EdgeProfile(edge, values[0], sides, gap, between if kind in TANGENT else None,
+                       curvature_jump_pct(sides[0][1], sides[1][1], _curvature_floor(shape)), between)

@@ -32,6 +32,7 @@ GROUPS = {
     "HapticSculpt_DisplayGroup": ("Displays", "Analysis displays: material map, curvature, combs, zebra stripes "
                                   "and their settings",
                                   ["HapticSculpt_ShowMap", "HapticSculpt_ShowCurvature", "HapticSculpt_Combs",
+                                   "HapticSculpt_ContinuityCheck",
                                    "HapticSculpt_CombDensity", "HapticSculpt_CombScale", "HapticSculpt_Zebra",
                                    "HapticSculpt_ZebraMode", "HapticSculpt_ZebraStripes",
                                    "HapticSculpt_ZebraDirection"], 0),
@@ -523,6 +524,19 @@ class Combs(_SculptCommand):
             ov.refresh()
 
 
+class ContinuityCheck(_SculptCommand):
+    icon_name, menu = "ContinuityCheck", "Continuity check"
+    tip = ("Toggle curvature combs across every edge, seam and followed curve of the sculpt, on both sides, "
+           "coloured by what holds there (green G2, yellow G1, orange G0, red: apart); the HUD gives the worst "
+           "g0, g1 and g2 over the smooth edges")
+
+    def Activated(self) -> None:
+        ov = _ctl().overlay()
+        if ov is not None:
+            ov.continuity = not ov.continuity
+            ov.refresh()
+
+
 class CombDensity(_SculptCommand):
     icon_name, menu = "CombDensity", "Combs: density"
     tip = "Cycle how many iso-lines carry a curvature comb: every 2nd, 4th or 8th"
@@ -640,7 +654,7 @@ COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_NewClampedPatch": N
             "HapticSculpt_PaintMass": PaintMass, "HapticSculpt_PaintDamping": PaintDamping,
             "HapticSculpt_PaintStiffness": PaintStiffness, "HapticSculpt_PaintBending": PaintBending,
             "HapticSculpt_ShowMap": ShowMap,
-            "HapticSculpt_ShowCurvature": ShowCurvature, "HapticSculpt_Combs": Combs, "HapticSculpt_Zebra": Zebra,
+            "HapticSculpt_ShowCurvature": ShowCurvature, "HapticSculpt_Combs": Combs, "HapticSculpt_ContinuityCheck": ContinuityCheck, "HapticSculpt_Zebra": Zebra,
             "HapticSculpt_ZebraMode": ZebraMode, "HapticSculpt_ZebraStripes": ZebraStripes,
             "HapticSculpt_ZebraDirection": ZebraDirection,
             "HapticSculpt_CombDensity": CombDensity, "HapticSculpt_CombScale": CombScale,

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from .. import core
-from ..app import analysis, curve_constraint
+from ..app import analysis, continuity_check, curve_constraint
 from . import coin_shapes as shapes
 from . import stripes as stripe_shading
 from .hud import Hud
@@ -33,6 +33,8 @@ DISPLAYS = ("shading", *MAPS, "curvature", "mean", "gauss", "zebra")
 JACK_COLOURS = {"point": (1.0, 0.0, 0.0), "tangent": (1.0, 0.5, 0.0), "normal": (0.0, 0.3, 1.0), "curvature": (1.0, 1.0, 1.0)}
 #: Curves the surface follows, drawn on it: G0 (through) and G1 (with its normal).
 CURVE_COLOURS = {"G0": (0.0, 0.9, 1.0), "G1": (1.0, 0.6, 0.0)}
+#: The continuity check's combs, by what holds across the edge.
+CONTINUITY_COLOURS = {"G2": (0.1, 0.85, 0.2), "G1": (1.0, 0.9, 0.0), "G0": (1.0, 0.45, 0.0), "none": (1.0, 0.0, 0.0)}
 
 
 class Overlay:
@@ -43,6 +45,9 @@ class Overlay:
         self.view, self.obj = view, obj
         self.display = "shading"
         self.combs = False
+        self.continuity = False  # the continuity check: combs across edges, seams and curves
+        self.continuity_worst: dict[str, Any] = {}
+        self._continuity: tuple[bytes, list[Any], float, float] | None = None  # poles, profiles, when, cost
         self.comb_every = 4  # a comb on every n-th iso-line of the mesh (density)
         self.comb_gain = 1.0  # the longest tooth is this many tenths of the patch size (scale)
         self.panel_visible = False
@@ -77,7 +82,7 @@ class Overlay:
     def needed(self) -> bool:
         """True while anything is to be drawn each frame."""
         return bool((self._session() is not None and self.live) or self.panel_visible
-                    or ((self.display != "shading" or self.combs) and self._visible()))
+                    or ((self.display != "shading" or self.combs or self.continuity) and self._visible()))
 
     @property
     def shown(self) -> bool:
@@ -205,10 +210,12 @@ class Overlay:
             segments, _ = analysis.curvature_combs(mesh, s.curvature_grid().reshape(mesh.shape[:2] + (6,)),
                                                    every=self.comb_every, gain=self.comb_gain)
             decor.addChild(shapes.lines(segments, (1.0, 0.0, 1.0), 1.0))
+        if self.continuity and seen:
+            decor.addChild(self._continuity_combs(s))
         if seen:
             decor.addChild(self._jacks(s, mesh))
             decor.addChild(self._curves(s))
-        self.surface_drawn = seen and (display != "shading" or (self.combs or bool(s.constraints)
+        self.surface_drawn = seen and (display != "shading" or (self.combs or self.continuity or bool(s.constraints)
                                                                  or bool(self._curves_text())))
         self.cursor_shown = self.cursor is not None and self.needed  # (the jacks alone are not redrawn as the mouse moves)
         if self.cursor_shown:
@@ -312,6 +319,8 @@ class Overlay:
             parts.append(f"zebra: {self.stripe_mode}, {self.stripes:g} stripes, {turn}")
         if self.combs:
             parts.append(f"combs: every {self.comb_every}, x{self.comb_gain:g}")
+        if self.continuity:
+            parts.append(continuity_text(self.continuity_worst))
         if self.mode:
             parts.append(self.mode)
         return "  |  ".join(parts)
@@ -352,6 +361,45 @@ class Overlay:
                 sep.addChild(shapes.circle(p, shapes.frame(*shapes.tangents(mesh, i, j))[:, 2], r, colour))
         return sep
 
+    def _continuity_combs(self, s: core.DynamicSurface) -> Any:
+        """Curvature combs across every edge, seam and curve of the sculpt, on both sides, coloured
+        by what holds there; measured again when the poles moved, but during a session not more
+        often than every twice its cost (it rebuilds the faces' surfaces: 5-20 ms)."""
+        from pivy import coin
+
+        from ..app import sculpt_properties, sculpt_state
+        key = np.asarray(s.poles).tobytes()
+        now = time.perf_counter()
+        if self._continuity is None or (self._continuity[0] != key and
+                                        now - self._continuity[2] >= 2.0 * self._continuity[3]):
+            state = sculpt_properties.read_state(self.obj)
+            frame = sculpt_state.SculptState({**state.arrays, "Poles": np.asarray(s.poles, float).ravel()},
+                                             state.settings)
+            try:
+                found = continuity_check.profiles(self.obj, frame)
+            except (RuntimeError, ValueError):
+                found = []
+            self._continuity = (key, found, now, time.perf_counter() - now)
+            self.continuity_worst = {**continuity_check.worst(found), "profiles": len(found),
+                                     "levels": {p.edge: continuity_check.level(p) for p in found}}
+        found = self._continuity[1]
+        sep = coin.SoSeparator()
+        kappa = max((float(np.nanmax(np.abs(k))) for p in found for _, k in p.sides if np.isfinite(k).any()),
+                    default=0.0)
+        flat = np.asarray(s.mesh).reshape(-1, 3)
+        size = float(np.linalg.norm(flat.max(0) - flat.min(0))) or 1.0
+        scale = 0.1 * size * self.comb_gain / kappa if kappa > 0 else 0.0
+        for p in found:
+            colour = CONTINUITY_COLOURS[continuity_check.level(p)]
+            for k, (normals, curvature) in enumerate(p.sides):
+                ok = np.isfinite(curvature) & np.all(np.isfinite(normals), axis=1)
+                base = p.points[ok]
+                tips = base - normals[ok] * (curvature[ok] * scale)[:, None]
+                teeth = np.stack([base, tips], axis=1)[:: 2 if k else 1]  # (the far side's: every other tooth)
+                outline = np.stack([tips[:-1], tips[1:]], axis=1)
+                sep.addChild(shapes.lines(np.concatenate([teeth, outline]), colour, 1.5 if k else 2.0))
+        return sep
+
     def _curves_text(self) -> str:
         return getattr(self.obj, curve_constraint.PROPERTY, "")
 
@@ -387,6 +435,18 @@ class Overlay:
         if self.contact is not None and grab:
             sep.addChild(shapes.lines(np.array([[pos, self.contact]]), (1.0, 0.85, 0.0), 2.0))
         return sep
+
+
+def continuity_text(worst: dict[str, Any]) -> str:
+    """The HUD's line for the continuity check: the worst g0, g1 and g2 over the smooth edges."""
+    if not worst or worst.get("g0_mm") is None:
+        return "continuity: held edges and curves only (they hold exactly)" if worst.get("profiles") else \
+            "continuity: no edge held, no curve followed"
+
+    def show(value: float | None, unit: str, digits: str) -> str:
+        return "-" if value is None else f"{value:{digits}}{unit}"
+    return (f"continuity: worst g0 {show(worst['g0_mm'], ' mm', '.1e')}, g1 {show(worst['g1_deg'], ' deg', '.3g')}, "
+            f"g2 {show(worst['g2_pct'], ' %', '.3g')} ({worst['smooth']} smooth of {worst['edges']} edges)")
 
 
 def _size(mesh: np.ndarray) -> float:

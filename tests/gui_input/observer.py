@@ -379,7 +379,8 @@ def write(*_):
                               "sliders": ov.panel.values(ov.obj) if ov.panel_visible else [],
                               "stripes": ov.stripes, "active_view": ov.view is getattr(Gui.ActiveDocument, "ActiveView", None),
                               "view": id(ov.view), "object": ov.obj.Name, "cursor": ov.cursor_shown,
-                              "surface_drawn": ov.surface_drawn,
+                              "surface_drawn": ov.surface_drawn, "continuity": ov.continuity,
+                              "continuity_worst": ov.continuity_worst,
                               "drawn": ov._root.getNumChildren() > 0}
                              for ov in ctl.overlays.values()]
     except Exception as exc:  # noqa: BLE001 - the workbench not loaded yet
