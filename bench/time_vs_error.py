@@ -495,9 +495,9 @@ def main() -> None:
         json.dump({"references": notes, "records": records}, f, indent=1)
     rows = pareto_table(records)
     print("\nfastest run (wall s per simulated s) reaching each error level; '-' = never reached")
-    print(f"{'scene':<12}{'solver':<18}" + "".join(f"{level:>10g}" for level in LEVELS))
+    print(f"{'scene':<14}{'solver':<18}" + "".join(f"{level:>10g}" for level in LEVELS))
     for r in rows:
-        print(f"{r['scene']:<12}{r['solver']:<18}" + "".join(
+        print(f"{r['scene']:<14}{r['solver']:<18}" + "".join(
             f"{r[f'{lv:g}']:>10.3g}" if r[f"{lv:g}"] is not None else f"{'-':>10}" for lv in LEVELS))
     print("\ndefault against the paper's schemes (ratio = their fastest / ours at the same error level):")
     for scene in SCENES:
@@ -508,7 +508,7 @@ def main() -> None:
             for lv in LEVELS:
                 a, b = ours[f"{lv:g}"], theirs[f"{lv:g}"]
                 cells.append("ours only" if a is not None and b is None else "-" if a is None else f"{b / a:.1f}x")
-            print(f"  {scene:<12}{label:<10}" + "".join(f"{c:>11}" for c in cells))
+            print(f"  {scene:<14}{label:<10}" + "".join(f"{c:>11}" for c in cells))
     plot(records, os.path.join(out_dir, "time_vs_error.png"))
 
 
