@@ -3,7 +3,8 @@ top meets its front through a 12 mm round, the top and the round sculpted as one
 file; Continuity check from the Displays drop-down draws curvature combs across every edge of the
 two faces and their seam, coloured by what holds (the seam tangent: yellow; the block's edges,
 creases by design: orange), the HUD gives the worst g0, g1 and g2; a mouse stroke in a session
-updates them as it goes; the check off again. Screenshots build/screenshots/real_continuity_*.png."""
+updates them as it goes; zebra stripes cover the faces next to the sculpted ones too; the check off
+again. Screenshots build/screenshots/real_continuity_*.png."""
 from __future__ import annotations
 
 import os
@@ -91,7 +92,10 @@ def test_continuity_check_on_a_top_and_its_round_sculpted_as_one(tmp_path):
         assert after["g0_mm"] <= 1e-7 and after["levels"][seam] == "G1", after
         assert after != worst, "the stroke changed what the check measures"
         assert moving["overlays"], moving
-        d.shot("continuity_stroked")
+        stroked = d.shot("continuity_stroked")
+        # zebra stripes cover the faces next to the sculpted ones too: the seams with them can be judged
+        s = d.press_button("Zebra", lambda s: overlay(s)["neighbours_drawn"] >= 4, "the zebra on the neighbours")
+        d.shot_changed("continuity_zebra", stroked, "the zebra stripes", share=0.05, level=0.3)
         s = d.press_button("ContinuityCheck", lambda s: not overlay(s)["continuity"], "the check off")
     finally:
         d.close()

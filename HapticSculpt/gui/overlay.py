@@ -46,6 +46,7 @@ class Overlay:
         self.display = "shading"
         self.combs = False
         self.continuity = False  # the continuity check: combs across edges, seams and curves
+        self.neighbours_drawn = 0  # faces next to the sculpted ones the last frame's display covered
         self.continuity_worst: dict[str, Any] = {}
         self._continuity: tuple[bytes, list[Any], float, float] | None = None  # poles, profiles, when, cost
         self.comb_every = 4  # a comb on every n-th iso-line of the mesh (density)
@@ -204,6 +205,11 @@ class Overlay:
             scene.addChild(shapes.coloured_mesh(mesh, colours, self._cells(mesh.shape[:2], s.mesh_parameters_u,
                                                                            s.mesh_parameters_v)))
             legend = (self.display, rng)
+        self.neighbours_drawn = 0
+        if display != "shading" and display not in MAPS:
+            for node in self._neighbours(display, bool(glsl) and display == "zebra", legend[1] if legend else None):
+                scene.addChild(node)
+                self.neighbours_drawn += 1
         decor = coin.SoSeparator()
         decor.addChild(light)
         if self.combs and seen:
@@ -296,6 +302,41 @@ class Overlay:
         return stripe_shading.stripe_mesh(points, texture, size, self.stripe_mode, self.stripes,
                                           self.stripe_direction, shapes.quad_indices(g, h) if cells is None else cells,
                                           self.stripe_angle)
+
+    def _neighbours(self, display: str, per_pixel: bool, rng: tuple[float, float] | None) -> list[Any]:
+        """The same display on the faces next to the sculpted ones (a face of a SculptedSolid), so a
+        seam with a face that is not sculpted can be judged across it; the curvature maps on the
+        sculpt's own colour scale."""
+        from ..app.neighbour_faces import neighbour_grids
+        from ..app.sculpted_solid import solid_of
+        solid = solid_of(self.obj)
+        if solid is None:
+            return []
+        try:
+            grids = neighbour_grids(solid)
+        except (RuntimeError, ValueError):
+            return []
+        nodes = []
+        for grid in grids:
+            quads = shapes.quad_indices(*grid.inside.shape) if grid.inside.all() else shapes.masked_quad_indices(grid.inside)
+            if per_pixel:
+                nodes.append(stripe_shading.stripe_mesh(grid.points, stripe_shading.normal_texture(grid.normals),
+                                                        grid.normals.shape[0], self.stripe_mode, self.stripes,
+                                                        self.stripe_direction, quads, self.stripe_angle))
+                continue
+            if display == "zebra":
+                d = self.view.getViewDirection()
+                colours, _ = analysis.zebra_colours(grid.points, np.array([d[0], d[1], d[2]]), self.stripes)
+            elif display == "curvature":
+                top = rng[1] if rng and rng[1] > 0 else 1.0
+                colours = np.zeros(grid.points.shape)
+                colours[..., 1] = np.clip(np.abs(grid.curvature[..., 0]) / top, 0, 1)
+                colours[..., 2] = np.clip(np.abs(grid.curvature[..., 1]) / top, 0, 1)
+            else:
+                lo, hi = rng if rng else analysis.symmetric_range(grid.curvature[..., 4 if display == "mean" else 5])
+                colours, _ = analysis.pseudo_colour(grid.curvature[..., 4 if display == "mean" else 5], lo, hi)
+            nodes.append(shapes.coloured_mesh(grid.points, colours, quads))
+        return nodes
 
     def _cells(self, shape: tuple[int, int], us: Any, vs: Any) -> list[int] | None:
         """The cells of a grid over the domain that lie on the face when the sculpt is a face of a

@@ -380,6 +380,7 @@ def write(*_):
                               "stripes": ov.stripes, "active_view": ov.view is getattr(Gui.ActiveDocument, "ActiveView", None),
                               "view": id(ov.view), "object": ov.obj.Name, "cursor": ov.cursor_shown,
                               "surface_drawn": ov.surface_drawn, "continuity": ov.continuity,
+                              "neighbours_drawn": ov.neighbours_drawn,
                               "continuity_worst": ov.continuity_worst,
                               "drawn": ov._root.getNumChildren() > 0}
                              for ov in ctl.overlays.values()]
