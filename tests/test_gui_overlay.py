@@ -278,7 +278,8 @@ def test_overlay_commands_keys_and_pictures(tmp_path):
     # a sculpt (constraint and paint need a cursor: they had one)
     assert out["inactive"].pop("HapticSculpt_NewPatch") and out["inactive"].pop("HapticSculpt_NewClampedPatch")
     assert not any(v for k, v in out["inactive"].items()), out["inactive"]
-    selection_based = {"HapticSculpt_SculptFace", "HapticSculpt_Thicken", "HapticSculpt_ExportStep"}
+    selection_based = {"HapticSculpt_SculptFace", "HapticSculpt_Thicken", "HapticSculpt_ExportStep",
+                       "HapticSculpt_FollowCurve"}
     assert all(v for k, v in out["active"].items() if k not in selection_based), out["active"]
     assert out["constraints"] == ["curvature", "normal", "point"]
     assert out["painting"] == "stiffness" and out["painting_after"] is None

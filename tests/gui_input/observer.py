@@ -381,6 +381,7 @@ def write(*_):
                               "view": id(ov.view), "object": ov.obj.Name, "cursor": ov.cursor_shown,
                               "surface_drawn": ov.surface_drawn, "continuity": ov.continuity,
                               "neighbours_drawn": ov.neighbours_drawn,
+                              "trimmed": any(v is not None for v in ov._trims.values()),
                               "continuity_worst": ov.continuity_worst,
                               "drawn": ov._root.getNumChildren() > 0}
                              for ov in ctl.overlays.values()]
