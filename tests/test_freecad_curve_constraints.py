@@ -172,7 +172,7 @@ class TestCurveConstraints(SolidChecks):
         n = self.doc.UndoCount
         profile = [(x, 0.0, 8 * math.exp(-(x / 15) ** 2)) for x in np.linspace(-45, 45, 40)]
         cases = [
-            (dict(curve=[(0, 0, 50), (10, 0, 50)]), ValueError, r"runs up to 50 mm from the surface, more than a quarter"),
+            (dict(curve=[(0, 0, 50), (10, 0, 50)]), ValueError, r"runs up to 50 mm from the surface, more than a quarter of the surface's size"),
             (dict(curve=profile), ValueError, r"cannot follow 'points' G0: with 8 x 8 controls.*use more controls"),
             (dict(curve=[(0, 0, 0), (10, 0, 0)], continuity="G2"), ValueError, r"continuity: one of G0, G1"),
             (dict(curve=[(0, 0, 0), (10, 0, 0)], continuity="G1", normal=(1, 0, 0)), ValueError,

@@ -51,17 +51,18 @@ def profiles(sculpt: Any, state: Any = None) -> list[face_in_solid.EdgeProfile]:
     return out + _curve_profiles(sculpt, state)
 
 
-#: An edge whose sides' normals differ by more than this is a crease the design has (a box's
-#: edge), not a smooth edge gone wrong: it counts for g0 only.
+#: An edge whose sides' normals differ by more than this in the base is a crease the design has (a
+#: box's edge), not a smooth edge gone wrong: it counts for g0 only.
 CREASE_DEG = 5.0
 
 
 def worst(found: list[face_in_solid.EdgeProfile]) -> dict[str, Any]:
     """The largest g0 (mm) over the profiles with two sides, and the largest g1 (degrees, between
-    the sides) and g2 (%) over the smooth ones among them (not creases); None where there is none;
-    ``smooth``: how many smooth edges."""
+    the sides) and g2 (%) over the smooth ones among them (smooth in the base, however far a
+    stroke has bent them since; not creases); None where there is none; ``smooth``: how many."""
     two = [p for p in found if len(p.sides) == 2]
-    smooth = [p for p in two if p.g1_deg_sides is not None and p.g1_deg_sides <= CREASE_DEG]
+    smooth = [p for p in two if p.g1_deg_sides is not None
+              and (p.base_deg if p.base_deg is not None else p.g1_deg_sides) <= CREASE_DEG]
     g2 = [p.g2_pct for p in smooth if p.g2_pct is not None]
     return {"g0_mm": max((p.g0_mm for p in two), default=None),
             "g1_deg": max((p.g1_deg_sides for p in smooth), default=None),

@@ -550,7 +550,7 @@ def make(dynamic: core.DynamicSurface, curve: Any, continuity: str, normal: Any,
     uv, distance = closest_parameters(surface, poles, points, nearest_mesh_parameters(dynamic, points))
     if distance.max() > MAX_DISTANCE_SHARE * size:
         raise ValueError(f"curve: '{label}' runs up to {distance.max():.3g} mm from the surface, more than a quarter "
-                         f"of its size ({size:.3g} mm); move it closer, or sculpt toward it first")
+                         f"of the surface's size ({size:.3g} mm); move it closer, or sculpt toward it first")
     p, q = surface.degree
     cells = len({(a, b) for a, b in zip(_basis(np.asarray(surface.knots_u, float), p, uv[:, 0])[0],
                                         _basis(np.asarray(surface.knots_v, float), q, uv[:, 1])[0])})

@@ -386,7 +386,8 @@ class EdgeProfile:
     """An edge of a sculpted face as the continuity check draws it: its points (on the sculpted
     side), and per side of it (one, or two where another face meets it) the unit normals, oriented
     alike on a closed solid, and the normal curvature across it; the report's numbers and
-    ``g1_deg_sides``, the largest angle between the sides' normals (None with one side); ``held``:
+    ``g1_deg_sides``, the largest angle between the sides' normals (None with one side), and
+    ``base_deg`` that angle as the base has it (a crease by design, or a smooth edge); ``held``:
     what an edge with one side holds by construction (a held edge, a curve followed), else None."""
 
     edge: str
@@ -397,6 +398,7 @@ class EdgeProfile:
     g2_pct: float | None
     g1_deg_sides: float | None = None
     held: str | None = None
+    base_deg: float | None = None  # the largest angle between the sides' normals as the base has them
 
 
 def _angle_between(a: np.ndarray, b: np.ndarray) -> float:
@@ -442,23 +444,27 @@ def edge_profiles(surface: Any, shape: Any, face_name: str, kinds: dict[str, str
             g0 = max(g0, float(np.linalg.norm(values - points, axis=1).max()))
             derivatives = surface_derivatives(surface, uv)  # (its normals for G1, its curvature for g2_pct)
             normals = sign * _unit(np.cross(derivatives[:, 0], derivatives[:, 1]))
+            was = sign * np.array([tuple(original.normal(u, v)) for u, v in uv], float)
             if kinds.get(name) in TANGENT:
-                was = sign * np.array([tuple(original.normal(u, v)) for u, v in uv], float)
                 g1 = max(g1 or 0.0, _angle_between(normals, was))
-            sampled.append((occ, uv, ts, points, tangents, derivatives, normals, values))
+            sampled.append(was)
+            originals = sampled.pop()
+            sampled.append((occ, uv, ts, points, tangents, derivatives, normals, values, originals))
         profile = EdgeProfile(name, sampled[0][7], [], g0, g1, None)
         edge = shape.getElement(name)
         if not edge.Degenerated:
-            occ, uv, ts, points, tangents, derivatives, normals, _ = sampled[0]
+            occ, uv, ts, points, tangents, derivatives, normals, _, was = sampled[0]
             here = curvature_across(surface, uv, sign, tangents, derivatives)
             profile.sides.append((normals, here))
             if len(sampled) == 2:  # the face's own seam: the sculpted surface on both sides
                 there = curvature_across(surface, sampled[1][1], sign, tangents, sampled[1][5])
                 profile.sides.append((sampled[1][6], there))
+                profile.base_deg = _angle_between(was, sampled[1][8])
             else:
                 other = _other_face(shape, face_name, edge)
                 if other is not None:
                     profile.sides.append(_neighbour_side(other, edge, occ, ts, points, tangents))
+                    profile.base_deg = _angle_between(was, profile.sides[1][0])
             if len(profile.sides) == 2:
                 profile.g2_pct = curvature_jump_pct(profile.sides[0][1], profile.sides[1][1], floor)
                 profile.g1_deg_sides = _angle_between(profile.sides[0][0], profile.sides[1][0])
@@ -478,7 +484,7 @@ def seam_between(surfaces: dict[str, Any], shape: Any, faces: tuple[str, str], e
 
 def seam_profile(surfaces: dict[str, Any], shape: Any, faces: tuple[str, str], edge: str, kind: str) -> EdgeProfile:
     """What :func:`seam_between` measures, with the samples it measures at (:class:`EdgeProfile`)."""
-    values, sides, originals = [], [], []
+    values, sides, originals, bases = [], [], [], []
     tangents = None
     for f in faces:
         nface = nurbs_face(shape.getElement(f))
@@ -489,6 +495,7 @@ def seam_profile(surfaces: dict[str, Any], shape: Any, faces: tuple[str, str], e
         points, along = _edge_samples(occ, ts)
         tangents = along if tangents is None else tangents  # (one tangent for both: the same direction across)
         d = surface_derivatives(surface, uv)
+        bases.append(sign * np.array([tuple(nface.Surface.normal(u, v)) for u, v in uv], float))
         values.append(np.array([tuple(surface.value(u, v)) for u, v in uv], float))
         sides.append((sign * _unit(np.cross(d[:, 0], d[:, 1])), curvature_across(surface, uv, sign, tangents, d)))
         originals.append(points)
@@ -498,4 +505,5 @@ def seam_profile(surfaces: dict[str, Any], shape: Any, faces: tuple[str, str], e
     gap = float(np.linalg.norm(values[0] - values[1], axis=1).max())
     between = _angle_between(sides[0][0], sides[1][0])
     return EdgeProfile(edge, values[0], sides, gap, between if kind in TANGENT else None,
-                       curvature_jump_pct(sides[0][1], sides[1][1], _curvature_floor(shape)), between)
+                       curvature_jump_pct(sides[0][1], sides[1][1], _curvature_floor(shape)), between,
+                       base_deg=_angle_between(bases[0], bases[1]))

@@ -311,8 +311,17 @@ class HoldEdges(_SculptCommand):
             cycle = BOUNDARIES[1:]  # (a solid's edges are never free: that would open it)
             only = next(iter(outer)) if len(outer) == 1 else None
             now = cycle.index(only) if only in cycle else -1
+            if obj.Proxy.live.session is not None:
+                FreeCAD.Console.PrintWarning(f"HapticSculpt: {solid.Label}: stop the sculpting session to change how "
+                                             "its edges are held\n")
+                return
             following = next((k for k in cycle[now + 1:] + cycle[:now + 1] if can_hold(solid, k)), "G0")
-            run_echoed(f"HapticSculpt.set_boundary({ref(solid)}, {following!r})")
+            try:
+                run_echoed(f"HapticSculpt.set_boundary({ref(solid)}, {following!r})")
+            except Exception as exc:  # noqa: BLE001 - doCommand raises what the call raised
+                FreeCAD.Console.PrintWarning(f"HapticSculpt: {solid.Label}: {exc}\n")
+                return
+            FreeCAD.Console.PrintMessage(f"HapticSculpt: {solid.Label}: edges held {following}\n")
             return
         now = set(held_boundary(obj).values())
         current = BOUNDARIES.index(now.pop()) if len(now) == 1 else 0
@@ -325,11 +334,16 @@ class HoldEdges(_SculptCommand):
                 return False
             return True
         following = next((k for k in BOUNDARIES[current + 1:] if holds(k)), "free")
-        run_echoed(f"HapticSculpt.hold_boundary({ref(obj)}, {following!r})")
+        try:
+            run_echoed(f"HapticSculpt.hold_boundary({ref(obj)}, {following!r})")
+        except Exception as exc:  # noqa: BLE001 - doCommand raises what the call raised (a curve that cannot hold)
+            FreeCAD.Console.PrintWarning(f"HapticSculpt: {obj.Label}: {exc}\n")
+            return
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label}: edges {following}\n")
 
 
-def _curve_selection() -> tuple[Any, str, Any] | None:
-    """(the sculpt, how a script names the curve, the curve) when the selection is one curve (a
+def _curve_selection() -> tuple[Any, str, Any, str] | None:
+    """(the sculpt, how a script names the curve, the curve, how messages name it) when the selection is one curve (a
     sketch or a wire, whole wherever it was clicked, or an edge of a part) and at most one sculpt or
     sculpted solid (else the one under the mouse or the document's only one); else None."""
     from ..app.sculpt_feature import is_sculpt
@@ -347,16 +361,17 @@ def _curve_selection() -> tuple[Any, str, Any] | None:
         return None
     whole = not shape.Faces and (len(shape.Wires) == 1 and len(shape.Wires[0].Edges) == len(shape.Edges)
                                  or len(shape.Edges) == 1)
-    if whole:  # a sketch or a wire: the whole curve, wherever on it the designer clicked
-        code, curve = ref(pick.Object), pick.Object
+    if whole or (not shape.Faces and not edges):  # a sketch or a wire: the whole curve, wherever clicked
+        code, curve, label = ref(pick.Object), pick.Object, pick.Object.Label  # (several wires: the call says why not)
     elif edges:  # an edge of a part (or of a sketch of several wires)
         code, curve = f"{ref(pick.Object)}.Shape.{edges[0]}", getattr(shape, edges[0])
+        label = f"{pick.Object.Label} {edges[0]} (that edge alone)"
     else:
         return None
     target = sculpts[0] if sculpts else _ctl().active_sculpt()
     if target is None or sculpt_for(target) is None:
         return None
-    return target, code, curve
+    return target, code, curve, label
 
 
 class FollowCurve:
@@ -379,8 +394,12 @@ class FollowCurve:
         picked = _curve_selection()
         if picked is None:
             return
-        target, code, curve = picked
-        now = constraint_along(target, curve)
+        target, code, curve, label = picked
+        try:
+            now = constraint_along(target, curve)
+        except (TypeError, ValueError) as exc:  # (a sketch of several wires: which one is meant?)
+            FreeCAD.Console.PrintWarning(f"HapticSculpt: {target.Label} cannot follow {label}: {exc}\n")
+            return
         if now is None:
             call = f"HapticSculpt.add_curve_constraint({ref(target)}, {code})"
         elif now["continuity"] == "G0":
@@ -394,7 +413,7 @@ class FollowCurve:
             return
         _ctl().refresh(sculpt_for(target))  # (the curve drawn on the surface)
         after = constraint_along(target, curve)
-        FreeCAD.Console.PrintMessage(f"HapticSculpt: {target.Label} follows {after['label']} {after['continuity']} "
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: {target.Label} follows {label} {after['continuity']} "
                                      f"(within {after['distance_mm']:.2g} mm)\n" if after else
                                      f"HapticSculpt: {target.Label} no longer follows it\n")
 
