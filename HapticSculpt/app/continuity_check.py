@@ -19,8 +19,8 @@ import numpy as np
 
 from . import curve_constraint, face_in_solid
 from .api import BOUNDARIES, held_boundary
-from .sculpt_properties import surface_of
-from .sculpted_solid import _pieces, base_solid, boundary_of, chain_of_solid, solid_of
+from .sculpt_properties import read_state, surface_of
+from .sculpted_solid import _pieces, base_solid, boundary_of, solid_of
 
 G0_MM, G1_DEG, G2_PCT = 1e-7, 0.01, 1.0
 #: Samples along a held edge of a sculpt on its own, and at most along a curve.
@@ -45,7 +45,7 @@ def level(profile: face_in_solid.EdgeProfile) -> str:
 def profiles(sculpt: Any, state: Any = None) -> list[face_in_solid.EdgeProfile]:
     """The profiles of the sculpt (a Sculpt; its SculptedSolid's edges if it is the face of one),
     with the poles of ``state`` (a SculptState: a session's newest frame) or the stored ones."""
-    state = state if state is not None else _stored(sculpt)
+    state = state if state is not None else read_state(sculpt)
     solid = solid_of(sculpt)
     out = _solid_profiles(solid, state) if solid is not None else _held_edge_profiles(sculpt, state)
     return out + _curve_profiles(sculpt, state)
@@ -67,11 +67,6 @@ def worst(found: list[face_in_solid.EdgeProfile]) -> dict[str, Any]:
     return {"g0_mm": max((p.g0_mm for p in two), default=None),
             "g1_deg": max((p.g1_deg_sides for p in smooth), default=None),
             "g2_pct": max(g2, default=None), "smooth": len(smooth), "edges": len(two)}
-
-
-def _stored(sculpt: Any) -> Any:
-    from .sculpt_properties import read_state
-    return read_state(sculpt)
 
 
 def _solid_profiles(solid: Any, state: Any) -> list[face_in_solid.EdgeProfile]:

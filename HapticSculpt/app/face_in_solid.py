@@ -358,9 +358,9 @@ def _uv_on(face: Any, edge: Any, occ: Any, ts: np.ndarray, points: np.ndarray) -
     return np.array([(q.x, q.y) for q in points2d], float)
 
 
-#: The curvature across an edge of a face that is not sculpted, by the face and the edge's samples:
-#: it is the same after every stroke (the report is remade at each one), so it is computed once.
-_NEIGHBOUR_CURVATURES: dict[tuple[Any, ...], np.ndarray] = {}
+#: The normals and curvature across an edge of a face that is not sculpted, by the face and the edge's samples:
+#: they are the same after every stroke (the report is remade at each one), so they are computed once.
+_NEIGHBOUR_SIDES: dict[tuple[Any, ...], tuple[np.ndarray, np.ndarray]] = {}
 _NEIGHBOUR_CACHE_SIZE = 256
 
 
@@ -369,15 +369,15 @@ def _neighbour_side(other: Any, edge: Any, occ: Any, ts: np.ndarray, points: np.
     """The unit normals and the curvature across ``edge`` of the unsculpted face ``other`` at the
     edge's samples."""
     key = (other.hashCode(), other.Orientation, points.tobytes(), tangents.tobytes())
-    side = _NEIGHBOUR_CURVATURES.get(key)
+    side = _NEIGHBOUR_SIDES.get(key)
     if side is None:
         uv = _uv_on(other, edge, occ, ts, points)
         sign = -1.0 if other.Orientation == "Reversed" else 1.0
         d = surface_derivatives(other.Surface, uv)
         side = (sign * _unit(np.cross(d[:, 0], d[:, 1])), curvature_across(other.Surface, uv, sign, tangents, d))
-        if len(_NEIGHBOUR_CURVATURES) >= _NEIGHBOUR_CACHE_SIZE:
-            _NEIGHBOUR_CURVATURES.pop(next(iter(_NEIGHBOUR_CURVATURES)))  # (the oldest)
-        _NEIGHBOUR_CURVATURES[key] = side
+        if len(_NEIGHBOUR_SIDES) >= _NEIGHBOUR_CACHE_SIZE:
+            _NEIGHBOUR_SIDES.pop(next(iter(_NEIGHBOUR_SIDES)))  # (the oldest)
+        _NEIGHBOUR_SIDES[key] = side
     return side
 
 
@@ -447,9 +447,7 @@ def edge_profiles(surface: Any, shape: Any, face_name: str, kinds: dict[str, str
             was = sign * np.array([tuple(original.normal(u, v)) for u, v in uv], float)
             if kinds.get(name) in TANGENT:
                 g1 = max(g1 or 0.0, _angle_between(normals, was))
-            sampled.append(was)
-            originals = sampled.pop()
-            sampled.append((occ, uv, ts, points, tangents, derivatives, normals, values, originals))
+            sampled.append((occ, uv, ts, points, tangents, derivatives, normals, values, was))
         profile = EdgeProfile(name, sampled[0][7], [], g0, g1, None)
         edge = shape.getElement(name)
         if not edge.Degenerated:
