@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import sys
+from typing import Any
 from types import ModuleType
 
 from .version import __version__
@@ -69,21 +70,33 @@ DynamicSurface = native.DynamicSurface
 MaterialMap = native.MaterialMap
 StepReport = native.StepReport
 Tool = native.Tool
-RopeTool = native.RopeTool
-MagnetTool = native.MagnetTool
-OrientationTool = native.OrientationTool
-SmoothTool = native.SmoothTool
 MAX_DEGREE: int = native.MAX_DEGREE
-#: How much harder the rope pulls per unit of the bending ratio where it is tied (RopeTool.gain).
+#: How much harder the rope pulls per unit of the bending ratio where it is tied (the rope's ``gain``).
 ROPE_PLATE_GAIN: float = native.ROPE_PLATE_GAIN
 
-# The names of the core's choices, from its one table of each (native_core/src/names.hpp).
+# The core's choices, each declared once in C++ (the table beside each enum; each tool's ToolInfo in
+# native_core/src/tools_and_constraints/tools/): nothing here repeats them.
 INTEGRATORS: tuple[str, ...] = native.INTEGRATORS
+#: The tools in menu order.
 TOOLS: tuple[str, ...] = native.TOOLS
+#: Per tool: ``title``, ``tip``, ``order``, ``falloff`` (whether it takes one), ``parameters``
+#: (name -> ``default``, ``allow_zero``, ``doc``) and ``readouts`` (name -> doc).
+TOOL_INFO: dict[str, dict[str, Any]] = native.TOOL_INFO
 CONSTRAINTS: tuple[str, ...] = native.CONSTRAINTS
 FALLOFFS: tuple[str, ...] = native.FALLOFFS
 LAWS: tuple[str, ...] = native.LAWS
 MAPS: tuple[str, ...] = native.MAPS
+#: The session defaults: ``haptic_rate`` (Hz), ``sim_dt`` (s) and ``realtime`` (ask for SCHED_FIFO).
+DEFAULTS: dict[str, Any] = native.DEFAULTS
+
+
+def tool_settings_of(tool: str) -> tuple[str, ...]:
+    """The settings ``tool`` takes: its parameters, ``falloff`` if it has one, and the limits every
+    tool has (``max_force``, ``ramp_time``). ``ValueError`` for an unknown tool."""
+    if tool not in TOOL_INFO:
+        raise ValueError(f"tool: unknown tool {tool!r} (one of {', '.join(TOOLS)})")
+    info = TOOL_INFO[tool]
+    return tuple(info["parameters"]) + (("falloff",) if info["falloff"] else ()) + ("max_force", "ramp_time")
 
 
 def patch(controls: tuple[int, int] = (8, 8), degree: tuple[int, int] = (3, 3),
@@ -92,6 +105,6 @@ def patch(controls: tuple[int, int] = (8, 8), degree: tuple[int, int] = (3, 3),
     return DynamicSurface(BSplineSurface.plane(controls, degree, size), mesh)
 
 
-__all__ = ["BSplineSurface", "DynamicSurface", "MaterialMap", "StepReport", "Tool", "RopeTool", "MagnetTool",
-           "OrientationTool", "SmoothTool", "MAX_DEGREE", "ROPE_PLATE_GAIN", "INTEGRATORS", "TOOLS", "CONSTRAINTS", "FALLOFFS",
-           "LAWS", "patch"]
+__all__ = ["BSplineSurface", "DynamicSurface", "MaterialMap", "StepReport", "Tool", "MAX_DEGREE", "ROPE_PLATE_GAIN",
+           "INTEGRATORS", "TOOLS", "TOOL_INFO", "CONSTRAINTS", "FALLOFFS", "LAWS", "MAPS", "DEFAULTS", "tool_settings_of",
+           "patch"]

@@ -178,7 +178,7 @@ def run_scene(seed: int, steps: int = STEPS) -> SceneResult:
             if msg:
                 res.failure = msg
                 return res
-        s.set_tool(core.TOOLS[int(rng.integers(0, 4))])
+        s.set_tool(core.TOOLS[int(rng.integers(0, len(core.TOOLS)))])
         # Held poles (hard constraints) in a quarter of the scenes, from a stream of their own so the
         # other scenes stay what they were: any subset, up to all of them.
         held_rng = np.random.default_rng([seed, 1])

@@ -1,6 +1,6 @@
-"""The package's layers (tools/architecture.py): imports run downward only, no import cycles, only
-core.py picks the native module, the live surface's private core surface stays private, no Qt binding, importing the package loads no
-GUI, and docs/architecture.dot is generated from the code as it is."""
+"""The layers (tools/architecture.py): the C++ core's includes and the package's imports run downward
+only, without cycles; only core.py picks the native module, the live surface's private core surface stays private, no Qt binding, importing the package loads no
+GUI, and docs/architecture.dot and docs/architecture_core.dot are generated from the code as it is."""
 from __future__ import annotations
 
 import ast
@@ -95,3 +95,57 @@ def test_the_architecture_picture_is_generated_from_the_code():
     assert committed == architecture.dot(GRAPH), \
         "docs/architecture.dot is out of date: run `python3 tools/architecture.py` and commit both files"
     assert architecture.DOT.with_suffix(".svg").is_file()
+
+
+def test_the_core_includes_run_downward_without_cycles():
+    assert architecture.core_violations() == []
+    assert not [f for f in architecture.core_files() if "/" not in f], "files loose in native_core/src"
+
+
+def test_the_core_rules_catch_upward_sideways_and_loose_includes(tmp_path, monkeypatch):
+    """The check above fails on a core that breaks the rules: an include planted upward (geometry
+    includes the runtime), one across device families, a file outside the layers, an include not
+    by its layer path, and a cycle."""
+    src = tmp_path / "native_core" / "src"
+    plant = {
+        "geometry/knot_vector.hpp": '#include "runtime/haptic_runtime.hpp"\n',
+        "runtime/haptic_runtime.hpp": '#include "geometry/knot_vector.hpp"\n',
+        "devices/hid/spacemouse.hpp": '#include "devices/device.hpp"\n#include "devices/falcon/falcon_usb.hpp"\n',
+        "devices/device.hpp": "",
+        "devices/falcon/falcon_usb.hpp": '#include "falcon_frames.hpp"\n',
+        "loose.hpp": "",
+    }
+    for name, text in plant.items():
+        (src / name).parent.mkdir(parents=True, exist_ok=True)
+        (src / name).write_text(text)
+    monkeypatch.setattr(architecture, "ROOT", tmp_path)
+    assert architecture.core_violations() == [
+        'include not by its layer path: devices/falcon/falcon_usb.hpp includes "falcon_frames.hpp"',
+        "sideways include: devices/hid/spacemouse.hpp (devices/hid) includes devices/falcon/falcon_usb.hpp (devices/falcon)",
+        "upward include: geometry/knot_vector.hpp (geometry) includes runtime/haptic_runtime.hpp (runtime)",
+        "outside the layers: loose.hpp",
+        "include cycle: geometry/knot_vector.hpp -> runtime/haptic_runtime.hpp -> geometry/knot_vector.hpp"]
+
+
+def test_the_bindings_mirror_the_core_layers():
+    """One binding file per layer of the core (devices in two: HID and force devices), each
+    including its own layer and those below."""
+    bindings = ROOT / "native_core" / "bindings"
+    files = {p.stem for p in bindings.glob("*.cpp")}
+    for layer in architecture.CORE_LAYERS[1:]:
+        assert layer in files, f"no bindings/{layer}.cpp"
+    rank = {name: i for i, name in enumerate(architecture.CORE_LAYERS)}
+    for path in bindings.glob("*.cpp"):
+        own = {"hid_devices": "devices", "force_devices": "devices"}.get(path.stem, path.stem)
+        if own not in rank:
+            continue  # module.cpp, convert.cpp: the module itself
+        for inc in architecture.core_includes(path):
+            layer = inc.split("/")[0]
+            assert layer not in rank or rank[layer] <= rank[own], f"{path.name} includes {inc}"
+
+
+def test_the_core_picture_is_generated_from_the_code():
+    committed = architecture.CORE_DOT.read_text()
+    assert committed == architecture.core_dot(architecture.core_graph()), \
+        "docs/architecture_core.dot is out of date: run `python3 tools/architecture.py` and commit it"
+    assert architecture.CORE_DOT.with_suffix(".svg").is_file()

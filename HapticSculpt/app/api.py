@@ -258,16 +258,17 @@ def replay_stroke(obj: Any, stroke: str) -> bool:
 
 
 def set_tool(obj: Any, tool: str, falloff: str | None = None) -> None:
-    """Selects the sculpting tool ("rope", "magnet", "orientation", "smooth"); ``falloff`` sets the
-    magnet's or smooth tool's ("constant", "spherical", "cylindrical", "conical"). One undo step; a
-    running session takes it at once."""
+    """Selects the sculpting tool (one of ``core.TOOLS``: "rope", "magnet", ...); ``falloff`` sets the
+    falloff of a tool that has one (``core.TOOL_INFO[tool]["falloff"]``: "constant", "spherical",
+    "cylindrical", "conical"). One undo step; a running session takes it at once."""
     obj = _sculpt(obj, solids=True)
     if tool not in core.TOOLS:
         raise ValueError(f"tool: unknown tool {tool!r} (one of {', '.join(core.TOOLS)})")
     if falloff is not None and falloff not in core.FALLOFFS:
         raise ValueError(f"falloff: one of {', '.join(core.FALLOFFS)}, got {falloff!r}")
-    if falloff is not None and tool not in ("magnet", "smooth"):
-        raise ValueError(f"falloff: only the magnet and the smooth tool have one, not {tool}")
+    if falloff is not None and not core.TOOL_INFO[tool]["falloff"]:
+        with_falloff = [t for t in core.TOOLS if core.TOOL_INFO[t]["falloff"]]
+        raise ValueError(f"falloff: only the {', '.join(with_falloff)} tools have one, not {tool}")
 
     def change(s: core.DynamicSurface) -> None:
         s.set_tool(tool)

@@ -2,7 +2,7 @@
 plane of the document), and which parameter direction the mirror image reverses. A face is
 symmetric in a plane when its mirror image is itself with u (or v) reversed about the middle of its
 parameter range; the sculpt's net is then refined with the mirror images of its knots, so the core
-can hold it exactly symmetric (see native_core/src/mirror_symmetry.hpp).
+can hold it exactly symmetric (see native_core/src/dynamics/mirror_symmetry.hpp).
 """
 from __future__ import annotations
 

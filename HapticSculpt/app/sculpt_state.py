@@ -34,14 +34,6 @@ def map_property(name: str) -> str:
     raise ValueError(f"map: one of mass, damping, stiffness, bending, not {name!r}")
 
 
-_TOOL_PARAMS = {
-    "rope": ("stiffness", "stiff_stiffness", "threshold", "reel_time"),
-    "magnet": ("radius", "stiffness", "falloff"),
-    "orientation": ("stiffness",),
-    "smooth": ("radius", "strength", "falloff"),
-}
-
-
 @dataclass
 class SculptState:
     """Arrays (flat float64) and settings (JSON-compatible) that fully describe a surface."""
@@ -57,9 +49,7 @@ class SculptState:
 def tool_settings(surface: core.DynamicSurface) -> dict[str, Any]:
     """The current tool's name and parameters."""
     tool = surface.tool
-    params = {k: getattr(tool, k) for k in _TOOL_PARAMS[tool.name]}
-    params.update(max_force=tool.max_force, ramp_time=tool.ramp_time)
-    return {"name": tool.name, "params": params}
+    return {"name": tool.name, "params": {k: getattr(tool, k) for k in core.tool_settings_of(tool.name)}}
 
 
 def apply_tool(surface: core.DynamicSurface, settings: dict[str, Any]) -> None:
@@ -68,7 +58,7 @@ def apply_tool(surface: core.DynamicSurface, settings: dict[str, Any]) -> None:
     if name not in core.TOOLS:
         raise ValueError(f"tool: unknown tool {name!r} (one of {', '.join(core.TOOLS)})")
     params = dict(settings.get("params", {}))
-    allowed = set(_TOOL_PARAMS[name]) | {"max_force", "ramp_time"}
+    allowed = set(core.tool_settings_of(name))
     unknown = set(params) - allowed
     if unknown:
         raise ValueError(f"tool: {name} has no parameter(s) {', '.join(sorted(unknown))}")

@@ -433,7 +433,7 @@ class Controller:
         obj = self.active_sculpt()
         if obj is None:
             return
-        falloff = f", falloff={self.falloff!r}" if tool == "magnet" else ""
+        falloff = f", falloff={self.falloff!r}" if core.TOOL_INFO[tool]["falloff"] else ""
         run_echoed(f"HapticSculpt.set_tool({ref(obj)}, {tool!r}{falloff})")
 
     def start_session(self, device: Any = None) -> Any:

@@ -124,18 +124,24 @@ def falcon_firmware(firmware: str | None = None) -> str:
     return path
 
 
+def _rate(rate: float | None) -> dict[str, float]:
+    """The rate argument for a force device: none for None, so that the core's default (the haptic
+    loop's, core.DEFAULTS["haptic_rate"]) applies."""
+    return {} if rate is None else {"rate": float(rate)}
+
+
 def haply(device_id: str = "", service: str | None = None, origin: Sequence[float] = (0.0, 0.0, 0.0),
-          scale: float = 1.0, force_scale: float = 1e-3, max_force: float = 0.0, rate: float = 1000.0) -> Any:
+          scale: float = 1.0, force_scale: float = 1e-3, max_force: float = 0.0, rate: float | None = None) -> Any:
     """A Haply Inverse3 through the Inverse Service (``service`` "host:port", else
     $HAPTICSCULPT_HAPLY_SERVICE, else this machine's port 10001); ``device_id`` "" takes the first
     one it lists. Where the grip is at ``start()`` maps to ``origin``."""
     host, port = _haply_address(service)
     return _core.HaplyDevice(host=host, port=port, device_id=str(device_id), origin=_point(origin), scale=scale,
-                             force_scale=force_scale, max_force=max_force, rate=rate)
+                             force_scale=force_scale, max_force=max_force, **_rate(rate))
 
 
 def falcon(index: int = 0, firmware: str | None = None, origin: Sequence[float] = (0.0, 0.0, 0.0),
-           scale: float = 1.0, force_scale: float = 1e-3, max_force: float = 0.0, rate: float = 1000.0,
+           scale: float = 1.0, force_scale: float = 1e-3, max_force: float = 0.0, rate: float | None = None,
            library: str | Sequence[str] | None = None) -> Any:
     """The ``index``-th Novint Falcon on USB. Its firmware (Novint's, loaded after each power-up) comes
     from ``firmware`` or $HAPTICSCULPT_FALCON_FIRMWARE when it is not running yet. ``origin``: where
@@ -145,21 +151,21 @@ def falcon(index: int = 0, firmware: str | None = None, origin: Sequence[float] 
         raise ValueError("index: must be >= 0")
     return _core.FalconDevice(index=int(index), firmware=falcon_firmware(firmware), library=_library(library, "falcon"),
                               origin=_point(origin), scale=scale, force_scale=force_scale, max_force=max_force,
-                              rate=rate)
+                              **_rate(rate))
 
 
 def openhaptics(origin: Sequence[float] = (0.0, 0.0, 0.0), scale: float = 1.0, force_scale: float = 1e-3,
-                max_force: float = 0.0, rate: float = 1000.0, library: str | Sequence[str] | None = None) -> Any:
+                max_force: float = 0.0, rate: float | None = None, library: str | Sequence[str] | None = None) -> Any:
     """3D Systems Touch / Phantom (its default device) through OpenHaptics, loaded at run time."""
     return _core.OpenHapticsDevice(library=_library(library, "openhaptics"), origin=_point(origin), scale=scale,
-                                   force_scale=force_scale, max_force=max_force, rate=rate)
+                                   force_scale=force_scale, max_force=max_force, **_rate(rate))
 
 
 def dhd(origin: Sequence[float] = (0.0, 0.0, 0.0), scale: float = 1.0, force_scale: float = 1e-3,
-        max_force: float = 0.0, rate: float = 1000.0, library: str | Sequence[str] | None = None) -> Any:
+        max_force: float = 0.0, rate: float | None = None, library: str | Sequence[str] | None = None) -> Any:
     """The first Force Dimension device through the DHD SDK, loaded at run time."""
     return _core.DhdDevice(library=_library(library, "dhd"), origin=_point(origin), scale=scale,
-                           force_scale=force_scale, max_force=max_force, rate=rate)
+                           force_scale=force_scale, max_force=max_force, **_rate(rate))
 
 
 def list(firmware: str | None = None, libraries: dict[str, Any] | None = None) -> builtins.list[dict[str, Any]]:

@@ -2,7 +2,7 @@
 
 Positions are interpolated linearly between samples, orientations by normalised linear
 interpolation of the quaternions (sign-aligned), buttons are held from the last sample; the
-interpolation is the core's (native_core/src/replay_device.cpp), shared with the threaded loops. The text
+interpolation is the core's (native_core/src/devices/replay_device.cpp), shared with the threaded loops. The text
 format (one sample per line: ``t x y z qw qx qy qz buttons``, floats written with 17 significant
 digits) round-trips bit for bit, so any session recorded into it replays exactly.
 """

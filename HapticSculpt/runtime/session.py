@@ -94,11 +94,12 @@ class Session:
         self.applied_edits: list[dict[str, Any]] = []
 
     # --- life cycle -------------------------------------------------------------------------------
-    def start(self, obj: Any, device: Any, tool: str = "rope", haptic_rate: float = 1000.0,
-              sim_dt: float = 5e-4, max_force: float = 0.0, max_stiffness: float = 0.0,
+    def start(self, obj: Any, device: Any, tool: str = "rope", haptic_rate: float | None = None,
+              sim_dt: float | None = None, max_force: float = 0.0, max_stiffness: float = 0.0,
               stale_limit: float = 0.02, record_seconds: float = 0.0, stop_when_finished: bool = False,
-              realtime: bool = True) -> "Session":
-        """Starts the loops. ``max_force``/``max_stiffness`` of 0 take the device's limits;
+              realtime: bool | None = None) -> "Session":
+        """Starts the loops. ``haptic_rate``, ``sim_dt`` and ``realtime`` of None take the core's
+        defaults (``core.DEFAULTS``). ``max_force``/``max_stiffness`` of 0 take the device's limits;
         ``record_seconds`` > 0 logs every haptic tick (for :meth:`recording` and benchmarks).
         ``realtime`` asks for real-time priority (SCHED_FIFO) for the haptic thread, which holds its
         1 ms period while other programs load the machine; Linux grants it to root or within an
@@ -118,6 +119,10 @@ class Session:
         surface = live.surface
         if surface.tool.name != tool:
             surface.set_tool(tool)
+        defaults = core.DEFAULTS
+        haptic_rate = defaults["haptic_rate"] if haptic_rate is None else haptic_rate
+        sim_dt = defaults["sim_dt"] if sim_dt is None else sim_dt
+        realtime = defaults["realtime"] if realtime is None else realtime
         runtime = _core.HapticRuntime(surface, native, haptic_rate=haptic_rate, sim_dt=sim_dt, max_force=max_force,
                                       max_stiffness=max_stiffness, stale_limit=stale_limit, log_seconds=record_seconds,
                                       stop_when_finished=stop_when_finished, realtime=realtime)

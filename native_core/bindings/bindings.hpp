@@ -1,14 +1,14 @@
-// One function per part of the Python module _core (module.cpp calls them in dependency order).
+// One function per layer of the core (native_core/src/<layer>), called by module.cpp bottom up.
 #pragma once
 #include <pybind11/pybind11.h>
 
 namespace hs {
-void bindNames(pybind11::module_& m);           ///< bind_names.cpp: the names of the core's choices
-void bindSurface(pybind11::module_& m);         ///< bind_surface.cpp: BSplineSurface
-void bindMaterial(pybind11::module_& m);        ///< bind_material.cpp: MaterialMap
-void bindTools(pybind11::module_& m);           ///< bind_tools.cpp: Tool and the four tools
-void bindDynamicSurface(pybind11::module_& m);  ///< bind_dynamic_surface.cpp: DynamicSurface, StepReport
-void bindRuntime(pybind11::module_& m);         ///< bind_runtime.cpp: Device, replays, HapticRuntime
-void bindDevices(pybind11::module_& m);         ///< bind_devices.cpp: HID, SpaceMouse, force feedback
-void bindForceDevices(pybind11::module_& m);    ///< bind_force_devices.cpp: Falcon, OpenHaptics, DHD
+void bindGeometry(pybind11::module_& m);             ///< geometry.cpp: BSplineSurface, MAX_DEGREE, FALLOFFS
+void bindDynamics(pybind11::module_& m);             ///< dynamics.cpp: MaterialMap, LAWS
+void bindToolsAndConstraints(pybind11::module_& m);  ///< tools_and_constraints.cpp: Tool, TOOLS, TOOL_INFO, CONSTRAINTS
+void bindSolvers(pybind11::module_& m);              ///< solvers.cpp: DynamicSurface, StepReport, INTEGRATORS
+void bindDevices(pybind11::module_& m);              ///< devices.cpp: Device, the replay and external devices
+void bindHidDevices(pybind11::module_& m);           ///< hid_devices.cpp: HID, SpaceMouse, HID PID force feedback
+void bindForceDevices(pybind11::module_& m);         ///< force_devices.cpp: Falcon, Haply, OpenHaptics, DHD, limits
+void bindRuntime(pybind11::module_& m);              ///< runtime.cpp: HapticRuntime, DEFAULTS, MAPS
 }  // namespace hs

@@ -3,11 +3,22 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <array>
 #include <vector>
 
-#include "types.hpp"
+#include "common/names.hpp"
+#include "common/types.hpp"
 
 namespace hs {
+
+/// The names in a Named table (common/names.hpp) as a tuple: INTEGRATORS, FALLOFFS and the like.
+template <class E, std::size_t N>
+pybind11::tuple namesOf(const std::array<Named<E>, N>& table) {
+    pybind11::tuple out(N);
+    for (std::size_t i = 0; i < N; ++i) out[i] = table[i].name;
+    return out;
+}
+
 
 using DoubleArray = pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>;
 

@@ -7,12 +7,12 @@
 PYBIND11_MODULE(HS_MODULE_NAME, m) {
     m.doc() = "HapticSculpt dynamics core: dynamic B-spline surfaces (Dachille et al.), tools, constraints, integrators.";
     m.attr("__version__") = HS_VERSION;
-    hs::bindNames(m);
-    hs::bindSurface(m);
-    hs::bindMaterial(m);
-    hs::bindTools(m);
-    hs::bindDynamicSurface(m);
-    hs::bindRuntime(m);
-    hs::bindDevices(m);  // SpaceMouse, HID PID: subclasses of Device
+    hs::bindGeometry(m);
+    hs::bindDynamics(m);
+    hs::bindToolsAndConstraints(m);
+    hs::bindSolvers(m);
+    hs::bindDevices(m);
+    hs::bindHidDevices(m);  // SpaceMouse, HID PID: subclasses of Device
     hs::bindForceDevices(m);
+    hs::bindRuntime(m);
 }

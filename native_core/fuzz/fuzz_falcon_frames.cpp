@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <cstdlib>
 
-#include "falcon_frames.hpp"
+#include "devices/falcon/falcon_frames.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     hs::falcon::FrameReader reader;

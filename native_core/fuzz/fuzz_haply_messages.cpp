@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "haply_messages.hpp"
+#include "devices/haply/haply_messages.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     static hs::haply::Reader reader;  // (sized once, as the device's is)

@@ -6,8 +6,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "recorded_transport.hpp"
-#include "spacemouse.hpp"
+#include "devices/hid/recorded_transport.hpp"
+#include "devices/hid/spacemouse.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     hs::HidRecording rec;

@@ -6,8 +6,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "hid_report_descriptor.hpp"
-#include "pid_force.hpp"
+#include "devices/hid/hid_report_descriptor.hpp"
+#include "devices/hid/pid_force.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     const std::vector<std::uint8_t> bytes(data, data + size);

@@ -3,7 +3,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "spacemouse.hpp"
+#include "devices/hid/spacemouse.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     hs::SpaceMouseParser parser;

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "recorded_transport.hpp"
+#include "devices/hid/recorded_transport.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
 

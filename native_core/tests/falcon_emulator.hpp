@@ -11,9 +11,9 @@
 #include <cstring>
 #include <functional>
 
-#include "falcon_frames.hpp"
-#include "falcon_kinematics.hpp"
-#include "falcon_transport.hpp"
+#include "devices/falcon/falcon_frames.hpp"
+#include "devices/falcon/falcon_kinematics.hpp"
+#include "devices/falcon/falcon_transport.hpp"
 
 namespace hs::falcon {
 

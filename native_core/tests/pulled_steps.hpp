@@ -1,7 +1,7 @@
 // A rope pulled slowly up from `start` for 50 steps of `dt` (after two steps to warm up), as
 // the no-allocation tests of the stepping hot path drive it: the allocations those 50 made.
 #pragma once
-#include "dynamic_surface.hpp"
+#include "solvers/dynamic_surface.hpp"
 
 long allocationCount();  // test_core.cpp
 

@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <new>
 
-#include "dynamic_surface.hpp"
+#include "solvers/dynamic_surface.hpp"
 
 // Counts heap allocations so a test can assert that stepping allocates nothing. Every form of
 // operator new and delete is replaced, all on malloc/free: a library that allocates with one form
@@ -263,7 +263,7 @@ INSTANTIATE_TEST_SUITE_P(Integrators, AllocationFree,
                          ::testing::Values(IntegratorKind::Explicit, IntegratorKind::ImplicitCG, IntegratorKind::LocalGlobal));
 
 TEST(Tools, ReactionIsMinusTheForceOnTheSurface) {
-    for (const char* name : {"rope", "magnet", "orientation", "smooth"}) {
+    for (const std::string& name : toolNames()) {
         DynamicSurface s(BSplineSurface::plane(6, 6, 3, 3, 40, 40), 15, 15);
         Points f = Points::Zero(s.mesh().rows(), 3);
         auto tool = makeTool(name);

@@ -7,10 +7,10 @@
 #include <memory>
 #include <thread>
 
-#include "dynamic_surface.hpp"
-#include "falcon_device.hpp"
+#include "solvers/dynamic_surface.hpp"
+#include "devices/falcon/falcon_device.hpp"
 #include "falcon_emulator.hpp"
-#include "haptic_runtime.hpp"
+#include "runtime/haptic_runtime.hpp"
 
 using namespace hs;
 

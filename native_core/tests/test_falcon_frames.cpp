@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "falcon_frames.hpp"
+#include "devices/falcon/falcon_frames.hpp"
 
 using namespace hs::falcon;
 

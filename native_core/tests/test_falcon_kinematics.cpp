@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "falcon_kinematics.hpp"
+#include "devices/falcon/falcon_kinematics.hpp"
 
 using namespace hs::falcon;
 

@@ -12,10 +12,10 @@
 #include <random>
 #include <thread>
 
-#include "dynamic_surface.hpp"
-#include "falcon_device.hpp"
-#include "falcon_usb.hpp"
-#include "haptic_runtime.hpp"
+#include "solvers/dynamic_surface.hpp"
+#include "devices/falcon/falcon_device.hpp"
+#include "devices/falcon/falcon_usb.hpp"
+#include "runtime/haptic_runtime.hpp"
 
 using namespace hs;
 

@@ -1,8 +1,8 @@
 // The energy guard and the sleep monitor on their own (DynamicSurface's tests cover them in use).
 #include <gtest/gtest.h>
 
-#include "energy_guard.hpp"
-#include "sleep_monitor.hpp"
+#include "dynamics/energy_guard.hpp"
+#include "dynamics/sleep_monitor.hpp"
 
 using namespace hs;
 

@@ -13,10 +13,10 @@
 #include <memory>
 #include <thread>
 
-#include "dynamic_surface.hpp"
-#include "haply_device.hpp"
+#include "solvers/dynamic_surface.hpp"
+#include "devices/haply/haply_device.hpp"
 #include "haply_mock_service.hpp"
-#include "haptic_runtime.hpp"
+#include "runtime/haptic_runtime.hpp"
 
 using namespace hs;
 

@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "dynamic_surface.hpp"
+#include "solvers/dynamic_surface.hpp"
 #include "pulled_steps.hpp"
 
 using namespace hs;

@@ -9,13 +9,13 @@
 #include <sstream>
 #include <thread>
 
-#include "haptic_runtime.hpp"
-#include "hid_report_descriptor.hpp"
-#include "pid_emulator.hpp"
-#include "pid_force.hpp"
-#include "recorded_transport.hpp"
-#include "replay_device.hpp"
-#include "spacemouse.hpp"
+#include "runtime/haptic_runtime.hpp"
+#include "devices/hid/hid_report_descriptor.hpp"
+#include "devices/hid/pid_emulator.hpp"
+#include "devices/hid/pid_force.hpp"
+#include "devices/hid/recorded_transport.hpp"
+#include "devices/replay_device.hpp"
+#include "devices/hid/spacemouse.hpp"
 
 using namespace hs;
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "dynamic_surface.hpp"
+#include "solvers/dynamic_surface.hpp"
 #include "pulled_steps.hpp"
 
 using namespace hs;

@@ -5,8 +5,8 @@
 
 #include <stdexcept>
 
-#include "device_limits.hpp"
-#include "passivity.hpp"
+#include "devices/device_limits.hpp"
+#include "devices/passivity.hpp"
 
 using namespace hs;
 

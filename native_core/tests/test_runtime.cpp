@@ -9,11 +9,11 @@
 #include <limits>
 #include <thread>
 
-#include "dynamic_surface.hpp"
-#include "external_device.hpp"
-#include "haptic_runtime.hpp"
-#include "replay_device.hpp"
-#include "triple_buffer.hpp"
+#include "solvers/dynamic_surface.hpp"
+#include "devices/external_device.hpp"
+#include "runtime/haptic_runtime.hpp"
+#include "devices/replay_device.hpp"
+#include "common/triple_buffer.hpp"
 
 long allocationCount();
 
@@ -142,7 +142,7 @@ TEST(HapticEstimate, ReproducesTheToolReactionAtTheSnapshot) {
         auto s = patch();
         if (tool == "rope on a plate") s->bendingMap().setUniform(10.0);
         s->setTool(tool.substr(0, tool.find(' ')));
-        if (tool == "magnet") static_cast<MagnetTool&>(s->tool()).radius = 20;
+        if (tool == "magnet") s->tool().set("radius", 20);
         Cursor c;
         c.position = Vec3(1, 2, 0.5);
         c.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Vec3::UnitZ()));
@@ -167,7 +167,7 @@ TEST(HapticEstimate, ReproducesTheToolReactionAtTheSnapshot) {
         EXPECT_NEAR((f - r.reaction.force).norm() / r.reaction.force.norm(), 0.0,
                     tool == "rope on a plate" ? 0.05 : 0.03) << tool;
         if (tool == "rope on a plate") {
-            EXPECT_DOUBLE_EQ(static_cast<RopeTool&>(s->tool()).gain(), 1 + 10 * kRopePlateGain);
+            EXPECT_DOUBLE_EQ(s->tool().read("gain"), 1 + 10 * kRopePlateGain);
         }
     }
 }
@@ -214,7 +214,7 @@ TEST(HapticRuntime, DeviceLossStopsWithZeroForceAndAClamp) {
     auto s = patch();
     auto dev = std::make_shared<RecordingDevice>();
     s->setTool("rope");
-    static_cast<RopeTool&>(s->tool()).stiffStiffness = 1000;  // steeper than the device's 40
+    s->tool().set("stiff_stiffness", 1000);  // steeper than the device's 40
     HapticRuntime rt(s, dev, RuntimeSettings{});
     rt.start();
     ASSERT_TRUE(waitFor([&] { return dev->nonZero.load(); }));  // the rope pulls back

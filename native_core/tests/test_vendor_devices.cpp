@@ -11,11 +11,11 @@
 #include <thread>
 #include <type_traits>
 
-#include "device_limits.hpp"
-#include "dhd_device.hpp"
-#include "dynamic_surface.hpp"
-#include "haptic_runtime.hpp"
-#include "openhaptics_device.hpp"
+#include "devices/device_limits.hpp"
+#include "devices/vendor/dhd_device.hpp"
+#include "solvers/dynamic_surface.hpp"
+#include "runtime/haptic_runtime.hpp"
+#include "devices/vendor/openhaptics_device.hpp"
 
 using namespace hs;
 

@@ -1,0 +1,90 @@
+// Fairing (the Fair operation): the poles that balance the shape's curvature variation, weighted
+// per mesh point, against staying where they are, with every hard constraint kept:
+//   min_p  (p - p0)^T A^T M A (p - p0) + tau p^T A^T C^T W C A p
+// with C the third differences of the mesh (x_uuu, x_uuv, x_uvv, x_vvv: the gradient of the
+// curvature, |grad^3 x|^2 = |x_uuu|^2 + 3 |x_uuv|^2 + 3 |x_uvv|^2 + |x_vvv|^2), whose null space
+// is the quadratic shapes: a sphere, a cylinder or a plane stays what it is, waves and tents relax.
+// Solved in the free poles (P = T z, held_poles.hpp) for the increment, then put through setPoles
+// (linked poles onto their masters, the mirror projection). tau = strength x trace(A^T M A) /
+// trace(A^T C^T C A): strength 1 weighs the curvature variation of the control net's own modes as
+// much as their displacement.
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "solvers/dynamic_surface.hpp"
+
+namespace hs {
+
+namespace {
+
+/// C (rows: the third differences at each mesh point where they fit, scaled to a square cell by
+/// r = sqrt(h_v / h_u)) and each row's mesh point.
+Eigen::SparseMatrix<double> variationOperator(int g, int h, double su, double sv, std::vector<int>& centre) {
+    const double r = std::sqrt(sv / su), s3 = std::sqrt(3.0);
+    const double cube[4] = {-1, 3, -3, 1}, second[3] = {1, -2, 1}, first[2] = {-1, 1};
+    std::vector<Eigen::Triplet<double>> t;
+    int row = 0;
+    auto at = [h](int a, int b) { return a * h + b; };
+    for (int a = 0; a < g; ++a)
+        for (int b = 0; b < h; ++b) {
+            if (a + 3 < g) {
+                for (int k = 0; k < 4; ++k) t.emplace_back(row, at(a + k, b), cube[k] * r * r * r);
+                centre.push_back(at(a + 1, b));
+                ++row;
+            }
+            if (b + 3 < h) {
+                for (int k = 0; k < 4; ++k) t.emplace_back(row, at(a, b + k), cube[k] / (r * r * r));
+                centre.push_back(at(a, b + 1));
+                ++row;
+            }
+            if (a + 2 < g && b + 1 < h) {  // uuv
+                for (int i = 0; i < 3; ++i)
+                    for (int j = 0; j < 2; ++j) t.emplace_back(row, at(a + i, b + j), second[i] * first[j] * s3 * r);
+                centre.push_back(at(a + 1, b));
+                ++row;
+            }
+            if (a + 1 < g && b + 2 < h) {  // uvv
+                for (int i = 0; i < 2; ++i)
+                    for (int j = 0; j < 3; ++j) t.emplace_back(row, at(a + i, b + j), first[i] * second[j] * s3 / r);
+                centre.push_back(at(a, b + 1));
+                ++row;
+            }
+        }
+    Eigen::SparseMatrix<double> C(row, g * h);
+    C.setFromTriplets(t.begin(), t.end());
+    return C;
+}
+
+}  // namespace
+
+void DynamicSurface::fair(const Eigen::VectorXd& weights, double strength) {
+    if (weights.size() != d_.rows()) throw std::invalid_argument("weights: one per mesh point (g x h)");
+    if (!weights.allFinite() || weights.minCoeff() < 0 || weights.maxCoeff() > 1)
+        throw std::invalid_argument("weights: must be in [0, 1]");
+    requireInRange(strength, "strength", 0.0, 1e12);
+    if (strength == 0 || weights.maxCoeff() == 0) return;
+    refreshMaterials();
+    std::vector<int> centre;
+    const Eigen::SparseMatrix<double> C = variationOperator(g(), h(), spacingU_, spacingV_, centre);
+    Eigen::VectorXd w(C.rows());
+    for (Eigen::Index r = 0; r < C.rows(); ++r) w[r] = weights[centre[static_cast<std::size_t>(r)]];
+    const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
+    const Eigen::SparseMatrix<double> CA = C * A;
+    const Eigen::SparseMatrix<double> M = A.transpose() * m_.asDiagonal() * A;
+    const Eigen::SparseMatrix<double> K = CA.transpose() * w.asDiagonal() * CA;
+    const double scale = M.diagonal().sum() / CA.squaredNorm();  // trace(A^T C^T C A) = |C A|_F^2
+    const double tau = strength * scale;
+    Eigen::SparseMatrix<double> sys = M + tau * K;
+    held_.restrict(sys, true);
+    Points rhs = -tau * (K * surface_.poles());
+    held_.reduce(rhs);
+    PrefactoredSolver solver;
+    solver.factor(sys, "fairing system A^T (M + tau C^T W C) A");
+    Points step(rhs.rows(), 3);
+    solver.solve(rhs, step);
+    held_.expand(step);
+    setPoles(surface_.poles() + step);
+}
+
+}  // namespace hs
