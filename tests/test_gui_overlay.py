@@ -116,7 +116,7 @@ try:
     for name, cls in commands.COMMANDS.items():
         out["active"][name] = bool(cls().IsActive())
     Gui.runCommand("HapticSculpt_ToolMagnet")
-    Gui.runCommand("HapticSculpt_MagnetFalloff")
+    Gui.runCommand("HapticSculpt_Falloff")
     out["magnet"] = [surface.tool.name, surface.tool.falloff]
     Gui.runCommand("HapticSculpt_ToolRope")
     out["undo"] = doc.UndoNames[:8]

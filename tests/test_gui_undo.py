@@ -25,7 +25,7 @@ try:
     ctl = controller()
     ctl.mouse_point = np.array(obj.Proxy.live.snapshot().mesh)[10, 10]
     steps = [("HapticSculpt_Material", None), ("HapticSculpt_Material", None), ("HapticSculpt_ToolMagnet", None),
-             ("HapticSculpt_MagnetFalloff", None), ("HapticSculpt_ToolOrientation", None),
+             ("HapticSculpt_Falloff", None), ("HapticSculpt_ToolOrientation", None),
              ("HapticSculpt_ToolSmooth", None), ("HapticSculpt_ToolRope", None),
              ("HapticSculpt_PointConstraint", None), ("HapticSculpt_NormalConstraint", None),
              ("HapticSculpt_CurvatureConstraint", None), ("HapticSculpt_PointConstraint", None),
@@ -58,7 +58,7 @@ os._exit(0)
 def test_every_editing_command_is_one_exact_undo_step(tmp_path):
     out = run_freecad_gui(GUI_SCRIPT, str(tmp_path))
     names = {"HapticSculpt_Material": "Material: ", "HapticSculpt_ToolMagnet": "Tool: magnet",
-             "HapticSculpt_MagnetFalloff": "Tool: magnet", "HapticSculpt_ToolOrientation": "Tool: orientation",
+             "HapticSculpt_Falloff": "Tool: magnet", "HapticSculpt_ToolOrientation": "Tool: orientation",
              "HapticSculpt_ToolSmooth": "Tool: smooth", "HapticSculpt_ToolRope": "Tool: rope",
              "HapticSculpt_PointConstraint": "constraint", "HapticSculpt_NormalConstraint": "Add normal constraint",
              "HapticSculpt_CurvatureConstraint": "Add curvature constraint", "slider stiffness": "Set stiffness",

@@ -6,6 +6,7 @@ from typing import Any
 import FreeCAD
 import FreeCADGui as Gui
 
+from .. import core
 from .view_provider import icon
 
 #: The drop-down command groups (FreeCAD group commands, as Draft's and PartDesign's): name ->
@@ -15,10 +16,10 @@ GROUPS = {
                               "clamped sheet)", ["HapticSculpt_NewPatch", "HapticSculpt_NewClampedPatch"], 0),
     "HapticSculpt_OutputGroup": ("Output", "Export STEP, or thicken the selected sculpt into a solid",
                                  ["HapticSculpt_ExportStep", "HapticSculpt_Thicken"], 0),
-    "HapticSculpt_ToolGroup": ("Tools", "Choose the sculpting tool: rope, magnet (and its falloff), orientation, "
-                               "smooth",
-                               ["HapticSculpt_ToolRope", "HapticSculpt_ToolMagnet", "HapticSculpt_MagnetFalloff",
-                                "HapticSculpt_ToolOrientation", "HapticSculpt_ToolSmooth"], 0),
+    "HapticSculpt_ToolGroup": ("Tools", f"Choose the sculpting tool: {', '.join(core.TOOLS)}; and the falloff of "
+                               "those that have one",
+                               [*(f"HapticSculpt_Tool{core.TOOL_INFO[t]['title']}" for t in core.TOOLS),
+                                "HapticSculpt_Falloff"], 0),
     "HapticSculpt_MaterialGroup": ("Material", "The material: elastic or clay, keep the shape, fair it, airbrush "
                                    "the mass, damping, stiffness or bending map, the slider panel",
                                    ["HapticSculpt_Material", "HapticSculpt_KeepShape", "HapticSculpt_Fair",
@@ -425,36 +426,33 @@ class _Tool(_SculptCommand):
         _ctl().set_tool(self.tool)
 
 
-class ToolRope(_Tool):
-    tool, icon_name, menu = "rope", "Rope", "Rope tool"
-    tip = "Rope: grabs the nearest mass point; pulls, cannot push; reels in over 1 s"
+def _tool_commands() -> dict[str, type]:
+    """One command per tool of the core, from what the tool declares (core.TOOL_INFO): its title
+    names the command (HapticSculpt_ToolRope) and its icon (Rope.svg), its tip is the tool tip."""
+    out = {}
+    for name in core.TOOLS:
+        info = core.TOOL_INFO[name]
+        out[f"HapticSculpt_Tool{info['title']}"] = type(
+            f"Tool{info['title']}", (_Tool,),
+            {"tool": name, "icon_name": info["title"], "menu": f"{info['title']} tool", "tip": info["tip"]})
+    return out
 
 
-class ToolMagnet(_Tool):
-    tool, icon_name, menu = "magnet", "Magnet", "Magnet tool"
-    tip = "Magnet: pulls every mass point within its radius, weighted by its falloff"
-
-
-class ToolOrientation(_Tool):
-    tool, icon_name, menu = "orientation", "Orientation", "Orientation tool"
-    tip = "Orientation: five springs turn the surface's u and v directions toward the cursor frame"
-
-
-class ToolSmooth(_Tool):
-    tool, icon_name, menu = "smooth", "Smooth", "Smooth tool"
-    tip = "Smooth: a fairing brush toward lower curvature variation under the cursor"
-
-
-class MagnetFalloff(_SculptCommand):
-    icon_name, menu = "MagnetFalloff", "Magnet falloff"
-    tip = "Cycle the magnet's falloff: constant, spherical, cylindrical (about the cursor axis), conical"
+class Falloff(_SculptCommand):
+    icon_name, menu = "Falloff", "Falloff"
+    tip = (f"Cycle the current tool's falloff ({', '.join(t for t in core.TOOLS if core.TOOL_INFO[t]['falloff'])}): "
+           "constant, spherical, cylindrical (about the cursor axis), conical")
 
     def Activated(self) -> None:
-        from ..core import FALLOFFS
         ctl = _ctl()
-        nxt = FALLOFFS[(FALLOFFS.index(ctl.falloff) + 1) % len(FALLOFFS)]
-        ctl.set_tool("magnet", nxt)
-        FreeCAD.Console.PrintMessage(f"HapticSculpt: magnet falloff {nxt}\n")
+        if not core.TOOL_INFO[ctl.tool]["falloff"]:
+            with_one = [t for t in core.TOOLS if core.TOOL_INFO[t]["falloff"]]
+            FreeCAD.Console.PrintWarning(f"HapticSculpt: the {ctl.tool} tool has no falloff (choose the "
+                                         f"{', '.join(with_one)} tool first)\n")
+            return
+        nxt = core.FALLOFFS[(core.FALLOFFS.index(ctl.falloff) + 1) % len(core.FALLOFFS)]
+        ctl.set_tool(ctl.tool, nxt)
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: {ctl.tool} falloff {nxt}\n")
 
 
 class _Constraint(_SculptCommand):
@@ -666,9 +664,7 @@ COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_NewClampedPatch": N
             "HapticSculpt_SculptFace": SculptFace, "HapticSculpt_Session": Session,
             "HapticSculpt_Material": Material, "HapticSculpt_KeepShape": KeepShape,
             "HapticSculpt_HoldEdges": HoldEdges, "HapticSculpt_FollowCurve": FollowCurve, "HapticSculpt_Fair": Fair,
-            "HapticSculpt_ToolRope": ToolRope, "HapticSculpt_ToolMagnet": ToolMagnet,
-            "HapticSculpt_MagnetFalloff": MagnetFalloff, "HapticSculpt_ToolOrientation": ToolOrientation,
-            "HapticSculpt_ToolSmooth": ToolSmooth, "HapticSculpt_PointConstraint": PointConstraint,
+            **_tool_commands(), "HapticSculpt_Falloff": Falloff, "HapticSculpt_PointConstraint": PointConstraint,
             "HapticSculpt_NormalConstraint": NormalConstraint, "HapticSculpt_CurvatureConstraint": CurvatureConstraint,
             "HapticSculpt_PaintMass": PaintMass, "HapticSculpt_PaintDamping": PaintDamping,
             "HapticSculpt_PaintStiffness": PaintStiffness, "HapticSculpt_PaintBending": PaintBending,

@@ -7,6 +7,7 @@
 #include <new>
 
 #include "solvers/dynamic_surface.hpp"
+#include "pulled_steps.hpp"
 
 // Counts heap allocations so a test can assert that stepping allocates nothing. Every form of
 // operator new and delete is replaced, all on malloc/free: a library that allocates with one form
@@ -261,6 +262,15 @@ TEST(Prepare, TheFirstStepAfterItDoesNotAllocate) {
 
 INSTANTIATE_TEST_SUITE_P(Integrators, AllocationFree,
                          ::testing::Values(IntegratorKind::Explicit, IntegratorKind::ImplicitCG, IntegratorKind::LocalGlobal));
+
+TEST(Tools, EveryToolStepsWithoutAllocating) {
+    for (const std::string& name : toolNames()) {
+        DynamicSurface s(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 30, 30);
+        s.setSleep({false, 1e-6, 10});
+        s.setTool(name);
+        EXPECT_EQ(allocationsWhilePulling(s, 1e-3, Vec3(1, 2, 0.5)), 0) << name;
+    }
+}
 
 TEST(Tools, ReactionIsMinusTheForceOnTheSurface) {
     for (const std::string& name : toolNames()) {
