@@ -162,7 +162,7 @@ public:
     const Points& externalForces() const { return fext_; }
     double maxPointForce = 1e6;
 
-    void setTool(const std::string& name);  ///< rope, magnet, orientation, smooth
+    void setTool(const std::string& name);  ///< a tool of the catalogue (toolNames(): rope, magnet, ...)
     Tool& tool() { return *tool_; }
     const Tool& tool() const { return *tool_; }
     /// Latest cursor; a rising grab edge grabs, a falling one releases.
