@@ -70,6 +70,8 @@ DynamicSurface = native.DynamicSurface
 MaterialMap = native.MaterialMap
 StepReport = native.StepReport
 Tool = native.Tool
+#: A tool by name, on its own (its settings checked as on a surface's tool): ``make_tool("flatten")``.
+make_tool = native.make_tool
 MAX_DEGREE: int = native.MAX_DEGREE
 #: How much harder the rope pulls per unit of the bending ratio where it is tied (the rope's ``gain``).
 ROPE_PLATE_GAIN: float = native.ROPE_PLATE_GAIN
@@ -106,5 +108,5 @@ def patch(controls: tuple[int, int] = (8, 8), degree: tuple[int, int] = (3, 3),
 
 
 __all__ = ["BSplineSurface", "DynamicSurface", "MaterialMap", "StepReport", "Tool", "MAX_DEGREE", "ROPE_PLATE_GAIN",
-           "INTEGRATORS", "TOOLS", "TOOL_INFO", "CONSTRAINTS", "FALLOFFS", "LAWS", "MAPS", "DEFAULTS", "tool_settings_of",
+           "INTEGRATORS", "TOOLS", "TOOL_INFO", "make_tool", "CONSTRAINTS", "FALLOFFS", "LAWS", "MAPS", "DEFAULTS", "tool_settings_of",
            "patch"]

@@ -146,3 +146,33 @@ answer({{"module": type(obj.Proxy).__module__, "poles": poles.ravel().tolist(),
             self.assertIn(mentions, got[name]["error"], name)
             self.assertIn(name, got[name]["error"])
             self.assertIn(mentions, got[name]["raised"], name)
+
+
+class TestToolSettings(DocumentTestCase):
+    """hs.set_tool takes a tool's settings by the names the core declares (TOOL_INFO): one undo step,
+    saved with the document; a refused value or name changes nothing."""
+
+    def test_settings_by_name_are_one_undo_step_saved_and_checked(self):
+        obj = hs.make_sculpt(self.doc)
+        hs.set_tool(obj, "magnet", "conical", radius=17.0, stiffness=30.0)
+        self.assertEqual(self.doc.UndoNames[0], "Tool: magnet")
+        tool = obj.Proxy.surface.tool
+        self.assertEqual((tool.name, tool.radius, tool.stiffness, tool.falloff), ("magnet", 17.0, 30.0, "conical"))
+        saved = sculpt_state.tool_settings(sculpt_state.restore(read_state(obj)))
+        self.assertEqual(saved, {"name": "magnet", "params": {"radius": 17.0, "stiffness": 30.0, "falloff": "conical",
+                                                              "max_force": 1000.0, "ramp_time": 0.05}})
+        steps = len(self.doc.UndoNames)
+        for kwargs, message in (({"radius": -1.0}, "radius"), ({"reel_time": 1.0}, "no setting reel_time"),
+                                ({"radius": float("nan")}, "radius")):
+            with self.assertRaisesRegex(ValueError, message):
+                hs.set_tool(obj, "magnet", **kwargs)
+        with self.assertRaisesRegex(ValueError, "only the magnet, smooth"):
+            hs.set_tool(obj, "rope", "conical")
+        self.assertEqual(len(self.doc.UndoNames), steps)
+        self.assertEqual(obj.Proxy.surface.tool.radius, 17.0)
+        self.doc.undo()
+        self.assertEqual(obj.Proxy.surface.tool.name, "rope")
+        for name in hs.core.TOOLS:  # every tool's declared defaults are what a new one has
+            made = hs.core.make_tool(name)
+            for key, p in hs.core.TOOL_INFO[name]["parameters"].items():
+                self.assertEqual(getattr(made, key), p["default"], (name, key))

@@ -257,10 +257,12 @@ def replay_stroke(obj: Any, stroke: str) -> bool:
     return True
 
 
-def set_tool(obj: Any, tool: str, falloff: str | None = None) -> None:
+def set_tool(obj: Any, tool: str, falloff: str | None = None, **settings: float) -> None:
     """Selects the sculpting tool (one of ``core.TOOLS``: "rope", "magnet", ...); ``falloff`` sets the
     falloff of a tool that has one (``core.TOOL_INFO[tool]["falloff"]``: "constant", "spherical",
-    "cylindrical", "conical"). One undo step; a running session takes it at once."""
+    "cylindrical", "conical"); ``settings`` set its parameters by name (``radius=25``; the names,
+    defaults and meanings in ``core.TOOL_INFO[tool]["parameters"]``, plus ``max_force`` and
+    ``ramp_time``). One undo step; a running session takes it at once."""
     obj = _sculpt(obj, solids=True)
     if tool not in core.TOOLS:
         raise ValueError(f"tool: unknown tool {tool!r} (one of {', '.join(core.TOOLS)})")
@@ -269,11 +271,21 @@ def set_tool(obj: Any, tool: str, falloff: str | None = None) -> None:
     if falloff is not None and not core.TOOL_INFO[tool]["falloff"]:
         with_falloff = [t for t in core.TOOLS if core.TOOL_INFO[t]["falloff"]]
         raise ValueError(f"falloff: only the {', '.join(with_falloff)} tools have one, not {tool}")
+    known = [k for k in core.tool_settings_of(tool) if k != "falloff"]
+    unknown = sorted(set(settings) - set(known))
+    if unknown:
+        raise ValueError(f"{tool}: no setting {', '.join(unknown)} (it has {', '.join(known)})")
+    values = {k: _finite(v, k) for k, v in settings.items()}
+    probe = core.make_tool(tool)  # (the core checks the ranges before the edit: a refused value changes nothing)
+    for key, value in values.items():
+        setattr(probe, key, value)
 
     def change(s: core.DynamicSurface) -> None:
         s.set_tool(tool)
         if falloff is not None:
             s.tool.falloff = falloff
+        for key, value in values.items():
+            setattr(s.tool, key, value)
     obj.Proxy.live.edit(change, f"Tool: {tool}")
 
 

@@ -93,6 +93,7 @@ void bindToolsAndConstraints(py::module_& m) {
             if (info.falloff) out.push_back("falloff");
             return out;
         });
+    m.def("make_tool", &makeTool, py::arg("name"), "A tool of the catalogue by name, on its own (unknown names: ValueError).");
 }
 
 }  // namespace hs
