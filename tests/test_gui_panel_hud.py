@@ -1,6 +1,7 @@
 """The slider panel and the HUD as a designer meets them: FreeCAD's real GUI under Xvfb, real X
-input (xdotool). The panel's sliders are dragged in the isometric and the front view, with and
-without a mouse session: each drag changes its value as one undo step and never sculpts. The HUD
+input (xdotool). The panel's sliders (the material's, the curvature targets', the current tool's
+settings) are dragged in the isometric and the front view, with and without a mouse session: each
+drag changes its value as one undo step and never sculpts. The HUD
 over white zebra stripes: its text stands on a dark backing, its items do not overlap, the zebra
 legend shows as many bands as the display has stripes. Screenshots: build/screenshots/real_panel_*.png."""
 from __future__ import annotations
@@ -13,7 +14,9 @@ import pytest
 from test_gui_real_input import NEEDS, SHOTS, Desktop, patch_with_keyed_constraints, sculpt, undo
 
 SLIDERS = [("mass", "Set mass"), ("damping", "Set damping"), ("stiffness", "Set stiffness"),
-           ("bending", "Set bending"), ("curvature_u", "Set curvature"), ("curvature_v", "Set curvature")]
+           ("bending", "Set bending"), ("curvature_u", "Set curvature"), ("curvature_v", "Set curvature"),
+           # then the current tool's settings, as the core declares them (the rope's: a new patch's tool)
+           *[(f"tool.rope.{name}", "Tool: rope") for name in ("stiffness", "stiff_stiffness", "threshold", "reel_time")]]
 VIEW_KEYS = {"iso": "0", "front": "1", "top": "2"}  # FreeCAD's standard view shortcuts
 pytestmark = pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD")
 

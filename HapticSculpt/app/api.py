@@ -262,7 +262,8 @@ def set_tool(obj: Any, tool: str, falloff: str | None = None, **settings: float)
     falloff of a tool that has one (``core.TOOL_INFO[tool]["falloff"]``: "constant", "spherical",
     "cylindrical", "conical"); ``settings`` set its parameters by name (``radius=25``; the names,
     defaults and meanings in ``core.TOOL_INFO[tool]["parameters"]``, plus ``max_force`` and
-    ``ramp_time``). One undo step; a running session takes it at once."""
+    ``ramp_time``). The current tool keeps the settings not given; another tool starts from its
+    defaults. One undo step; a running session takes it at once."""
     obj = _sculpt(obj, solids=True)
     if tool not in core.TOOLS:
         raise ValueError(f"tool: unknown tool {tool!r} (one of {', '.join(core.TOOLS)})")
@@ -281,7 +282,8 @@ def set_tool(obj: Any, tool: str, falloff: str | None = None, **settings: float)
         setattr(probe, key, value)
 
     def change(s: core.DynamicSurface) -> None:
-        s.set_tool(tool)
+        if s.tool.name != tool:  # (the current tool keeps the settings not given)
+            s.set_tool(tool)
         if falloff is not None:
             s.tool.falloff = falloff
         for key, value in values.items():

@@ -97,19 +97,25 @@ class Hud:
         if legend is not None:
             self._group("legend", lambda: self._legend(w, h, *legend, zebra_bands, floor), w, h)
         if sliders:
-            self._group("sliders", lambda: self._sliders(w, h, sliders), w, h)
+            self._group("sliders", lambda: self._sliders(w, h, sliders, floor), w, h)
         if lines:
             self._group("status", lambda: [self._text(line, MARGIN + PAD, MARGIN + PAD + (len(lines) - 1 - k) * LINE,
                                                       TEXT, "status" if k == 0 else f"status{k + 1}", w)
                                            for k, line in enumerate(lines)], w, h)
 
-    def _sliders(self, w: int, h: int, sliders: list[tuple[str, float, bool, float]]) -> None:
-        """Each slider: its number, label and value, and under them its track with the knob."""
-        x0 = MARGIN + PAD
+    def _sliders(self, w: int, h: int, sliders: list[tuple[str, float, bool, float]], floor: float) -> None:
+        """Each slider: its number, label and value, and under them its track with the knob; down
+        from the top-left corner to the status lines (``floor``), then on in a column to the right."""
+        texts = [f"{k + 1}  {label} {value:.3g}" for k, (label, value, _, _) in enumerate(sliders)]
+        step = LINE + TRACK_ROW
         top = h - MARGIN - PAD
-        for k, (label, value, held, f) in enumerate(sliders):
-            row = top - k * (LINE + TRACK_ROW)
-            self._text(f"{k + 1}  {label} {value:.3g}", x0, row - FONT_SIZE, HELD if held else TEXT, f"slider{k + 1}", w)
+        rows = max(1, int((top - floor) // step))
+        widest = max(len(f"{k + 1}  {label} ") + 9 for k, (label, *_) in enumerate(sliders))  # (9: any value)
+        column = max(TRACK_WIDTH, widest * CHAR_WIDTH) + 2 * PAD + MARGIN
+        for k, (text, (_, _, held, f)) in enumerate(zip(texts, sliders)):
+            x0 = MARGIN + PAD + (k // rows) * column
+            row = top - (k % rows) * step
+            self._text(text, x0, row - FONT_SIZE, HELD if held else TEXT, f"slider{k + 1}", w)
             yc = row - LINE - TRACK_ROW / 2
             self._quad(x0, yc - 1.5, x0 + TRACK_WIDTH, yc + 1.5, TRACK_COLOUR)
             kx = x0 + f * TRACK_WIDTH

@@ -26,7 +26,7 @@ from ..app import analysis, continuity_check, curve_constraint
 from . import coin_shapes as shapes
 from . import stripes as stripe_shading
 from .hud import Hud
-from .panel import SLIDERS, SliderPanel
+from .panel import SliderPanel, sliders
 
 MAPS = ("mass", "damping", "stiffness", "bending")
 DISPLAYS = ("shading", *MAPS, "curvature", "mean", "gauss", "zebra")
@@ -249,7 +249,8 @@ class Overlay:
         if not self.panel_visible or self.hud is None:
             return {}
         boxes = self.hud.boxes()
-        return {name: boxes[f"track{k + 1}"] for k, (name, _, _, _) in enumerate(SLIDERS) if f"track{k + 1}" in boxes}
+        return {name: boxes[f"track{k + 1}"] for k, (name, _, _, _) in enumerate(sliders(self.obj))
+                if f"track{k + 1}" in boxes}
 
     def panel_press(self, x: float, y: float) -> bool:
         """Button down at view pixel (x, y): True if it took a slider (shown at once)."""

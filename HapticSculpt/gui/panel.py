@@ -1,4 +1,5 @@
-"""The paper's control panel: sliders for mass, damping, stiffness, bending and the curvature targets, drawn
+"""The paper's control panel: sliders for mass, damping, stiffness, bending and the curvature targets,
+then one per setting of the current tool (as the core declares them: core.TOOL_INFO), drawn
 in the screen-space HUD (:mod:`hud`, top-left corner) and operated with the mouse in view pixels.
 
 The HUD lays the tracks out (in a column, one under another, so they never overlap in any view) and
@@ -14,6 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from .. import core
+
 # name, label, low, high (log scale)
 SLIDERS = (("mass", "mass", 1e-2, 1e2), ("damping", "damping", 1e-2, 1e3), ("stiffness", "stiffness", 1e0, 1e5),
            ("bending", "bending (plate/springs)", 1e-1, 1e3),
@@ -21,6 +24,39 @@ SLIDERS = (("mass", "mass", 1e-2, 1e2), ("damping", "damping", 1e-2, 1e3), ("sti
 MAPS = ("mass", "damping", "stiffness", "bending")
 #: Sliders whose left end is 0, not their low value: no plate at all is springs alone.
 ZERO_AT_LEFT = ("bending",)
+
+#: A tool setting's slider spans this factor either side of its declared default (log scale).
+TOOL_RANGE = 10.0
+
+
+def tool_sliders(tool: str) -> list[tuple[str, str, float, float]]:
+    """The sliders of ``tool``'s settings: "tool.<tool>.<setting>", its label, its range."""
+    out = []
+    for name, p in core.TOOL_INFO[tool]["parameters"].items():
+        default = p["default"] if p["default"] > 0 else 1.0
+        out.append((f"tool.{tool}.{name}", f"{tool} {name.replace('_', ' ')}", default / TOOL_RANGE,
+                    default * TOOL_RANGE))
+    return out
+
+
+def sliders(obj: Any) -> list[tuple[str, str, float, float]]:
+    """The panel's sliders for ``obj``: the material's and curvature's, then its current tool's."""
+    return [*SLIDERS, *tool_sliders(obj.Proxy.live.snapshot().tool.name)]
+
+
+def _spec(name: str) -> tuple[str, str, float, float]:
+    if name.startswith("tool."):
+        tool = name.split(".")[1]
+        return next(s for s in tool_sliders(tool) if s[0] == name)
+    return next(s for s in SLIDERS if s[0] == name)
+
+
+def _zero_at_left(name: str) -> bool:
+    if name.startswith("tool."):
+        _, tool, setting = name.split(".")
+        return bool(core.TOOL_INFO[tool]["parameters"][setting]["allow_zero"])
+    return name in ZERO_AT_LEFT
+
 
 Box = tuple[float, float, float, float]  # x0, y0, x1, y1 in view pixels, origin bottom-left
 REACH = 8  # pixels beyond a track's ends that still take it (a knob at an end sticks out by half)
@@ -38,6 +74,10 @@ class SliderPanel:
     @staticmethod
     def value(obj: Any, name: str) -> float:
         live = obj.Proxy.live
+        if name.startswith("tool."):
+            tool = live.snapshot().tool
+            _, owner, setting = name.split(".")
+            return float(getattr(tool, setting)) if tool.name == owner else 0.0
         if name in MAPS:
             return float(np.mean(live.map_values(name)))
         s = live.snapshot()
@@ -51,7 +91,10 @@ class SliderPanel:
         """Sets slider ``name`` to ``value`` as one undo step through the scripting call (echoed to
         the Python console and a recorded macro); a running session takes it at once."""
         from .echo import ref, run_echoed
-        if name in MAPS:
+        if name.startswith("tool."):
+            _, tool, setting = name.split(".")
+            run_echoed(f"HapticSculpt.set_tool({ref(obj)}, {tool!r}, {setting}={float(value)!r})")
+        elif name in MAPS:
             run_echoed(f"HapticSculpt.set_uniform({ref(obj)}, {name!r}, {float(value)!r})")
         elif [c for c in obj.Proxy.live.snapshot().constraints if c["kind"] == "curvature"]:
             run_echoed(f"HapticSculpt.set_curvature_target({ref(obj)}, {name[-1]}={float(value)!r})")
@@ -62,15 +105,15 @@ class SliderPanel:
 
     @staticmethod
     def fraction(name: str, value: float) -> float:
-        _, _, low, high = next(s for s in SLIDERS if s[0] == name)
+        _, _, low, high = _spec(name)
         if value <= 0:
             return 0.0
         return float(np.clip((math.log10(value) - math.log10(low)) / (math.log10(high) - math.log10(low)), 0, 1))
 
     @staticmethod
     def from_fraction(name: str, f: float) -> float:
-        _, _, low, high = next(s for s in SLIDERS if s[0] == name)
-        if f <= 0 and name in ZERO_AT_LEFT:
+        _, _, low, high = _spec(name)
+        if f <= 0 and _zero_at_left(name):
             return 0.0
         return 10 ** (math.log10(low) + float(np.clip(f, 0, 1)) * (math.log10(high) - math.log10(low)))
 
@@ -113,7 +156,7 @@ class SliderPanel:
     def values(self, obj: Any) -> list[tuple[str, float, bool, float]]:
         """(label, shown value, held, knob position 0..1) of each slider in order, for the HUD."""
         out = []
-        for name, label, _, _ in SLIDERS:
+        for name, label, _, _ in sliders(obj):
             v = self.shown_value(obj, name)
             out.append((label, v, self.held == name, self.fraction(name, v)))
         return out
