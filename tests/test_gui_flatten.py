@@ -1,0 +1,103 @@
+"""The flatten tool as a designer meets it in FreeCAD's GUI, with real X events: a clay patch with a
+round bump and held edges opened from a file; Flatten picked from the Tools drop-down (one undo
+step); its radius set on the slider panel, where its settings appear as the core declares them (one
+undo step); a session, a press on the bump's summit held there while the mouse moves a few pixels:
+the crown is pressed flatter in one undo step and the patch far from it stays; Undo brings the bump
+back exactly. Screenshots in build/screenshots/real_flatten_*.png (look at them)."""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+from freecad_support import run_freecad_gui
+from test_gui_panel_hud import calibrate, overlay
+from test_gui_real_input import NEEDS, SHOTS, Desktop, sculpt, undo
+
+#: A 60 mm clay patch (16 x 16 poles, edges held) with a bump 6 mm high (sigma 8 mm) in the middle, saved by
+#: FreeCAD's GUI (a file saved by freecadcmd has no view data).
+SCENE = """
+import json, math, os
+import FreeCAD, Part
+import HapticSculpt as hs
+V = FreeCAD.Vector
+n = 16
+poles = [[V(-30 + 60 * i / (n - 1), -30 + 60 * j / (n - 1),
+            6 * math.exp(-((-30 + 60 * i / (n - 1)) ** 2 + (-30 + 60 * j / (n - 1)) ** 2) / (2 * 8.0 ** 2)))
+          for j in range(n)] for i in range(n)]
+knots = [k / (n - 3) for k in range(n - 2)]
+mults = [4] + [1] * (n - 4) + [4]
+bump = Part.BSplineSurface()
+bump.buildFromPolesMultsKnots(poles, mults, mults, knots, knots, False, False, 3, 3)
+doc = FreeCAD.newDocument("Bump")
+obj = hs.make_sculpt(doc, source=bump.toShape(), controls=(16, 16), mesh=(48, 48), material="clay")
+hs.hold_boundary(obj, "G0")  # (a free sheet would rise whole under the tool's net pull)
+doc.recompute()
+doc.saveAs(PATH)
+json.dump({"size": obj.Proxy.surface.size}, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+def poles(s: dict) -> np.ndarray:
+    return np.array(sculpt(s)["poles"]).reshape(-1, 3)
+
+
+def unevenness(p: np.ndarray) -> float:
+    """How far the crown (the poles within 10 mm of the middle, in plan) is from flat: the RMS of
+    their heights about the plane that fits them best."""
+    near = p[np.hypot(p[:, 0], p[:, 1]) < 10.0]
+    a = np.c_[near[:, :2], np.ones(len(near))]
+    fit, *_ = np.linalg.lstsq(a, near[:, 2], rcond=None)
+    return float(np.sqrt(np.mean((near[:, 2] - a @ fit) ** 2)))
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_flatten_presses_the_bump_flatter_in_one_undo_step(tmp_path):
+    os.makedirs(SHOTS, exist_ok=True)
+    path = str(tmp_path / "bump.FCStd")
+    run_freecad_gui(f"PATH = {path!r}\n" + SCENE, str(tmp_path))
+    d = Desktop(str(tmp_path), "CAD", open_file=path)
+    try:
+        s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["sculpts"] and sculpt(s)["screen"], "the file")
+        d.xdo("mousemove", "640", "500", "key", "0")  # isometric
+        d.xdo("key", "--delay", "150", "v", "f")  # fit all
+        bumped = poles(s)
+        before = d.shot("flatten_before")
+        s = d.press_button("ToolFlatten", lambda s: undo(s) and undo(s)[0] == "Tool: flatten",
+                           "Flatten from the Tools drop-down")
+        # its settings on the panel after the material's six: radius (7) and stiffness (8)
+        s = d.press_button("Panel", lambda s: "track8" in overlay(s)["hud"] and "track9" not in overlay(s)["hud"],
+                           "the slider panel with the flatten tool's two settings")
+        calibrate(d)
+        label, radius, _, f = overlay(s)["sliders"][6]
+        assert label == "flatten radius" and radius == 10.0, overlay(s)["sliders"][6]
+        x0, y0, x1, y1 = overlay(s)["hud"]["track7"]
+        d.drag([d.to_screen([x0 + (f + (0.65 - f) * t) * (x1 - x0), (y0 + y1) / 2]) for t in np.linspace(0, 1, 8)],
+               seconds=0.5)
+        s = d.wait(lambda s: undo(s)[:2] == ["Tool: flatten", "Tool: flatten"] and 15 < overlay(s)["sliders"][6][1] < 25,
+                   "the radius set to about 20 mm as one undo step")
+        d.shot("flatten_panel")
+        d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
+        d.calibrate()
+        summit = d.to_screen(sculpt(d.state())["screen"][0])
+        # pressed on the summit and held there, the mouse moving a few pixels (a hand is never still)
+        d.drag([summit] + [(summit[0] + dx, summit[1]) for dx in (3, 5, 6, 5, 6, 5, 6, 5, 6, 5, 6)], seconds=2.0)
+        s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the flatten stroke's undo step")
+        d.click_button("Session")
+        s = d.wait(lambda s: not sculpt(s)["session"], "the session to stop")
+        pressed = poles(s)
+        print(f"the crown's unevenness: {unevenness(bumped):.3f} mm -> {unevenness(pressed):.3f} mm")
+        assert unevenness(pressed) < 0.7 * unevenness(bumped), "the crown was not pressed flatter"
+        # (the crown down, its foot up: within the 20 mm radius and the cubic poles' reach beyond it)
+        far = np.hypot(bumped[:, 0], bumped[:, 1]) > 35.0
+        assert np.abs(pressed[far] - bumped[far]).max() < 0.1, "the patch far from the tool moved"
+        d.xdo("mousemove", "1000", "650")  # (off the patch: no preselection colour in the picture)
+        d.wait(lambda s: not s["preselection"], "no preselection")
+        d.shot_changed("flatten_pressed", before, "the flatten stroke")
+        assert undo(s)[:3] == ["Sculpt stroke", "Tool: flatten", "Tool: flatten"], undo(s)[:4]
+        d.xdo("mousemove", "640", "500", "key", "ctrl+z")
+        s = d.wait(lambda s: undo(s)[0] == "Tool: flatten", "Undo of the stroke")
+        assert np.array_equal(poles(s), bumped), "Undo brings the bump back exactly"
+    finally:
+        d.close()
