@@ -7,22 +7,13 @@
 #include <memory>
 #include <thread>
 
+#include "device_session.hpp"
 #include "solvers/dynamic_surface.hpp"
 #include "devices/falcon/falcon_device.hpp"
 #include "falcon_emulator.hpp"
 #include "runtime/haptic_runtime.hpp"
 
 using namespace hs;
-
-long allocationCount();  // test_core.cpp
-
-// Sanitizers slow the loops several-fold: the simulation then drops backlog and simulates less of
-// the pull (seen under ASan on a loaded machine: 0.35 mm), which must still lift the surface.
-#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
 
 namespace {
 std::shared_ptr<falcon::Emulator> emulator() {
@@ -131,19 +122,7 @@ TEST(FalconDevice, ARopeStrokeInAThreadedSessionAndALostLink) {
     e->hand = [](double t) { return falcon::Vec3d(0, 0.02 * std::min(1.0, t / 0.6), 0.11); };
     e->buttons = [](double t) { return std::uint8_t(t < 0.8 ? 1 : 0); };
     e->loseAfter = 1400;  // then the link dies
-    auto dev = std::make_shared<FalconDevice>(e, FalconSettings{});
-    RuntimeSettings settings;
-    HapticRuntime rt(surface, dev, settings);
-    rt.start();
-    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-    while (rt.running() && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    rt.stop();
-    const RuntimeStatus st = rt.status();
-    EXPECT_EQ(st.error, "device lost");
-    EXPECT_EQ(st.force.norm(), 0.0);
-    EXPECT_EQ(st.strokes, 1u);
-    StrokeSnapshot stroke;
-    ASSERT_TRUE(rt.takeStroke(stroke));
-    EXPECT_GT(stroke.poles.col(2).maxCoeff(), kSanitized ? 0.05 : 0.5);  // the surface was pulled up
+    const SessionOutcome out = sessionUntilItStops(std::make_shared<FalconDevice>(e, FalconSettings{}));
+    expectLostAfterAStroke(out);
     EXPECT_GT(e->largestForce, 0.05);                 // and pulled the grip back: force out
 }

@@ -8,11 +8,10 @@
 #include <random>
 #include <vector>
 
+#include "device_session.hpp"
 #include "devices/falcon/falcon_kinematics.hpp"
 
 using namespace hs::falcon;
-
-long allocationCount();  // test_core.cpp
 
 namespace {
 /// Points across the workspace: a 60 mm cube around its middle.

@@ -12,20 +12,13 @@
 #include <random>
 #include <thread>
 
+#include "device_session.hpp"
 #include "solvers/dynamic_surface.hpp"
 #include "devices/falcon/falcon_device.hpp"
 #include "devices/falcon/falcon_usb.hpp"
 #include "runtime/haptic_runtime.hpp"
 
 using namespace hs;
-
-long allocationCount();  // test_core.cpp
-
-#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
 
 namespace {
 const std::string kUsb = std::string(HS_FAKE_VENDOR_DIR) + "/libusb-fake.so";
@@ -72,15 +65,6 @@ std::string writeFile(const std::vector<std::uint8_t>& bytes, const char* name) 
     const std::string path = testing::TempDir() + name;
     std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
     return path;
-}
-
-std::string errorOf(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    return "";
 }
 }  // namespace
 
@@ -158,20 +142,8 @@ TEST(FalconUsb, ARopeStrokeInAThreadedSessionThenUnplugged) {
     fake.call<void (*)(const double*, int)>("script")(rows.data(), 4);
     fake.call<void (*)(long)>("unplug_after")(1400);
     {
-        auto dev = std::make_shared<FalconDevice>(falcon::openFalconUsb(fakeLibusb(), 0, ""), FalconSettings{});
-        auto surface = std::make_shared<DynamicSurface>(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 24, 24);
-        HapticRuntime rt(surface, dev, RuntimeSettings{});
-        rt.start();
-        const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-        while (rt.running() && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(std::chrono::milliseconds(2));
-        rt.stop();
-        const RuntimeStatus st = rt.status();
-        EXPECT_EQ(st.error, "device lost");
-        EXPECT_EQ(st.force.norm(), 0.0);
-        EXPECT_EQ(st.strokes, 1u);
-        StrokeSnapshot stroke;
-        ASSERT_TRUE(rt.takeStroke(stroke));
-        EXPECT_GT(stroke.poles.col(2).maxCoeff(), kSanitized ? 0.05 : 0.5);
+        expectLostAfterAStroke(
+            sessionUntilItStops(std::make_shared<FalconDevice>(falcon::openFalconUsb(fakeLibusb(), 0, ""), FalconSettings{})));
         EXPECT_GT(fake.observe().largestForce, 0.05);
     }
     EXPECT_EQ(fake.observe().claimed, 0);  // released when the device went

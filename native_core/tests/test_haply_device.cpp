@@ -13,20 +13,13 @@
 #include <memory>
 #include <thread>
 
+#include "device_session.hpp"
 #include "solvers/dynamic_surface.hpp"
 #include "devices/haply/haply_device.hpp"
 #include "haply_mock_service.hpp"
 #include "runtime/haptic_runtime.hpp"
 
 using namespace hs;
-
-long allocationCount();  // test_core.cpp
-
-#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
 
 namespace {
 // The Inverse3's cursor at rest (Haply's example inventory), and the hand's script around it.
@@ -52,15 +45,6 @@ void tick(HaplyDevice& dev, DeviceSample& s, const Vec3& force) {
     dev.setForce(force);
     const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(2);
     while (dev.updates() + dev.malformed() == before && std::chrono::steady_clock::now() < end) std::this_thread::yield();
-}
-
-std::string errorOf(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    return "";
 }
 }  // namespace
 
@@ -152,20 +136,7 @@ TEST(HaplyDevice, ARopeStrokeInAThreadedSessionThenTheLinkDrops) {
     // the hand takes the grip 20 mm up over 0.6 s with the button held, lets go at 0.8 s
     script(service, {{0, 0, 0, 0, 1}, {0.6, 0, 0, 0.02, 1}, {0.8, 0, 0, 0.02, 0}, {5, 0, 0, 0.02, 0}});
     service.closeAfter = 1400;
-    auto dev = std::make_shared<HaplyDevice>(at(service));
-    auto surface = std::make_shared<DynamicSurface>(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 24, 24);
-    HapticRuntime rt(surface, dev, RuntimeSettings{});
-    rt.start();
-    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-    while (rt.running() && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    rt.stop();
-    const RuntimeStatus st = rt.status();
-    EXPECT_EQ(st.error, "device lost");
-    EXPECT_EQ(st.force.norm(), 0.0);
-    EXPECT_EQ(st.strokes, 1u);
-    StrokeSnapshot stroke;
-    ASSERT_TRUE(rt.takeStroke(stroke));
-    EXPECT_GT(stroke.poles.col(2).maxCoeff(), kSanitized ? 0.05 : 0.5);  // the surface was pulled up
+    expectLostAfterAStroke(sessionUntilItStops(std::make_shared<HaplyDevice>(at(service))));
     std::lock_guard<std::recursive_mutex> g(service.lock);
     EXPECT_GT(service.mechanism.largestForce, 0.05);  // and pulled the grip back
 }

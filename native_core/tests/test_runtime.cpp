@@ -9,21 +9,14 @@
 #include <limits>
 #include <thread>
 
+#include "device_session.hpp"
 #include "solvers/dynamic_surface.hpp"
 #include "devices/external_device.hpp"
 #include "runtime/haptic_runtime.hpp"
 #include "devices/replay_device.hpp"
 #include "common/triple_buffer.hpp"
 
-long allocationCount();
-
-// Sanitizers slow the loops several-fold: there the tests check behaviour and races, not rates.
-#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-
+// (Sanitizers slow the loops several-fold: there the tests check behaviour and races, not rates.)
 using namespace hs;
 
 namespace {

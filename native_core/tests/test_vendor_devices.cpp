@@ -11,6 +11,7 @@
 #include <thread>
 #include <type_traits>
 
+#include "device_session.hpp"
 #include "devices/device_limits.hpp"
 #include "devices/vendor/dhd_device.hpp"
 #include "solvers/dynamic_surface.hpp"
@@ -18,14 +19,6 @@
 #include "devices/vendor/openhaptics_device.hpp"
 
 using namespace hs;
-
-long allocationCount();  // test_core.cpp
-
-#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
 
 namespace {
 const std::string kHd = std::string(HS_FAKE_VENDOR_DIR) + "/libHD.so";
@@ -108,17 +101,6 @@ void holdsASpring(D& dev, double tolerance) {
     EXPECT_NEAR(s.position.z(), 20.0 * 300 / 700, tolerance);
 }
 
-RuntimeStatus strokeInSession(const std::shared_ptr<Device>& dev, StrokeSnapshot& stroke, RuntimeSettings& used) {
-    auto surface = std::make_shared<DynamicSurface>(BSplineSurface::plane(8, 8, 3, 3, 100, 100), 24, 24);
-    HapticRuntime rt(surface, dev, RuntimeSettings{});
-    rt.start();
-    used = rt.settings();
-    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-    while (rt.running() && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    rt.stop();
-    rt.takeStroke(stroke);
-    return rt.status();
-}
 }  // namespace
 
 TEST(VendorDevices, AMissingLibraryOrCallIsAClearError) {
@@ -277,15 +259,9 @@ TEST(VendorDevices, OpenHapticsRopeStrokeInAThreadedSessionThenUnplugged) {
     fake.script(strokeUp(1));
     fake.call<void (*)(long)>("unplug_after")(1400);
     auto dev = std::make_shared<OpenHapticsDevice>(settingsFor(kHd));
-    StrokeSnapshot stroke;
-    RuntimeSettings used;
-    const RuntimeStatus st = strokeInSession(dev, stroke, used);
-    EXPECT_NEAR(used.maxForce, 3300, 1e-9);  // mN: the Touch's, as it reported itself on opening
-    EXPECT_EQ(st.error, "device lost");
-    EXPECT_EQ(st.force.norm(), 0.0);
-    EXPECT_EQ(st.strokes, 1u);
-    ASSERT_GT(stroke.poles.rows(), 0);
-    EXPECT_GT(stroke.poles.col(2).maxCoeff(), kSanitized ? 0.05 : 0.5);  // the surface was pulled up
+    const SessionOutcome out = sessionUntilItStops(dev);
+    EXPECT_NEAR(out.used.maxForce, 3300, 1e-9);  // mN: the Touch's, as it reported itself on opening
+    expectLostAfterAStroke(out);
     const Fake::Seen seen = fake.observe();
     EXPECT_GT(seen.largestForce, 0.01);  // N: and pulled the stylus back
     EXPECT_EQ(seen.live, 0);             // a clean stop: the scheduler is down
@@ -296,17 +272,11 @@ TEST(VendorDevices, DhdRopeStrokeInAThreadedSessionThenUnplugged) {
     fake.script(strokeUp(2));
     fake.call<void (*)(long)>("unplug_after")(1400);
     auto dev = std::make_shared<DhdDevice>(settingsFor(kDhd));
-    StrokeSnapshot stroke;
-    RuntimeSettings used;
-    const RuntimeStatus st = strokeInSession(dev, stroke, used);
+    const SessionOutcome out = sessionUntilItStops(dev);
     // the omega.3's limits, known once it was opened (before: the softest row's)
-    EXPECT_NEAR(used.maxStiffness, 5000, 1e-9);
-    EXPECT_NEAR(used.maxForce, 12000, 1e-9);
-    EXPECT_EQ(st.error, "device lost");
-    EXPECT_EQ(st.force.norm(), 0.0);
-    EXPECT_EQ(st.strokes, 1u);
-    ASSERT_GT(stroke.poles.rows(), 0);
-    EXPECT_GT(stroke.poles.col(2).maxCoeff(), kSanitized ? 0.05 : 0.5);
+    EXPECT_NEAR(out.used.maxStiffness, 5000, 1e-9);
+    EXPECT_NEAR(out.used.maxForce, 12000, 1e-9);
+    expectLostAfterAStroke(out);
     const Fake::Seen seen = fake.observe();
     EXPECT_GT(seen.largestForce, 0.01);
     EXPECT_EQ(seen.live, 0);  // closed

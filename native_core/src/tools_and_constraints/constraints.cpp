@@ -251,10 +251,8 @@ void ConstraintSet::addLaplacian(std::vector<Eigen::Triplet<double>>& trip) cons
         };
         switch (c.kind) {
             case ConstraintKind::Point: trip.emplace_back(p, p, effectiveStiffness(c)); break;
-            case ConstraintKind::Tangent:
+            case ConstraintKind::Tangent:  // (all three tie the point to its four neighbours)
             case ConstraintKind::Normal:
-                pair(p + h_, p); pair(p - h_, p); pair(p + 1, p); pair(p - 1, p);
-                break;
             case ConstraintKind::Curvature:
                 pair(p + h_, p); pair(p - h_, p); pair(p + 1, p); pair(p - 1, p);
                 break;
@@ -272,10 +270,8 @@ void ConstraintSet::addStiffness(const Points& y, Points& out) const {
         };
         switch (c.kind) {
             case ConstraintKind::Point: out.row(p) += effectiveStiffness(c) * y.row(p); break;
-            case ConstraintKind::Tangent:
+            case ConstraintKind::Tangent:  // (all three tie the point to its four neighbours)
             case ConstraintKind::Normal:
-                pair(p + h_, p); pair(p - h_, p); pair(p + 1, p); pair(p - 1, p);
-                break;
             case ConstraintKind::Curvature:
                 pair(p + h_, p); pair(p - h_, p); pair(p + 1, p); pair(p - 1, p);
                 break;
