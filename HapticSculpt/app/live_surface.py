@@ -66,6 +66,10 @@ class LiveSurface:
         self._session: SessionLink | None = None
         self._shadow: core.DynamicSurface | None = None  # reads while a session runs
         self._shadow_stale = True
+        # What the document's state properties hold, as this object last wrote or read them (None:
+        # unknown, read them): a commit compares with it instead of reading them all back.
+        self._stored: sculpt_state.SculptState | None = None
+        self._own_write = False
         # During a session: the configuration the last edit left, which the next one builds on (its
         # commit may not have reached the document yet); None: the document's.
         self._head: sculpt_state.SculptState | None = None
@@ -195,15 +199,16 @@ class LiveSurface:
         """Stores ``state`` in the properties (those that changed) and rebuilds the Shape if its
         geometry changed; the caller holds the transaction."""
         obj = self._obj
-        stored = read_state(obj)
+        stored = self.stored()
         geometry = any(not np.array_equal(stored.arrays[k], state.arrays[k]) for k in _SHAPE_ARRAYS)
-        self.writing = True
+        self.writing = self._own_write = True
         try:
-            write_state(obj, state)
+            write_state(obj, state, stored)
+            self._stored = state
             if geometry or obj.Shape.isNull():
                 obj.Shape = face_of(state)
         finally:
-            self.writing = False
+            self.writing = self._own_write = False
         self._shadow_stale = True
         if geometry:
             notify_dependents(obj)
@@ -241,6 +246,18 @@ class LiveSurface:
         prop = sculpt_state.map_property(name)
         rows, cols = state.settings["maps"][prop]
         getattr(self.surface, name + "_map").set_values(state.arrays[prop].reshape(int(rows), int(cols)))
+
+    def stored(self) -> sculpt_state.SculptState:
+        """What the document's state properties hold, as this object last wrote or read them (read
+        once after anything else wrote them). Read-only: states are replaced, never changed."""
+        if self._stored is None:
+            self._stored = read_state(self._obj)
+        return self._stored
+
+    def property_written(self) -> None:
+        """A state property was written: unless by :meth:`write`, what they hold is no longer known."""
+        if not self._own_write:
+            self._stored = None
 
     def document_changed(self) -> None:
         """The document properties changed from outside (Undo, Redo, a script): during a session the

@@ -64,8 +64,10 @@ class SculptFeature:
     def onChanged(self, obj: Any, prop: str) -> None:
         """A state property changed from outside (Undo, Redo, a script): the live surface follows."""
         live = getattr(self, "live", None)
-        if live is not None and prop in STATE_PROPERTIES and not live.writing:
-            live.document_changed()
+        if live is not None and prop in STATE_PROPERTIES:
+            live.property_written()
+            if not live.writing:
+                live.document_changed()
 
     def onDocumentRestored(self, obj: Any) -> None:
         """Opening a file: add properties older files lack, then load the state (errors are reported

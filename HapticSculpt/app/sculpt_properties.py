@@ -48,15 +48,21 @@ def read_state(obj: Any) -> sculpt_state.SculptState:
     return sculpt_state.SculptState(arrays, sculpt_state.parse_settings(obj.SculptSettings))
 
 
-def write_state(obj: Any, state: sculpt_state.SculptState) -> None:
-    """Writes a state into an object's properties (only those that changed, so undo stays small)."""
+def write_state(obj: Any, state: sculpt_state.SculptState, stored: sculpt_state.SculptState | None = None) -> None:
+    """Writes a state into an object's properties: only those that changed, so undo stays small.
+    ``stored``: what the properties hold, if the caller knows (reading them back costs more than
+    the write of one map at 128 x 128)."""
     for name in sculpt_state.ARRAY_NAMES:
         values = state.arrays[name]
-        current = getattr(obj, name)
-        if len(current) != values.size or not np.array_equal(np.asarray(current, dtype=float), values):
+        if stored is not None:
+            changed = not np.array_equal(stored.arrays[name], values)
+        else:
+            current = getattr(obj, name)
+            changed = len(current) != values.size or not np.array_equal(np.asarray(current, dtype=float), values)
+        if changed:
             setattr(obj, name, values.tolist())
     text = state.settings_json()
-    if obj.SculptSettings != text:
+    if (stored.settings_json() if stored is not None else obj.SculptSettings) != text:
         obj.SculptSettings = text
 
 

@@ -27,7 +27,6 @@ import numpy as np
 from .. import core
 from ..app import sculpt_state
 from ..app.sculpt_feature import is_sculpt
-from ..app.sculpt_properties import read_state
 from ..app.undo import transaction
 from ..core import native as _core
 from .devices import native_device
@@ -131,13 +130,13 @@ class Session:
         self._latest_poles, self._latest_maps, self._edits, self.applied_edits = None, {}, {}, []
         self._previewed = False
         self._committed = False  # a stroke, spray or edit this run (else its end commits nothing)
-        self._console, self._last_commit = read_state(obj), None
+        self._console, self._last_commit = obj.Proxy.live.stored(), None
         runtime.set_airbrush(**self._airbrush)
         runtime.start()
         _ACTIVE.add(self)
         _Observer.ensure()
         if _gui_up():
-            self._frame_base = read_state(obj)
+            self._frame_base = obj.Proxy.live.stored()
             self._start_timer()
         return self
 
@@ -321,7 +320,7 @@ class Session:
         None) leaves the console with what the document holds now."""
         obj = self._obj
         if state is None or replay is None:
-            self._console = read_state(obj)
+            self._console = obj.Proxy.live.stored()
             return
         if self._console is None:
             return
@@ -356,19 +355,19 @@ class Session:
                 strokes = 0
             else:
                 title = f"Paint {event['painted']}" if event["painted"] else "Sculpt stroke"
-                state, strokes = read_state(obj), 1
-            before = self._console if self._console is not None else read_state(obj)
+                state, strokes = obj.Proxy.live.stored(), 1
+            before = self._console if self._console is not None else obj.Proxy.live.stored()
             live.reset_shape()  # (so the transaction records the stored face as what Undo goes back to)
             doc = obj.Document
             with transaction(doc, title):
                 live.write(final if final is not None and k == last else _with_event(state, event))
                 if strokes:
                     obj.Strokes = obj.Strokes + strokes
-                told = bool(strokes) or _differs(before, read_state(obj))  # (else the edit's own call gives it)
+                told = bool(strokes) or _differs(before, obj.Proxy.live.stored())  # (else the edit's own call gives it)
                 if told:
                     _tell_commit(obj, before, title, strokes)
                 obj.purgeTouched()
-            self._console = read_state(obj)  # (the replay_stroke line just echoed gives it)
+            self._console = obj.Proxy.live.stored()  # (the replay_stroke line just echoed gives it)
             self._last_commit = (len(doc.UndoNames), title, strokes, before, told, final is not None)
             self._committed = True
             n += strokes
@@ -389,7 +388,7 @@ class Session:
             live.document_changed()
             return
         current = sculpt_state.capture(live.surface)
-        stored = read_state(obj)
+        stored = obj.Proxy.live.stored()
         drift = float(np.max(np.abs(current.arrays["Poles"] - stored.arrays["Poles"]), initial=0.0))
         same = current.settings_json() == obj.SculptSettings and all(
             np.array_equal(current.arrays[k], stored.arrays[k])

@@ -167,7 +167,10 @@ void bindSolvers(py::module_& m) {
         .def_property_readonly("bending_energy", &DynamicSurface::bendingEnergy,
                                "The bending energy at the current mesh")
         .def_property_readonly("spring_count", [](const DynamicSurface& s) { return s.springs().size(); })
-        .def_property_readonly("rest_lengths", [](const DynamicSurface& s) { return s.springs().rest(); })
+        .def_property_readonly("rest_lengths", [](py::object self) {
+            const auto& s = self.cast<const DynamicSurface&>();  // a read-only view (no copy)
+            return view(s.springs().rest().data(), {static_cast<py::ssize_t>(s.springs().rest().size())}, self);
+        })
         .def("set_rest_lengths", [](DynamicSurface& s, const std::vector<double>& r) { s.springs().setRest(r); }, py::arg("rest"))
         .def("relax", &DynamicSurface::relax,
              "Make the current shape the rest shape (rest lengths and bending reference from the current mesh).")
