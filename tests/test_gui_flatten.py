@@ -3,7 +3,7 @@ round bump and held edges opened from a file; Flatten picked from the Tools drop
 step); its radius set on the slider panel, where its settings appear as the core declares them (one
 undo step); a session, a press on the bump's summit held there while the mouse moves a few pixels:
 the crown is pressed flatter in one undo step and the patch far from it stays; Undo brings the bump
-back exactly. Screenshots in build/screenshots/real_flatten_*.png (look at them)."""
+back exactly; Rope and back to Flatten: its radius is kept. Screenshots in build/screenshots/real_flatten_*.png (look at them)."""
 from __future__ import annotations
 
 import os
@@ -99,5 +99,11 @@ def test_flatten_presses_the_bump_flatter_in_one_undo_step(tmp_path):
         d.xdo("mousemove", "640", "500", "key", "ctrl+z")
         s = d.wait(lambda s: undo(s)[0] == "Tool: flatten", "Undo of the stroke")
         assert np.array_equal(poles(s), bumped), "Undo brings the bump back exactly"
+        # another tool and back: the flatten tool comes back with the radius it was left with
+        d.press_button("ToolRope", lambda s: undo(s)[0] == "Tool: rope", "Rope from the drop-down")
+        s = d.press_button("ToolFlatten", lambda s: undo(s)[:2] == ["Tool: flatten", "Tool: rope"],
+                           "Flatten again from the drop-down")
+        d.wait(lambda s: overlay(s)["sliders"][6][0] == "flatten radius" and 15 < overlay(s)["sliders"][6][1] < 25,
+               "the flatten radius kept across the change of tools")
     finally:
         d.close()

@@ -104,23 +104,38 @@ class Hud:
                                            for k, line in enumerate(lines)], w, h)
 
     def _sliders(self, w: int, h: int, sliders: list[tuple[str, float, bool, float]], floor: float) -> None:
-        """Each slider: its number, label and value, and under them its track with the knob; down
-        from the top-left corner to the status lines (``floor``), then on in a column to the right."""
+        """Each slider: its number, label and value, and its track with the knob, down from the
+        top-left corner to the status lines (``floor``), left of the navigation cube's corner. The
+        first layout that fits: each text over its track in one column; text and track side by
+        side (a low view); either in more columns; else the first, running past the floor."""
         texts = [f"{k + 1}  {label} {value:.3g}" for k, (label, value, _, _) in enumerate(sliders)]
-        step = LINE + TRACK_ROW
-        top = h - MARGIN - PAD
-        rows = max(1, int((top - floor) // step))
-        widest = max(len(f"{k + 1}  {label} ") + 9 for k, (label, *_) in enumerate(sliders))  # (9: any value)
-        column = max(TRACK_WIDTH, widest * CHAR_WIDTH) + 2 * PAD + MARGIN
+        chars = max(len(f"{k + 1}  {label} ") + 9 for k, (label, *_) in enumerate(sliders))  # (9: any value)
+        top, room = h - MARGIN - PAD, w - CUBE_CORNER - MARGIN  # (room: where a column may end)
+        layouts = []  # (row height, track's offset right of the text, column width)
+        for side_by_side in (False, True):
+            offset = chars * CHAR_WIDTH + PAD if side_by_side else 0.0
+            layouts.append((FONT_SIZE + 6 if side_by_side else LINE + TRACK_ROW, offset,
+                            max(TRACK_WIDTH + offset, chars * CHAR_WIDTH) + 2 * PAD + MARGIN))
+        chosen = None
+        for columns in (1, 2, 3):
+            for step, offset, column in layouts:
+                rows = -(-len(sliders) // columns)
+                if top - rows * step >= floor and MARGIN + PAD + columns * column - MARGIN <= room:
+                    chosen = (step, offset, column, rows)
+                    break
+            if chosen:
+                break
+        step, offset, column, rows = chosen or (*layouts[0], len(sliders))
         for k, (text, (_, _, held, f)) in enumerate(zip(texts, sliders)):
             x0 = MARGIN + PAD + (k // rows) * column
             row = top - (k % rows) * step
             self._text(text, x0, row - FONT_SIZE, HELD if held else TEXT, f"slider{k + 1}", w)
-            yc = row - LINE - TRACK_ROW / 2
-            self._quad(x0, yc - 1.5, x0 + TRACK_WIDTH, yc + 1.5, TRACK_COLOUR)
-            kx = x0 + f * TRACK_WIDTH
+            tx = x0 + offset
+            yc = row - FONT_SIZE / 2 - 1 if offset else row - LINE - TRACK_ROW / 2
+            self._quad(tx, yc - 1.5, tx + TRACK_WIDTH, yc + 1.5, TRACK_COLOUR)
+            kx = tx + f * TRACK_WIDTH
             self._quad(kx - KNOB[0] / 2, yc - KNOB[1] / 2, kx + KNOB[0] / 2, yc + KNOB[1] / 2, HELD if held else KNOB_COLOUR)
-            self._boxes[f"track{k + 1}"] = (float(x0), float(yc - KNOB[1] / 2), float(x0 + TRACK_WIDTH),
+            self._boxes[f"track{k + 1}"] = (float(tx), float(yc - KNOB[1] / 2), float(tx + TRACK_WIDTH),
                                             float(yc + KNOB[1] / 2))
 
     def _group(self, name: str, draw: Any, w: int, h: int) -> None:

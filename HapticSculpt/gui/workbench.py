@@ -123,6 +123,8 @@ class Controller:
         self._paint_path: list[tuple[float, float]] = []  # where the stroke's dabs went (map coordinates)
         self.tool = "rope"
         self.falloff = "spherical"
+        #: each tool's settings as they were when another tool was chosen: choosing it again takes them
+        self.tool_settings: dict[str, dict[str, float]] = {}
         self._populated: set[int] = set()  # views whose sculpts have their overlays (jacks) since they opened
 
     # --- views ------------------------------------------------------------------------------------
@@ -433,8 +435,14 @@ class Controller:
         obj = self.active_sculpt()
         if obj is None:
             return
-        falloff = f", falloff={self.falloff!r}" if core.TOOL_INFO[tool]["falloff"] else ""
-        run_echoed(f"HapticSculpt.set_tool({ref(obj)}, {tool!r}{falloff})")
+        current = obj.Proxy.live.snapshot().tool
+        if current.name != tool:  # (remember the settings left behind; take back the chosen tool's)
+            self.tool_settings[current.name] = {k: getattr(current, k) for k in core.TOOL_INFO[current.name]["parameters"]}
+        info = core.TOOL_INFO[tool]
+        kept = {k: v for k, v in self.tool_settings.get(tool, {}).items() if v != info["parameters"][k]["default"]}
+        call = f"{tool!r}" + (f", falloff={self.falloff!r}" if info["falloff"] else "")
+        call += "".join(f", {k}={v!r}" for k, v in kept.items()) if current.name != tool else ""
+        run_echoed(f"HapticSculpt.set_tool({ref(obj)}, {call})")
 
     def start_session(self, device: Any = None) -> Any:
         """Starts sculpting the active sculpt with `device`, else the first attached force device, else

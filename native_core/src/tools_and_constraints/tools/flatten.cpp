@@ -18,9 +18,8 @@ namespace {
 enum { Radius, Stiffness };
 enum { Selected };
 constexpr ToolInfo kInfo{"flatten", "Flatten",
-                         "Flatten: presses the surface within its radius toward the plane of its mean height "
-                         "there, tangent where it grabs, weighted by its falloff; move along the normal to raise or "
-                         "lower the plane",
+                         "Flatten: presses the surface within its radius flat, toward its tangent plane where "
+                         "it grabs, at its mean height there",
                          4, true,
                          {{{"radius", 10.0, false, "radius of the region pressed flat"},
                            {"stiffness", 10.0, false, "spring stiffness per point toward the plane"}}},
