@@ -271,6 +271,10 @@ class TestStop(DocumentTestCase):
             time.sleep(0.002)
         steps, released = list(self.doc.UndoNames), read_state(obj)
         self.assertEqual(steps[0], "Sculpt stroke")
+        stepped = session.status()["sim_steps"]  # (the patch moves on after the commit: 20 steps of it)
+        while session.status()["sim_steps"] < stepped + 20:
+            self.assertLess(time.monotonic(), end, "the simulation stopped")
+            time.sleep(0.002)
         session.stop()
         ended = sculpt_state.capture(obj.Proxy.live.surface)
         self.assertEqual(list(self.doc.UndoNames), steps)
