@@ -91,6 +91,12 @@ def violations(g: dict[str, set[str]]) -> list[str]:
         for t in sorted(g[m]):
             if layer(t) == "facade" or rank[layer(t)] > rank[layer(m)]:
                 out.append(f"upward import: {m} ({layer(m)}) imports {t} ({layer(t)})")
+    return out + cycles(g, "import cycle")
+
+
+def cycles(g: dict[str, set[str]], what: str) -> list[str]:
+    """Each cycle a depth-first walk of ``g`` finds, as "<what>: a -> b -> a"."""
+    out = []
     state: dict[str, int] = {}  # 1: on the current path, 2: done
     path: list[str] = []
 
@@ -99,7 +105,7 @@ def violations(g: dict[str, set[str]]) -> list[str]:
         path.append(m)
         for t in sorted(g[m]):
             if state.get(t) == 1:
-                out.append("import cycle: " + " -> ".join(path[path.index(t):] + [t]))
+                out.append(f"{what}: " + " -> ".join(path[path.index(t):] + [t]))
             elif t not in state:
                 visit(t)
         path.pop()
@@ -182,24 +188,7 @@ def core_violations(files: dict[str, pathlib.Path] | None = None) -> list[str]:
             elif layer_there == layer_here and "/" in there and there != folder:
                 out.append(f"sideways include: {name} ({folder}) includes {inc} ({there})")
     g = {n: {i for i in core_includes(p) if i in files} for n, p in files.items()}
-    state: dict[str, int] = {}
-    path: list[str] = []
-
-    def visit(m: str) -> None:
-        state[m] = 1
-        path.append(m)
-        for t in sorted(g[m]):
-            if state.get(t) == 1:
-                out.append("include cycle: " + " -> ".join(path[path.index(t):] + [t]))
-            elif t not in state:
-                visit(t)
-        path.pop()
-        state[m] = 2
-
-    for m in sorted(g):
-        if m not in state:
-            visit(m)
-    return out
+    return out + cycles(g, "include cycle")
 
 
 def core_dot(g: dict[str, set[str]]) -> str:
