@@ -196,7 +196,8 @@ void bindSolvers(py::module_& m) {
         .def("set_point_force", [](DynamicSurface& s, int index, const std::vector<double>& f) { s.setPointForce(index, vec3(f, "force")); },
              py::arg("index"), py::arg("force"), "Persistent external force on a mesh point (clamped to max_point_force).")
         .def("clear_forces", &DynamicSurface::clearForces)
-        .def_readwrite("max_point_force", &DynamicSurface::maxPointForce)
+        .def_property("max_point_force", &DynamicSurface::maxPointForce, &DynamicSurface::setMaxPointForce,
+                      "largest external force on one mesh point (> 0)")
         .def("set_tool", &DynamicSurface::setTool, py::arg("name"), "rope, magnet, orientation or smooth")
         .def_property_readonly("tool", py::overload_cast<>(&DynamicSurface::tool), py::return_value_policy::reference_internal)
         .def("set_cursor", [](DynamicSurface& s, const std::vector<double>& position, const std::vector<double>& orientation, bool grab) {
@@ -280,8 +281,8 @@ void bindSolvers(py::module_& m) {
         }, py::arg("id"), py::arg("kind"), py::arg("index"), py::arg("stiffness"), py::arg("target") = py::none(),
            py::arg("curvature") = py::none(), py::arg("offsets") = py::none(),
            "Re-insert a constraint exactly as listed by `constraints` (id, offsets and targets kept).")
-        .def_readwrite("constraint_stiffness_factor", &DynamicSurface::constraintStiffnessFactor,
-                       "default penalty stiffness = factor * mean material stiffness")
+        .def_property("constraint_stiffness_factor", &DynamicSurface::constraintStiffnessFactor,
+                      &DynamicSurface::setConstraintStiffnessFactor, "default penalty stiffness = factor * mean material stiffness (> 0)")
         .def("mesh_curvature", &DynamicSurface::meshCurvature, py::arg("index"), py::arg("direction"), "Curvature of the circle through a point and its two neighbours along u (0) or v (1)")
         // stepping
         .def_property("integrator", [](const DynamicSurface& s) { return std::string(nameOf(kIntegratorNames, s.solver().kind)); },

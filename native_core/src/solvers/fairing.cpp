@@ -59,32 +59,32 @@ Eigen::SparseMatrix<double> variationOperator(int g, int h, double su, double sv
 }  // namespace
 
 void DynamicSurface::fair(const Eigen::VectorXd& weights, double strength) {
-    if (weights.size() != d_.rows()) throw std::invalid_argument("weights: one per mesh point (g x h)");
+    if (weights.size() != state_.d.rows()) throw std::invalid_argument("weights: one per mesh point (g x h)");
     if (!weights.allFinite() || weights.minCoeff() < 0 || weights.maxCoeff() > 1)
         throw std::invalid_argument("weights: must be in [0, 1]");
     requireInRange(strength, "strength", 0.0, 1e12);
     if (strength == 0 || weights.maxCoeff() == 0) return;
     refreshMaterials();
     std::vector<int> centre;
-    const Eigen::SparseMatrix<double> C = variationOperator(g(), h(), spacingU_, spacingV_, centre);
+    const Eigen::SparseMatrix<double> C = variationOperator(g(), h(), state_.spacingU, state_.spacingV, centre);
     Eigen::VectorXd w(C.rows());
     for (Eigen::Index r = 0; r < C.rows(); ++r) w[r] = weights[centre[static_cast<std::size_t>(r)]];
-    const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
+    const Eigen::SparseMatrix<double> A = state_.A.matrix().toEigen();
     const Eigen::SparseMatrix<double> CA = C * A;
-    const Eigen::SparseMatrix<double> M = A.transpose() * m_.asDiagonal() * A;
+    const Eigen::SparseMatrix<double> M = A.transpose() * material_.masses().asDiagonal() * A;
     const Eigen::SparseMatrix<double> K = CA.transpose() * w.asDiagonal() * CA;
     const double scale = M.diagonal().sum() / CA.squaredNorm();  // trace(A^T C^T C A) = |C A|_F^2
     const double tau = strength * scale;
     Eigen::SparseMatrix<double> sys = M + tau * K;
     held_.restrict(sys, true);
-    Points rhs = -tau * (K * surface_.poles());
+    Points rhs = -tau * (K * state_.poles());
     held_.reduce(rhs);
     PrefactoredSolver solver;
     solver.factor(sys, "fairing system A^T (M + tau C^T W C) A");
     Points step(rhs.rows(), 3);
     solver.solve(rhs, step);
     held_.expand(step);
-    setPoles(surface_.poles() + step);
+    setPoles(state_.poles() + step);
 }
 
 }  // namespace hs

@@ -7,63 +7,58 @@
 // spring mode by 1 + (w dt)^2 per step whatever the step size; we update the position with the new
 // velocity (semi-implicit Euler), which has the same cost, conserves energy for small steps and is
 // stable for dt < 2 / w_max.
+#include "solvers/integrator_explicit.hpp"
+
 #include <algorithm>
 #include <cmath>
 
-#include "solvers/dynamic_surface.hpp"
-
 namespace hs {
 
-void DynamicSurface::computeAcceleration() {
-    A_.apply(v_, dd_);
-    explicit_.energy = meshForces(d_, dd_, 0.0) + 0.5 * (m_.asDiagonal() * dd_).cwiseProduct(dd_).sum();
-    A_.applyTransposed(force_, fp_);
-    held_.reduce(fp_);
-    massSolver_.solve(fp_, acc_);
-    held_.expand(acc_);
-    accelerationValid_ = true;
+ExplicitIntegrator::ExplicitIntegrator(Eigen::Index poles) {
+    for (Points* m : {&a_, &p0_, &v0_, &a0_}) m->setZero(poles, 3);
 }
 
-StepReport DynamicSurface::stepExplicit(double dt) {
+StepReport ExplicitIntegrator::step(StepModel& m, double dt) {
     StepReport r;
-    ensureMassFactor();
-    applyToolForces(dt, r, d_);
-    explicitSubstep(dt, 0, r);
+    m.ensureMass();
+    if (m.applyTool(dt, r, m.state.d)) valid_ = false;
+    substep(m, dt, 0, r);
     return r;
 }
 
-void DynamicSurface::explicitSubstep(double dt, int depth, StepReport& r) {
-    if (!accelerationValid_) computeAcceleration();
+void ExplicitIntegrator::substep(StepModel& m, double dt, int depth, StepReport& r) {
+    if (!valid_) accelerate(m);
     // One saved state suffices: a rejected trial always restarts from the current substep's start.
-    explicit_.p0 = surface_.poles();
-    explicit_.v0 = v_;
-    explicit_.a0 = acc_;
-    meshTmp_ = d_;
-    const double e0 = explicit_.energy;
-    Points& p = surface_.mutablePoles();
-    v_ += dt * acc_;
-    p += dt * v_;
-    A_.apply(p, d_);
-    computeAcceleration();
-    const double amax = acc_.cwiseAbs().maxCoeff();
-    const double limit = solver_.accelerationLimit > 0 ? solver_.accelerationLimit : 0.1 * size_ / (dt * dt);
-    double work = 0;
-    if (hasExternal_) work += fext_.cwiseProduct(d_ - meshTmp_).sum();
-    if (toolForces_) work += ftool_.cwiseProduct(d_ - meshTmp_).sum();
-    const double gained = explicit_.energy - e0 - std::max(0.0, work);
-    const bool ok = std::isfinite(amax) && amax <= limit && std::isfinite(explicit_.energy) &&
-                    gained <= solver_.energyTolerance * (e0 + std::abs(work)) + 1e-12 * stiffness_.mean() * size_ * size_;
-    if (ok || depth >= solver_.maxHalvings) {
+    SurfaceState& s = m.state;
+    p0_ = s.poles();
+    v0_ = s.v;
+    a0_ = a_;
+    Points& before = m.scratch.mesh;
+    before = s.d;
+    const double e0 = energy_;
+    Points& p = s.mutablePoles();
+    s.v += dt * a_;
+    p += dt * s.v;
+    s.sampleMesh();
+    accelerate(m);
+    const double amax = a_.cwiseAbs().maxCoeff();
+    const double limit = m.settings.accelerationLimit > 0 ? m.settings.accelerationLimit : 0.1 * s.size / (dt * dt);
+    const double work = m.forces.appliedWork(s.d, before);
+    const double gained = energy_ - e0 - std::max(0.0, work);
+    const bool ok = std::isfinite(amax) && amax <= limit && std::isfinite(energy_) &&
+                    gained <= m.settings.energyTolerance * (e0 + std::abs(work)) +
+                                  1e-12 * m.material.stiffnessMap.mean() * s.size * s.size;
+    if (ok || depth >= m.settings.maxHalvings) {
         ++r.substeps;
         return;
     }
-    p = explicit_.p0;
-    v_ = explicit_.v0;
-    acc_ = explicit_.a0;
-    explicit_.energy = e0;
-    A_.apply(p, d_);
-    explicitSubstep(0.5 * dt, depth + 1, r);
-    explicitSubstep(0.5 * dt, depth + 1, r);
+    p = p0_;
+    s.v = v0_;
+    a_ = a0_;
+    energy_ = e0;
+    s.sampleMesh();
+    substep(m, 0.5 * dt, depth + 1, r);
+    substep(m, 0.5 * dt, depth + 1, r);
 }
 
 }  // namespace hs

@@ -11,11 +11,11 @@
 // estimate 2 v+ - v_n of v_n+1. The applied forces (tool, external) are held over the step, taken
 // at the mesh predicted half a step ahead (midpoint rule, second order), so a cursor that moves
 // between steps is seen at once.
+#include "solvers/integrator_verlet.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#include "solvers/dynamic_surface.hpp"
 
 namespace hs {
 
@@ -23,109 +23,110 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
 
-double DynamicSurface::verletForces(const Points& d, const Points& dd) {
-    force_.setZero();
-    double energy = springs_.addProjections(d, force_, 0.0, 1.0, true);  // the spring forces, for a linear law
-    energy += bending_.addForces(d, force_);
-    if (!constraints_.empty()) energy += constraints_.addForces(d, force_, terms_);
-    if (maxDampingRate_ > 0) force_ -= gamma_.asDiagonal() * dd;
-    return energy;
+VerletIntegrator::VerletIntegrator(Eigen::Index poles) {
+    a_.setZero(poles, 3);
+    appliedPoles_.reserve(static_cast<size_t>(poles));
+    poleMark_.assign(static_cast<size_t>(poles), 0);
 }
 
-double DynamicSurface::verletToolTerm() const {
-    if (!solver_.explicitWhenStable) return kInf;
+double VerletIntegrator::toolTerm(const StepModel& m) const {
+    if (!m.settings.explicitWhenStable) return kInf;
     // Non-linear laws stiffen without bound; curvature constraints project onto arcs (not convex).
-    if (springs_.law.kind != LawKind::Linear || dampingLaw_.kind != LawKind::Linear || constraints_.anyNonConvex())
+    if (m.material.springs.law.kind != LawKind::Linear || m.material.dampingLaw.kind != LawKind::Linear ||
+        m.forces.constraints().anyNonConvex())
         return kInf;
     // The tool adds at most slope on each point it holds: omega^2 grows by at most slope / m_min.
-    return tool_->grabbed() ? toolSlope() / minMass_ : 0.0;
+    return m.forces.tool().grabbed() ? m.toolSlope() / m.material.minMass() : 0.0;
 }
 
-bool DynamicSurface::verletStable(double dt) {
+bool VerletIntegrator::stable(StepModel& m, double dt) {
     // Damping is explicit too (rate gamma / m, A^T D A <= rate A^T M A): stable up to rate dt = 0.1
     // together with omega dt = 1.8 (the scalar recurrence's spectral radius is then 0.84).
-    if (dt * maxDampingRate_ > 0.1) return false;
-    const double tool = verletToolTerm();
+    if (dt * m.material.maxDampingRate() > 0.1) return false;
+    const double tool = toolTerm(m);
     if (!std::isfinite(tool)) return false;
     const double limit = kVerletStability * kVerletStability / (dt * dt);
-    return omegaSquaredBelow(limit - tool);
+    return bound_.below(m, limit - tool);
 }
 
-double DynamicSurface::verletStepLimit() {
-    refreshMaterials();
-    const double tool = verletToolTerm();
+double VerletIntegrator::stepLimit(StepModel& m) {
+    const double tool = toolTerm(m);
     if (!std::isfinite(tool)) return 0.0;
-    omegaSquaredBelow(kInf, true);
-    double dt = kVerletStability / std::sqrt(omega_.upper + tool);
-    if (maxDampingRate_ > 0) dt = std::min(dt, 0.1 / maxDampingRate_);
+    bound_.below(m, kInf, true);
+    double dt = kVerletStability / std::sqrt(bound_.upper() + tool);
+    if (m.material.maxDampingRate() > 0) dt = std::min(dt, 0.1 / m.material.maxDampingRate());
     return dt;
 }
 
-void DynamicSurface::solveApplied() {
-    const CsrMatrix& a = A_.matrix();
-    fp_.setZero();
-    verlet_.appliedPoles.clear();
-    for (Eigen::Index r = 0; r < d_.rows(); ++r) {
+void VerletIntegrator::solveApplied(StepModel& m) {
+    const CsrMatrix& a = m.state.A.matrix();
+    const SurfaceForces& forces = m.forces;
+    Points& fp = m.scratch.poleForce;
+    fp.setZero();
+    appliedPoles_.clear();
+    for (Eigen::Index r = 0; r < m.state.d.rows(); ++r) {
         Vec3 f = Vec3::Zero();
-        if (hasExternal_) f += fext_.row(r).transpose();
-        if (toolForces_) f += ftool_.row(r).transpose();
+        if (forces.hasExternal()) f += forces.external().row(r).transpose();
+        if (forces.toolActive()) f += forces.fromTool().row(r).transpose();
         if (f.isZero(0.0)) continue;
         for (int e = a.rowStart[static_cast<size_t>(r)]; e < a.rowStart[static_cast<size_t>(r) + 1]; ++e) {
             const int c = a.col[static_cast<size_t>(e)];
-            if (!verlet_.poleMark[static_cast<size_t>(c)]) {
-                verlet_.poleMark[static_cast<size_t>(c)] = 1;
-                verlet_.appliedPoles.push_back(c);
+            if (!poleMark_[static_cast<size_t>(c)]) {
+                poleMark_[static_cast<size_t>(c)] = 1;
+                appliedPoles_.push_back(c);
             }
-            fp_.row(c) += a.value[static_cast<size_t>(e)] * f.transpose();
+            fp.row(c) += a.value[static_cast<size_t>(e)] * f.transpose();
         }
     }
-    held_.addMasters(verlet_.appliedPoles, verlet_.poleMark);  // (a linked pole's force goes to its masters)
-    for (int c : verlet_.appliedPoles) verlet_.poleMark[static_cast<size_t>(c)] = 0;
-    held_.reduce(fp_);
-    massSolver_.solveSparse(fp_, verlet_.appliedPoles, acc_);
-    held_.expand(acc_);
+    m.held.addMasters(appliedPoles_, poleMark_);  // (a linked pole's force goes to its masters)
+    for (int c : appliedPoles_) poleMark_[static_cast<size_t>(c)] = 0;
+    m.held.reduce(fp);
+    m.systems.mass().solveSparse(fp, appliedPoles_, m.scratch.poleStep);
+    m.held.expand(m.scratch.poleStep);
 }
 
-StepReport DynamicSurface::stepVerlet(double dt) {
+StepReport VerletIntegrator::step(StepModel& m, double dt) {
     StepReport r;
     r.verlet = true;
     r.substeps = 1;
-    ensureMassFactor();
+    m.ensureMass();
+    SurfaceState& s = m.state;
+    Points &fp = m.scratch.poleForce, &applied = m.scratch.poleStep, &tmp = m.scratch.mesh;
+    const PrefactoredSolver& mass = m.systems.mass();
     const double h = dt;
-    if (!avValid_) A_.apply(v_, av_);
-    if (!verlet_.valid) {
-        verletForces(d_, av_);
-        A_.applyTransposed(force_, fp_);
-        held_.reduce(fp_);
-        massSolver_.solve(fp_, verlet_.a);
-        held_.expand(verlet_.a);
+    if (!s.avValid) s.A.apply(s.v, s.av);
+    if (!valid_) {
+        m.forces.internalLinear(m.material, s.d, s.av);
+        s.A.applyTransposed(m.forces.total(), fp);
+        m.held.reduce(fp);
+        mass.solve(fp, a_);
+        m.held.expand(a_);
     }
-    if (tool_->grabbed()) {
-        meshTmp_ = d_ + (0.5 * h) * av_;
-        applyToolForces(dt, r, meshTmp_, 0.5);
+    if (m.forces.tool().grabbed()) {
+        tmp = s.d + (0.5 * h) * s.av;
+        m.applyTool(dt, r, tmp, 0.5);
     } else {
-        applyToolForces(dt, r, d_);
+        m.applyTool(dt, r, s.d);
     }
-    const bool applied = hasExternal_ || toolForces_;
-    if (applied) {  // their acceleration, held over the step, into acc_
-        solveApplied();
-        v_ += (0.5 * h) * acc_;
+    const bool anyApplied = m.forces.anyApplied();
+    if (anyApplied) {  // their acceleration, held over the step
+        solveApplied(m);
+        s.v += (0.5 * h) * applied;
     }
-    v_ += (0.5 * h) * verlet_.a;
-    surface_.mutablePoles() += h * v_;
-    A_.apply(surface_.poles(), d_);
+    s.v += (0.5 * h) * a_;
+    s.mutablePoles() += h * s.v;
+    s.sampleMesh();
     // The mesh velocity at the step's end, to second order, for the damping: 2 v+ - v_n.
-    meshTmp_ = (2.0 / h) * (d_ - dPrev_) - av_;
-    verlet_.stepPotential = verletForces(d_, meshTmp_);
-    A_.applyTransposed(force_, fp_);
-    held_.reduce(fp_);
-    massSolver_.solve(fp_, verlet_.a);
-    held_.expand(verlet_.a);
-    v_ += (0.5 * h) * verlet_.a;
-    if (applied) v_ += (0.5 * h) * acc_;
-    A_.apply(v_, av_);
-    avValid_ = verlet_.valid = true;
-    history_.valid = accelerationValid_ = false;
+    tmp = (2.0 / h) * (s.d - s.meshAtStart) - s.av;
+    stepPotential_ = m.forces.internalLinear(m.material, s.d, tmp);
+    s.A.applyTransposed(m.forces.total(), fp);
+    m.held.reduce(fp);
+    mass.solve(fp, a_);
+    m.held.expand(a_);
+    s.v += (0.5 * h) * a_;
+    if (anyApplied) s.v += (0.5 * h) * applied;
+    s.A.apply(s.v, s.av);
+    s.avValid = valid_ = true;
     return r;
 }
 

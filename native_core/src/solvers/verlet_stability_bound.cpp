@@ -6,79 +6,81 @@
 // M = A^T M A, found by Lanczos. Painting a map changes K and M every few steps: there the bounds
 // are rescaled from the last computed ones instead (K' <= max(k'/k) K, M' >= min(m'/m) M, and the
 // reverse for the lower bound), and recomputed only when the rescaled pair no longer decides.
+#include "solvers/verlet_stability_bound.hpp"
+
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <Eigen/Eigenvalues>
-#include <limits>
 #include <random>
 #include <vector>
 
-#include "solvers/dynamic_surface.hpp"
-
 namespace hs {
 
-bool DynamicSurface::omegaSquaredBelow(double limit, bool tight) {
-    const std::uint64_t key[4] = {mass_.version(), stiffness_.version(), structureKey(), bendingMap_.version()};
-    if (key[0] != omega_.key[0] || key[1] != omega_.key[1] || key[2] != omega_.key[2] || key[3] != omega_.key[3]) {
-        rescaleOmegaBounds();
-        for (int i = 0; i < 4; ++i) omega_.key[i] = key[i];
+bool VerletStabilityBound::below(StepModel& m, double limit, bool tight) {
+    const Material& mat = m.material;
+    const std::uint64_t key[4] = {mat.massMap.version(), mat.stiffnessMap.version(), m.structureKey(),
+                                  mat.bendingMap.version()};
+    if (key[0] != key_[0] || key[1] != key_[1] || key[2] != key_[2] || key[3] != key_[3]) {
+        rescale(m);
+        for (int i = 0; i < 4; ++i) key_[i] = key[i];
     }
     if (!tight) {
-        if (omega_.upper <= limit) return true;
-        if (omega_.lower > limit || omega_.tight) return false;
+        if (upper_ <= limit) return true;
+        if (lower_ > limit || tight_) return false;
     }
-    if (!omega_.tight) computeOmegaBounds(tight ? std::numeric_limits<double>::infinity() : limit);
-    return omega_.upper <= limit;
+    if (!tight_) compute(m, tight ? std::numeric_limits<double>::infinity() : limit);
+    return upper_ <= limit;
 }
 
-void DynamicSurface::rescaleOmegaBounds() {
-    omega_.tight = false;
-    if (omega_.snapK.size() == 0 || omega_.snapStructure != structureKey()) {
-        omega_.upper = std::numeric_limits<double>::infinity();
-        omega_.lower = 0;
+void VerletStabilityBound::rescale(const StepModel& m) {
+    tight_ = false;
+    if (snapK_.size() == 0 || snapStructure_ != m.structureKey()) {
+        upper_ = std::numeric_limits<double>::infinity();
+        lower_ = 0;
         return;
     }
     double kUp = 1, kDown = 1, mUp = 0, mDown = std::numeric_limits<double>::infinity();
-    for (Eigen::Index s = 0; s < omega_.snapK.size(); ++s) {
-        const double r = springs_.stiffness(static_cast<int>(s)) / omega_.snapK[s];
+    for (Eigen::Index s = 0; s < snapK_.size(); ++s) {
+        const double r = m.material.springs.stiffness(static_cast<int>(s)) / snapK_[s];
         kUp = std::max(kUp, r);
         kDown = std::min(kDown, r);
     }
     // K_b = B^T W B grows by at most the largest ratio of its row weights (0 stays 0; from 0, unbounded).
-    const Eigen::VectorXd& w = bending_.weights();
+    const Eigen::VectorXd& w = m.material.bending.weights();
     for (Eigen::Index s = 0; s < w.size(); ++s) {
-        const double was = omega_.snapBending[s];
+        const double was = snapBending_[s];
         const double r = was > 0 ? w[s] / was : w[s] > 0 ? std::numeric_limits<double>::infinity() : 1.0;
         kUp = std::max(kUp, r);
         kDown = std::min(kDown, r);
     }
-    for (Eigen::Index i = 0; i < m_.size(); ++i) {
-        const double r = m_[i] / omega_.snapM[i];
+    const Eigen::VectorXd& masses = m.material.masses();
+    for (Eigen::Index i = 0; i < masses.size(); ++i) {
+        const double r = masses[i] / snapM_[i];
         mUp = std::max(mUp, r);
         mDown = std::min(mDown, r);
     }
-    omega_.upper = omega_.snapUpper * kUp / mDown;
-    omega_.lower = omega_.snapLower * kDown / mUp;
+    upper_ = snapUpper_ * kUp / mDown;
+    lower_ = snapLower_ * kDown / mUp;
 }
 
-void DynamicSurface::computeOmegaBounds(double limit) {
-    ensureMassFactor();
-    const Eigen::SparseMatrix<double> A = A_.matrix().toEigen();
-    Eigen::SparseMatrix<double> K = A.transpose() * laplacian() * A;
-    held_.restrict(K, false);  // the held poles' modes are gone (massMatrix_ is restricted too)
-    const Eigen::SparseMatrix<double>& M = massMatrix_;
-    omega_.snapK.resize(static_cast<Eigen::Index>(springs_.first().size()));
-    for (Eigen::Index s = 0; s < omega_.snapK.size(); ++s) omega_.snapK[s] = springs_.stiffness(static_cast<int>(s));
-    omega_.snapM = m_;
-    omega_.snapStructure = structureKey();
-    omega_.snapBending = bending_.weights();
+void VerletStabilityBound::compute(StepModel& m, double limit) {
+    m.ensureMass();
+    const Eigen::SparseMatrix<double> A = m.state.A.matrix().toEigen();
+    Eigen::SparseMatrix<double> K = A.transpose() * m.laplacian() * A;
+    m.held.restrict(K, false);  // the held poles' modes are gone (the mass matrix is restricted too)
+    const Eigen::SparseMatrix<double>& M = m.systems.massMatrix();
+    const SpringMesh& springs = m.material.springs;
+    snapK_.resize(static_cast<Eigen::Index>(springs.first().size()));
+    for (Eigen::Index s = 0; s < snapK_.size(); ++s) snapK_[s] = springs.stiffness(static_cast<int>(s));
+    snapM_ = m.material.masses();
+    snapStructure_ = m.structureKey();
+    snapBending_ = m.material.bending.weights();
     // max K_ii / M_ii is a Rayleigh quotient, so a lower bound: it rules out long steps cheaply.
     const double lower = (K.diagonal().array() / M.diagonal().array()).maxCoeff();
     if (lower > limit) {
-        omega_.lower = omega_.snapLower = lower;
-        omega_.upper = omega_.snapUpper = std::numeric_limits<double>::infinity();
-        omega_.tight = false;
+        lower_ = snapLower_ = lower;
+        upper_ = snapUpper_ = std::numeric_limits<double>::infinity();
+        tight_ = false;
         return;
     }
     // Lanczos in the M inner product (M^-1 K is self-adjoint there): its largest Ritz value is a
@@ -91,7 +93,7 @@ void DynamicSurface::computeOmegaBounds(double limit) {
     std::mt19937 rng(12345);
     std::uniform_real_distribution<double> uni(-1.0, 1.0);
     for (Eigen::Index i = 0; i < q.size(); ++i) q.data()[i] = uni(rng);
-    held_.zeroRows(q);
+    m.held.zeroRows(q);
     mw = M * q;
     for (int c = 0; c < 3; ++c) q.col(c) /= std::sqrt(q.col(c).dot(mw.col(c)));
     Eigen::MatrixXd alpha = Eigen::MatrixXd::Zero(kMaxSteps, 3), beta = Eigen::MatrixXd::Zero(kMaxSteps, 3);
@@ -100,7 +102,7 @@ void DynamicSurface::computeOmegaBounds(double limit) {
     bool live[3] = {true, true, true};
     for (int j = 0; j < kMaxSteps; ++j) {
         kq = K * q;
-        massSolver_.solve(kq, w);
+        m.systems.mass().solve(kq, w);
         for (int c = 0; c < 3; ++c) {
             if (!live[c]) continue;
             alpha(j, c) = q.col(c).dot(kq.col(c));
@@ -122,9 +124,9 @@ void DynamicSurface::computeOmegaBounds(double limit) {
         if (!live[0] && !live[1] && !live[2]) break;
     }
     // Ritz values are Rayleigh quotients: lower bounds that reach lambda_max from below; hence the margin.
-    omega_.lower = omega_.snapLower = best;
-    omega_.upper = omega_.snapUpper = 1.05 * best;
-    omega_.tight = true;
+    lower_ = snapLower_ = best;
+    upper_ = snapUpper_ = 1.05 * best;
+    tight_ = true;
 }
 
 }  // namespace hs

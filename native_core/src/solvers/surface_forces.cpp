@@ -1,0 +1,105 @@
+#include "solvers/surface_forces.hpp"
+
+#include <stdexcept>
+
+namespace hs {
+
+SurfaceForces::SurfaceForces(int g, int h) : constraints_(g, h) {
+    const Eigen::Index S = static_cast<Eigen::Index>(g) * h;
+    for (Points* m : {&external_, &fromTool_, &total_}) m->setZero(S, 3);
+    dampingFactor_.setZero(S);
+    terms_.reserve(64);
+    setTool("rope");
+}
+
+void SurfaceForces::setPointForce(int index, const Vec3& force, const MirrorSymmetry& mirror) {
+    if (index < 0 || index >= external_.rows()) throw std::invalid_argument("index: mesh index out of range");
+    if (!force.allFinite()) throw std::invalid_argument("force: must be finite");
+    const double n = force.norm();
+    const Vec3 f = n > maxPointForce ? Vec3(force * (maxPointForce / n)) : force;
+    if (mirror.empty()) external_.row(index) = f.transpose();
+    else mirror.pointForce(external_, index, f);
+    hasExternal_ = true;
+}
+
+void SurfaceForces::clearExternal() {
+    external_.setZero();
+    hasExternal_ = false;
+}
+
+double SurfaceForces::appliedWork(const Points& d, const Points& before) const {
+    // (whole-array products, so the loop vectorises)
+    double work = 0;
+    if (hasExternal_) work += external_.cwiseProduct(d - before).sum();
+    if (toolActive_) work += fromTool_.cwiseProduct(d - before).sum();
+    return work;
+}
+
+void SurfaceForces::setTool(const std::string& name) {
+    auto t = makeTool(name);
+    t->reserve(static_cast<size_t>(total_.rows()));
+    tool_ = std::move(t);
+}
+
+bool SurfaceForces::applyTool(const Points& at, int g, int h, double su, double sv, const MirrorSymmetry& mirror,
+                              double dt, Reaction& reaction, double phase) {
+    if (tool_->grabbed()) {
+        fromTool_.setZero();
+        reaction = tool_->apply({at, g, h, su, sv}, cursor, dt, fromTool_, phase);
+        if (!mirror.empty()) mirror.addMirrored(fromTool_);
+        toolActive_ = true;
+        return true;
+    }
+    if (!toolActive_) return false;
+    fromTool_.setZero();
+    toolActive_ = false;
+    return true;
+}
+
+double SurfaceForces::all(Material& material, const Points& d, const Points& dd) {
+    total_.setZero();
+    const double energy = material.springs.addForces(d, total_);
+    const ResponseLaw& law = material.dampingLaw;
+    const bool nonlinearDamping = law.kind != LawKind::Linear;
+    if (nonlinearDamping)
+        for (Eigen::Index i = 0; i < d.rows(); ++i) dampingFactor_[i] = law.dampingFactor(total_.row(i).norm());
+    const double bend = material.bending.addForces(d, total_);  // (after the damping law: it reads spring forces)
+    if (hasExternal_) total_ += external_;
+    if (toolActive_) total_ += fromTool_;
+    double penalty = 0;
+    if (!constraints_.empty()) penalty = constraints_.addForces(d, total_, terms_);
+    const Eigen::VectorXd& gamma = material.damping();
+    if (nonlinearDamping)
+        for (Eigen::Index i = 0; i < d.rows(); ++i) total_.row(i) -= gamma[i] * dampingFactor_[i] * dd.row(i);
+    else
+        total_ -= gamma.asDiagonal() * dd;
+    return energy + bend + penalty;
+}
+
+double SurfaceForces::internalLinear(Material& material, const Points& d, const Points& dd) {
+    total_.setZero();
+    double energy = material.springs.addProjections(d, total_, 0.0, 1.0, true);  // the spring forces, for a linear law
+    energy += material.bending.addForces(d, total_);
+    if (!constraints_.empty()) energy += constraints_.addForces(d, total_, terms_);
+    if (material.maxDampingRate() > 0) total_ -= material.damping().asDiagonal() * dd;
+    return energy;
+}
+
+double SurfaceForces::potential(Material& material, const Points& d) {
+    total_.setZero();
+    double e = material.springs.addForces(d, total_);
+    e += material.bending.addForces(d, total_);
+    if (!constraints_.empty()) e += constraints_.addForces(d, total_, terms_);
+    return e;
+}
+
+double SurfaceForces::potentialEnergy(const Material& material, const Points& d) {
+    double e = material.springs.energy(d) + material.bending.energy(d);
+    if (!constraints_.empty()) {
+        total_.setZero();
+        e += constraints_.addForces(d, total_, terms_);
+    }
+    return e;
+}
+
+}  // namespace hs
