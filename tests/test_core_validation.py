@@ -86,6 +86,9 @@ def test_dynamic_surface_validation():
         (lambda: ds.remove_constraint(99), "id"),
         (lambda: ds.mesh_index_at(float("nan"), 0.5), "uv"),
         (lambda: ds.set_rest_lengths([1.0]), "rest"),
+        (lambda: setattr(ds, "max_point_force", 0.0), "max_point_force"),
+        (lambda: setattr(ds, "max_point_force", float("inf")), "max_point_force"),
+        (lambda: setattr(ds, "constraint_stiffness_factor", -1.0), "constraint_stiffness_factor"),
     ]
     for call, match in cases:
         with pytest.raises(ValueError, match=match):
