@@ -25,6 +25,19 @@ inline constexpr bool kSanitized = true;
 inline constexpr bool kSanitized = false;
 #endif
 
+/// Waits until `done` holds (polling every millisecond), at most `seconds`; returns whether it held.
+/// The loops run slowly under sanitizers and on a loaded machine, so the tests wait for what they
+/// need (a grab, a count of steps, a force) instead of sleeping a fixed time.
+template <class Condition>
+bool waitFor(Condition done, double seconds = 30.0) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (!done()) {
+        if (std::chrono::steady_clock::now() > end) return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return true;
+}
+
 /// The message of what `f` throws ("" if it throws nothing).
 inline std::string errorOf(const std::function<void()>& f) {
     try {

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <thread>
 
+#include "device_session.hpp"
 #include "runtime/haptic_runtime.hpp"
 #include "devices/hid/hid_report_descriptor.hpp"
 #include "devices/hid/pid_emulator.hpp"
@@ -182,7 +183,7 @@ TEST(SpaceMouse, DeviceOverARecordingInRateAndPositionControl) {
         rec.events.push_back({0.0, {0x01, 0xaf, 0x00, 0x00, 0x00, 0x00, 0x00}});  // x = 175
         SpaceMouseDevice dev(std::make_unique<RecordedTransport>(rec, false), settings);
         dev.start();
-        for (int k = 0; k < 200 && dev.state().reports < 1; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        ASSERT_TRUE(waitFor([&] { return dev.state().reports >= 1; }));
         DeviceSample s;
         ASSERT_TRUE(dev.sample(1.0, s));
         ASSERT_TRUE(dev.sample(1.1, s));
@@ -199,7 +200,7 @@ TEST(SpaceMouse, DeviceOverARecordingInRateAndPositionControl) {
     rec.events.push_back({0.0, {0x01, 0x12, 0x00, 0x00, 0x00, 0xf8, 0x00}});
     SpaceMouseDevice dev(std::make_unique<RecordedTransport>(rec, false), settings);
     dev.start();
-    for (int k = 0; k < 200 && dev.state().reports < 1; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    ASSERT_TRUE(waitFor([&] { return dev.state().reports >= 1; }));
     DeviceSample s;
     ASSERT_TRUE(dev.sample(0.0, s));
     dev.stop();
@@ -210,7 +211,7 @@ TEST(SpaceMouse, DeviceOverARecordingInRateAndPositionControl) {
 TEST(SpaceMouse, LossEndsTheDevice) {
     SpaceMouseDevice dev(std::make_unique<RecordedTransport>(fixture("spacenavigator.hid"), false, true), SpaceMouseSettings{});
     dev.start();
-    for (int k = 0; k < 500 && !dev.lost(); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    ASSERT_TRUE(waitFor([&] { return dev.lost(); }));
     DeviceSample s;
     EXPECT_FALSE(dev.sample(0.1, s));
     dev.stop();
@@ -234,7 +235,7 @@ TEST(HidPid, DriverStartsStreamsAndStopsEffectsOnTheEmulator) {
         }
     EXPECT_EQ(running, 3);
     driver.setForce(Vec3(5.0, -2.5, 20.0));
-    std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    EXPECT_TRUE(waitFor([&] { return emu->effects()[2].magnitude == 10000; }));  // (set by the driver's thread)
     effects = emu->effects();
     EXPECT_EQ(effects[0].magnitude, 5000);
     EXPECT_EQ(effects[1].magnitude, -2500);
@@ -274,10 +275,12 @@ TEST(HidPid, SessionWithForceFeedbackZeroesAndStopsOnExit) {
     RuntimeSettings settings;
     HapticRuntime rt(surface, device, settings);
     rt.start();
-    std::this_thread::sleep_for(std::chrono::milliseconds(400));
-    bool pushing = false;
-    for (const auto& e : emu->effects()) pushing |= e.running && e.magnitude != 0;
-    EXPECT_TRUE(pushing);
+    // The replayed cursor pulls the rope 30 mm up over 0.5 s and holds: the device pushes back.
+    EXPECT_TRUE(waitFor([&] {
+        bool pushing = false;
+        for (const auto& e : emu->effects()) pushing |= e.running && e.magnitude != 0;
+        return pushing;
+    }));
     rt.stop();
     for (const auto& e : emu->effects()) EXPECT_FALSE(e.running);
     EXPECT_FALSE(emu->actuatorsEnabled());

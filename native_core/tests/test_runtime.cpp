@@ -20,19 +20,6 @@
 using namespace hs;
 
 namespace {
-// Waits until `done` holds (polling every millisecond), at most `seconds`; returns whether it held.
-// The loops run slowly under sanitizers and on a loaded machine, so the tests wait for what they
-// need (a grab, a count of steps) instead of sleeping a fixed time.
-template <class Condition>
-bool waitFor(Condition done, double seconds = 30.0) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (!done()) {
-        if (std::chrono::steady_clock::now() > end) return false;
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
-    return true;
-}
-
 std::shared_ptr<DynamicSurface> patch(int controls = 8, int mesh = 24) {
     return std::make_shared<DynamicSurface>(BSplineSurface::plane(controls, controls, 3, 3, 100, 100), mesh, mesh);
 }
