@@ -5,12 +5,12 @@ BUILD       := build
 JOBS        ?= 2
 APT_PACKAGES := build-essential cmake ninja-build pkg-config libeigen3-dev pybind11-dev libgtest-dev \
                 python3-dev python3-numpy python3-scipy python3-pytest python3-hypothesis python3-matplotlib \
-                python3-venv freecad-python3 freecad libhidapi-dev libusb-1.0-0 libwebsockets-dev libsimdjson-dev python3-websockets xvfb xauth xdotool imagemagick debootstrap \
+                python3-venv python3-distributed freecad-python3 freecad libhidapi-dev libusb-1.0-0 libwebsockets-dev libsimdjson-dev python3-websockets xvfb xauth xdotool imagemagick debootstrap \
                 ccache
 SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
-PHONY_LONG := stress fuzz bench-peers
+PHONY_LONG := stress fuzz bench-peers batch-replay
 .PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-gui-repeat test-cpp test-asan test-python \
         test-gui test-freecad test-addon wheel ocp-venv demo bench install install-udev install-realtime uninstall clean test-other-debians \
         wheels wheel-check
@@ -208,10 +208,19 @@ fuzz: deps
 	  test $${PIPESTATUS[0]} -eq 0; \
 	done
 
+# Campaigns run their scenes on Dask distributed (bench/campaign.py): a local cluster over all cores
+# unless CAMPAIGN says otherwise ("--workers 4", "--scheduler tcp://HOST:8786", "--workers 0": serial).
+CAMPAIGN ?=
 # The long stability campaign (make test runs seeds 0..9999; this goes on from there). Resumable.
 STRESS_SCENES ?= 100000
 stress: build
-	$(PY) bench/stress_campaign.py --scenes $(STRESS_SCENES)
+	$(PY) bench/stress_campaign.py --scenes $(STRESS_SCENES) $(CAMPAIGN)
+
+# A recorded stroke (TRAJECTORY, a ReplayDevice text file; default: a scripted rope pull) replayed in
+# FreeCAD console mode onto many parts (PARTS, a JSON list; default: eight), each writing STEP, FCStd
+# and a figure to build/batch_replay/.
+batch-replay: build
+	$(PY) bench/batch_replay.py $(if $(TRAJECTORY),--trajectory $(TRAJECTORY)) $(if $(PARTS),--parts $(PARTS)) $(CAMPAIGN)
 
 DEMO_OUT ?= out
 demo: build
@@ -245,7 +254,7 @@ bench: build wheel
 	$(PY) bench/table1.py
 	$(PY) bench/loops.py
 	$(PY) bench/skip.py
-	$(PY) bench/time_vs_error.py
+	$(PY) bench/time_vs_error.py $(CAMPAIGN)
 	$(PY) bench/discretisation.py
 	$(PY) bench/builds.py
 	$(PY) bench/solids.py

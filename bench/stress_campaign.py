@@ -8,7 +8,13 @@ resumes where it stopped (a log written by another build of the core is moved as
 NaN guard refused, failures with their seeds) is printed and written to
 bench/results/stress_campaign.json. Exit status 1 if any scene failed.
 
+The scenes run as tasks on Dask distributed (campaign.py: a local cluster over all cores by default,
+--workers N, or --scheduler tcp://HOST:PORT for a cluster of machines; --workers 0 runs them here in
+order). A scene is seeded, so its record is the same whichever worker runs it and in whatever order;
+the log holds them in the order they finished, the summary does not depend on it.
+
     python3 bench/stress_campaign.py --scenes 100000 [--first 10000] [--log build/stress/campaign.jsonl]
+                                     [--workers N | --scheduler tcp://HOST:PORT]
 """
 from __future__ import annotations
 
@@ -22,7 +28,7 @@ import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path[:0] = [ROOT, os.path.join(ROOT, "tests"), os.path.dirname(os.path.abspath(__file__))]
-from progress import progress  # noqa: E402
+import campaign  # noqa: E402
 from stress_scenes import run_scene  # noqa: E402
 
 
@@ -81,6 +87,7 @@ def main() -> int:
     ap.add_argument("--first", type=int, default=10_000, help="first seed (make test covers 0..9999)")
     ap.add_argument("--log", default=os.path.join(ROOT, "build", "stress", "campaign.jsonl"))
     ap.add_argument("--out", default=os.path.join(ROOT, "bench", "results", "stress_campaign.json"))
+    campaign.add_arguments(ap)
     a = ap.parse_args()
     os.makedirs(os.path.dirname(a.log), exist_ok=True)
     start_log(a.log)
@@ -88,8 +95,7 @@ def main() -> int:
     interrupted = False
     try:
         with open(a.log, "a") as log:
-            for seed in progress(todo, "stress", total=len(todo)):
-                r = run_scene(seed)
+            for seed, r in campaign.run(run_scene, todo, "stress", a.workers, a.scheduler):
                 log.write(json.dumps(dataclasses.asdict(r)) + "\n")
                 log.flush()
                 if not r.ok:
@@ -98,6 +104,7 @@ def main() -> int:
         interrupted = True
         print("\ninterrupted: finished scenes are kept in the log; rerun to resume", file=sys.stderr)
     summary = summarise(a.log, a.first, a.scenes)
+    summary["ran_on"] = campaign.describe(a.workers, a.scheduler)
     summary["complete"] = not interrupted and sum(c["scenes"] for c in summary["per_integrator"].values()) == a.scenes
     print(f"{'integrator':<14}{'scenes':>9}{'steps':>10}{'verlet':>10}{'refused':>10}{'energy guard':>14}"
           f"{'invalid refused':>17}{'failures':>10}")

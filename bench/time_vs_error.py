@@ -39,6 +39,11 @@ level 1e-2 .. 1e-6 and the default's speed-up over the paper's schemes. Finished
 interrupted (Ctrl-C writes what is done). ``--scenes rope,two_faces`` runs only those scenes and
 replaces their records in the JSON (every scene's solvers are compared within one run).
 
+The references and the runs are tasks on Dask distributed (campaign.py: a local cluster over all
+cores by default, ``--workers N``, ``--scheduler tcp://HOST:PORT``; ``--workers 0`` runs them here in
+order). The errors do not depend on where a run ran; the times do: runs side by side share the
+machine's memory bandwidth, so compare times within one run (``--workers 1`` for the quietest).
+
 ``--fairness`` runs only the fair-stroke measure (issue 26): curvature sign changes and total
 variation along sections of a rope stroke (exact derivatives), free and pinned, clay and elastic,
 today's springs alone beside the default bending, and the per-step time of each integrator on each
@@ -47,6 +52,7 @@ fairness_table).
 """
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import os
@@ -59,7 +65,7 @@ from scipy import optimize
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path[:0] = [ROOT, os.path.dirname(os.path.abspath(__file__)), os.path.join(ROOT, "tests")]
 from HapticSculpt import core  # noqa: E402
-from progress import progress  # noqa: E402
+import campaign  # noqa: E402
 
 MS = 1e-3
 DTS = [MS * 2.0 ** -k for k in range(0, 11)] + [2 * MS, 4 * MS, 8 * MS]  # 8 ms .. 0.98 us
@@ -271,6 +277,17 @@ def static_reference() -> tuple[list[np.ndarray], float]:
     return [np.array(s.mesh)], residual
 
 
+def reference(scene: str) -> tuple[list[np.ndarray], float]:
+    """A scene's reference run and its quality (a campaign task)."""
+    return static_reference() if scene == "equilibrium" else richardson_reference(scene)
+
+
+def run_job(job: tuple[str, str, str, dict, float]) -> tuple[float, list[np.ndarray]]:
+    """One run of the sweep (a campaign task): (scene, label, integrator, settings, dt)."""
+    scene, _, integrator, settings, dt = job
+    return timed_run(scene, integrator, settings, dt)
+
+
 def timed_run(scene: str, integrator: str, settings: dict, dt: float) -> tuple[float, list[np.ndarray]]:
     """Wall seconds per simulated second (median of 3 for short runs) and the run's snapshots."""
     build, play, seconds, _ = SCENES[scene]
@@ -458,39 +475,45 @@ def plot_fairness(profiles: dict, default: float, path: str) -> None:
 
 
 def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--fairness", action="store_true", help="the fairness table instead of the sweep")
+    ap.add_argument("--scenes", default=",".join(SCENES), help="comma-separated scenes (default: all)")
+    campaign.add_arguments(ap)
+    a = ap.parse_args()
     out_dir = os.path.join(ROOT, "bench", "results")
     os.makedirs(out_dir, exist_ok=True)
-    if "--fairness" in sys.argv:
+    if a.fairness:
         fairness_table(out_dir)
         return
-    chosen = list(SCENES)
-    if "--scenes" in sys.argv:
-        chosen = sys.argv[sys.argv.index("--scenes") + 1].split(",")
-        unknown = [c for c in chosen if c not in SCENES]
-        if unknown:
-            sys.exit(f"--scenes: no scene {', '.join(unknown)} (scenes: {', '.join(SCENES)})")
+    chosen = [c for c in a.scenes.split(",") if c]
+    unknown = [c for c in chosen if c not in SCENES]
+    if unknown or not chosen:
+        sys.exit(f"--scenes: no scene {', '.join(unknown)} (scenes: {', '.join(SCENES)})")
     path = os.path.join(out_dir, "time_vs_error.json")
     kept: dict = {"references": {}, "records": []}
     if chosen != list(SCENES) and os.path.exists(path):
         with open(path, encoding="utf-8") as f:
             kept = json.load(f)
     refs, notes = {}, {k: v for k, v in kept["references"].items() if k not in chosen}
-    for scene in progress(chosen, "references"):
-        refs[scene], notes[scene] = static_reference() if scene == "equilibrium" else richardson_reference(scene)
+    for scene, (refs[scene], notes[scene]) in campaign.run(reference, chosen, "references", a.workers, a.scheduler):
+        pass
     print("reference quality: " + ", ".join(
         f"{k}: {'relative gradient left' if k == 'equilibrium' else 'Richardson spread / size'} {v:.1e}" for k, v in notes.items()))
     jobs = [(scene, label, integ, settings, dt) for scene in chosen for label, integ, settings in SOLVERS
             for dt in DTS if max(SCENES[scene][3][0], shortest_step(label, settings)) <= dt <= SCENES[scene][3][1]]
     records: list[dict] = [r for r in kept["records"] if r["scene"] not in chosen]
     try:
-        for scene, label, integ, settings, dt in progress(jobs, "runs"):
-            sps, snaps = timed_run(scene, integ, settings, dt)
+        for (scene, label, integ, settings, dt), (sps, snaps) in campaign.run(run_job, jobs, "runs", a.workers,
+                                                                                 a.scheduler):
             err = max(float(np.abs(a - b).max()) for a, b in zip(snaps, refs[scene])) / SIZE
             records.append({"scene": scene, "solver": label, "dt": dt,
                             "iterations": settings.get("iterations", settings.get("cg_iterations", 1)),
                             "seconds_per_sim_second": sps, "error": err if math.isfinite(err) else float("inf")})
     except KeyboardInterrupt:
         print(f"\ninterrupted after {len(records)} of {len(jobs)} runs; writing those", file=sys.stderr)
+    # (in the order of the jobs, whatever order they finished in)
+    order = {(j[0], j[1], j[4]): i for i, j in enumerate(jobs)}
+    records.sort(key=lambda r: (r["scene"] in chosen, order.get((r["scene"], r["solver"], r["dt"]), -1)))
     with open(path, "w") as f:
         json.dump({"references": notes, "records": records}, f, indent=1)
     rows = pareto_table(records)
