@@ -308,6 +308,37 @@ def test_plastic_deformation_keeps_shape_after_release():
     assert ds.mesh[..., 2].max() > 3.0  # stays deformed
 
 
+def test_clay_keeps_what_a_stroke_leaves_without_springing_back():
+    """The release makes the stroke's shape the rest shape: a rope's bump and a flatten's press stay
+    where they were left (before, the strain below the yield sprang back: the bump lost a third of
+    its height in a minute, the flatten most of its press), and the surface falls asleep."""
+    ds = core.patch((8, 8), mesh=(40, 40))
+    ds.set_plasticity(True, 0.01, 5.0)  # the clay of make_sculpt(material="clay")
+    ds.damping_map.set_uniform(10.0)
+    ds.bending_map.set_uniform(10.0)
+    ds.hold_poles([0, 7, 56, 63])
+
+    def stroke(tool, z0, z1, seconds, **settings):
+        ds.set_tool(tool)
+        for k, v in settings.items():
+            setattr(ds.tool, k, v)
+        n = int(seconds / DT)
+        for k in range(n + 200):
+            ds.set_cursor([0.0, 0.0, z0 + min(1.0, k / n) * (z1 - z0)], grab=True)
+            ds.step(DT)
+        ds.set_cursor([0.0, 0.0, z1], grab=False)
+        return ds.mesh[..., 2].max()
+
+    top = stroke("rope", 0.0, 20.0, 1.0)
+    ds.step(DT, 10000)
+    assert ds.mesh[..., 2].max() == pytest.approx(top, abs=0.05)
+    pressed = stroke("flatten", top, top - 3.0, 0.5, radius=20.0)
+    assert pressed < top - 2.0
+    ds.step(DT, 30000)
+    assert ds.mesh[..., 2].max() == pytest.approx(pressed, abs=0.05)
+    assert ds.asleep
+
+
 @pytest.mark.parametrize("law", ["cubic", "saturating"])
 def test_nonlinear_stiffness_changes_response(law):
     def pull(kind):

@@ -146,7 +146,8 @@ def _add_sculpt(doc: Any, name: str, made: Any, state: sculpt_state.SculptState)
 
 
 #: The "clay" material: springs stretched past 1 % creep toward their new length at a rate of 5 per
-#: second (the demo's plasticity), and ten times the default damping, so a released patch stops
+#: second (the demo's plasticity), the release makes the stroke's shape the rest shape (the core),
+#: and ten times the default damping, so a released patch stops
 #: where it was left instead of flying on (measured: a free patch pulled to 28 mm ends at 27.0 mm
 #: 6 s later with damping 10, at 76 mm with the default 1).
 CLAY = (True, 0.01, 5.0)

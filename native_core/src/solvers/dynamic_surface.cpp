@@ -188,10 +188,17 @@ void DynamicSurface::setCursor(const Cursor& c) {
         touch();
     } else if (!n.grab && t.grabbed()) {
         t.release();
-        // Clay keeps what it is given: the stroke's shape becomes what bending measures from.
-        // (follow, not setReference: the state is the core's own, finite by its guards, and may lie
-        // past the +-1e9 a caller's reference is held to after extreme forces)
-        if (material_.springs.plasticity.enabled) material_.bending.follow(state_.d, 1.0);
+        // Clay keeps what it is given: the stroke's shape becomes the rest shape, its springs' rest
+        // lengths and what bending measures from. Left to plastic flow alone, the strain below the
+        // yield sprang back for a minute after the release (a flatten stroke undone in 30 s, a
+        // free sheet curling by itself). (follow, not setReference: the state is the core's own,
+        // finite by its guards, and may lie past the +-1e9 a caller's reference is held to after
+        // extreme forces)
+        if (material_.springs.plasticity.enabled) {
+            material_.springs.resetRest(state_.d);
+            material_.bending.follow(state_.d, 1.0);
+            guard_.reset();  // (the potential energy just dropped: a new ceiling)
+        }
         localGlobal_.restart();
         touch();
     }
