@@ -761,3 +761,35 @@ def test_stop_right_after_a_stroke_on_an_elastic_patch_keeps_what_was_shown_in_t
         d.shot("elastic_stop")  # (the stripes on the face: no part of the face shows through them)
     finally:
         d.close()
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_a_clay_stroke_stays_where_it_was_left(tmp_path):
+    """New clamped patch (clay), a session, one rope stroke by the mouse: the face comes to rest
+    where the stroke left it (before, the strain below the yield sprang back for a minute after the
+    release, and the drift was folded into the next undo step), and Stop adds nothing."""
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        d.xdo("mousemove", "640", "500")
+        d.xdo("key", "ctrl+n")
+        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
+        s = d.press_button("NewClampedPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new clamped patch")
+        assert sculpt(s)["plasticity"][0], "the GUI's patch is not clay"
+        s = d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
+        d.calibrate()
+        centre = d.to_screen(sculpt(s)["screen"][0])
+        d.drag([centre] + [(centre[0], centre[1] - 8 * k) for k in range(1, 11)], seconds=0.8)
+        s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke's undo step")
+        stroke = float(np.array(sculpt(s)["poles"]).reshape(-1, 3)[:, 2].max())
+        assert stroke > 2.0, f"the rope did not pull ({stroke:.2f} mm)"
+        # the face at rest (its highest pole the same to 1 um over five of the observer's writes)
+        rest = d.wait_still(lambda s: round(float(np.array(sculpt(s)["shape_poles"])[:, 2].max()), 3),
+                            "the face after the stroke", timeout=30.0)
+        assert abs(rest - stroke) < 0.05, f"the face moved {rest - stroke:+.3f} mm after the stroke's commit"
+        s = d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
+        assert undo(s)[0] == "Sculpt stroke", undo(s)
+        kept = float(np.array(sculpt(s)["poles"]).reshape(-1, 3)[:, 2].max())
+        assert abs(kept - stroke) < 0.05, f"Stop kept {kept:.3f} mm, the stroke left {stroke:.3f} mm"
+        d.shot("clay_stroke_at_rest")
+    finally:
+        d.close()
