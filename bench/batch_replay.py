@@ -179,7 +179,7 @@ def main() -> int:
     for task, record in campaign.run(replay, tasks, "parts", a.workers, a.scheduler):
         records[task["part"]["name"]] = record
     ordered = [records[p["name"]] for p in parts]  # (in the order of the parts, whatever order they finished in)
-    with open(os.path.join(out, "batch_replay.json"), "w") as f:
+    with open(os.path.join(out, "batch_replay.json"), "w", encoding="utf-8") as f:
         json.dump({"trajectory": trajectory, "ran_on": campaign.describe(a.workers, a.scheduler), "parts": ordered},
                   f, indent=1)
     print(f"{'part':<24}{'steps':>7}{'refused':>9}{'lift (mm)':>11}{'depth (mm)':>12}{'STEP faces':>12}{'wall (s)':>10}")

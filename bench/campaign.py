@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 from collections.abc import Callable, Iterable, Iterator
 from typing import Any, TypeVar
 
@@ -93,8 +92,3 @@ def describe(workers: int | None, scheduler: str | None) -> str:
     if scheduler is not None:
         return f"Dask scheduler {scheduler}"
     return f"Dask LocalCluster, {workers or os.cpu_count() or 1} workers"
-
-
-__all__ = ["add_arguments", "run", "describe", "PATHS"]
-if __name__ == "__main__":
-    sys.exit("bench/campaign.py is a module: the campaigns (stress_campaign.py, time_vs_error.py, batch_replay.py) use it")

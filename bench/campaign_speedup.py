@@ -32,7 +32,7 @@ def stress(scenes: int, workers: int, tmp: str) -> tuple[float, object]:
     subprocess.run([sys.executable, os.path.join(BENCH, "stress_campaign.py"), "--scenes", str(scenes), "--first", "20000",
                     "--log", log, "--out", out, "--workers", str(workers)], check=True, capture_output=True)
     wall = time.perf_counter() - t0
-    with open(out) as f:
+    with open(out, encoding="utf-8") as f:
         summary = json.load(f)
     return wall, (summary["per_integrator"], summary["failures"])
 
@@ -43,7 +43,7 @@ def replay(workers: int, tmp: str) -> tuple[float, object]:
     subprocess.run([sys.executable, os.path.join(BENCH, "batch_replay.py"), "--out", out, "--workers", str(workers)],
                    check=True, capture_output=True)
     wall = time.perf_counter() - t0
-    with open(os.path.join(out, "batch_replay.json")) as f:
+    with open(os.path.join(out, "batch_replay.json"), encoding="utf-8") as f:
         parts = json.load(f)["parts"]
     return wall, [{k: v for k, v in p.items() if k != "wall_seconds"} for p in parts]
 
@@ -73,7 +73,7 @@ def main() -> None:
                      "speedup_2_vs_1": med[1] / med[2], "speedup_2_vs_serial": med[0] / med[2], "runs": per})
         print(f"{name:<16}{med[0]:>9.1f}{med[1]:>10.1f}{med[2]:>11.1f}{med[1] / med[2]:>8.2f}x{med[0] / med[2]:>12.2f}x")
     out = os.path.join(ROOT, "bench", "results", "campaign_speedup.json")
-    with open(out, "w") as f:
+    with open(out, "w", encoding="utf-8") as f:
         json.dump({"cores": os.cpu_count(), "repeats": a.repeats, "rows": rows}, f, indent=1)
     import matplotlib
     matplotlib.use("Agg")

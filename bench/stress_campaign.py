@@ -43,26 +43,26 @@ def start_log(log: str) -> None:
     """Keeps `log` only if it was written by this build of the core; otherwise moves it aside (its
     results would not describe this core) and starts afresh."""
     stamp, current = log + ".core", core_fingerprint()
-    previous = open(stamp).read().strip() if os.path.exists(stamp) else None
+    previous = open(stamp, encoding="utf-8").read().strip() if os.path.exists(stamp) else None
     if os.path.exists(log) and previous != current:
         aside = f"{log}.{(previous or 'unknown')[:12]}"
         os.replace(log, aside)
         print(f"the log was written by another build of the core: moved to {aside}; starting afresh", file=sys.stderr)
-    with open(stamp, "w") as f:
+    with open(stamp, "w", encoding="utf-8") as f:
         f.write(current + "\n")
 
 
 def done_seeds(log: str) -> set[int]:
     if not os.path.exists(log):
         return set()
-    with open(log) as f:
+    with open(log, encoding="utf-8") as f:
         return {json.loads(line)["seed"] for line in f if line.strip()}
 
 
 def summarise(log: str, first: int, scenes: int) -> dict:
     per: dict[str, collections.Counter] = collections.defaultdict(collections.Counter)
     failures = []
-    with open(log) as f:
+    with open(log, encoding="utf-8") as f:
         for line in f:
             r = json.loads(line)
             if not first <= r["seed"] < first + scenes:
@@ -94,7 +94,7 @@ def main() -> int:
     todo = [s for s in range(a.first, a.first + a.scenes) if s not in done_seeds(a.log)]
     interrupted = False
     try:
-        with open(a.log, "a") as log:
+        with open(a.log, "a", encoding="utf-8") as log:
             for seed, r in campaign.run(run_scene, todo, "stress", a.workers, a.scheduler):
                 log.write(json.dumps(dataclasses.asdict(r)) + "\n")
                 log.flush()
@@ -113,7 +113,7 @@ def main() -> int:
               f"{c['energy_limited_steps']:>14}{c['invalid_inputs_refused']:>17}{c.get('failures', 0):>10}")
     for f in summary["failures"][:20]:
         print(f"seed {f['seed']} ({f['integrator']}): {f['failure']}")
-    with open(a.out, "w") as f:
+    with open(a.out, "w", encoding="utf-8") as f:
         json.dump(summary, f, indent=1)
     return 1 if summary["failures"] else 0
 
