@@ -247,6 +247,19 @@ def run_scene(seed: int, steps: int = STEPS) -> SceneResult:
                 if "curve" not in str(exc):
                     res.failure = f"a curve constraint refused without saying why: {exc}"
                     return res
+        # Walls (a face kept behind its neighbours' planes) in a third of the scenes with nothing
+        # held or mirrored, from a stream of their own: one to three planes through the net, at any angle.
+        wall_rng = np.random.default_rng([seed, 5])
+        walls: list = []
+        if not held and not mirrored and wall_rng.random() < 0.33:
+            net = np.array(s.poles).reshape(-1, 3)
+            for _ in range(int(wall_rng.integers(1, 4))):
+                normal = wall_rng.normal(size=3)
+                normal /= np.linalg.norm(normal)
+                heights = net @ normal
+                point = normal * float(wall_rng.uniform(heights.min(), heights.max()) + 1e-3 * np.ptp(heights))
+                walls.append((point.tolist(), normal.tolist(), list(range(len(net)))))
+            s.set_walls(walls)
         energy0 = _energy(s)
         work_in = 0.0
         last_work = s.work_done
@@ -286,6 +299,12 @@ def run_scene(seed: int, steps: int = STEPS) -> SceneResult:
                              for link in links):
                 res.failure = f"a linked pole left its masters in step {k}"
                 return res
+            if walls:
+                free = np.setdiff1d(np.arange(len(flat)), [link[0] for link in links])
+                out = max(float(((flat[free] - point) @ np.asarray(normal)).max()) for point, normal, _ in walls)
+                if out > 1e-9 * max(1.0, np.abs(flat).max()):
+                    res.failure = f"a pole left its wall by {out:g} in step {k}"
+                    return res
             if mirrored and not np.array_equal(p[::-1] * [-1.0, 1.0, 1.0], p):
                 res.failure = f"the mirror symmetry broke in step {k}"
                 return res

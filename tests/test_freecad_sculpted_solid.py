@@ -303,6 +303,30 @@ class TestSculptedSolid(SolidChecks):
             self.assertLessEqual(max(r["g0_mm"] for r in hs.seam_report_of(obj)), 1e-12 * 40 * scale)
             self.assertNotEqual(obj.Shape.Volume, box.Shape.Volume)
 
+    def test_a_top_pushed_over_its_side_stays_behind_it_and_the_solid_does_not_cut_itself(self):
+        """A stroke that pushes a box's top sideways and down across its side (what a mouse drag in an
+        isometric view does): without walls the top folds over the side and the solid intersects
+        itself (BOPAlgo SelfIntersect); with them it stays behind the side's plane, a valid solid."""
+        box = self.part(Part.makeBox(40, 40, 20), "Box")
+        top = face_named(box.Shape, lambda f: abs(f.CenterOfMass.z - 20) < 1e-9)
+        unwalled = hs.sculpt_solid(self.doc, box, [top], name="Unwalled")
+        unwalled.Sculpts[0].Proxy.live.surface.set_walls([])
+        pull(unwalled, (20, 20, 20), (-40, 0, -15), seconds=2.0)
+        with self.assertRaises(Exception):
+            unwalled.Shape.check(True)
+        obj = hs.sculpt_solid(self.doc, box, [top])
+        walls = obj.Sculpts[0].Proxy.live.surface.walls
+        outward = {tuple(np.round(normal, 9)) for _, normal, _ in walls}
+        self.assertEqual(outward, {(-1, 0, 0), (1, 0, 0), (0, -1, 0), (0, 1, 0)})  # the four sides, nothing else
+        pull(obj, (20, 20, 20), (-40, 0, -15), seconds=2.0)
+        obj.Shape.check(True)  # (raises where the solid cuts itself)
+        poles = np.asarray(obj.Sculpts[0].Proxy.live.snapshot().poles).reshape(-1, 3)
+        self.assertGreaterEqual(poles[:, 0].min(), -1e-9)
+        self.assertLess(poles[:, 2].min(), 20 - 1.0)  # (it was pushed: a dent against the side)
+        self.check_sculpted(obj, box, top)
+        again = self.reopened(obj, "walls.FCStd")
+        self.assertEqual(again.Sculpts[0].Proxy.live.surface.walls, walls)
+
     def test_run_and_constraints_accept_the_solid(self):
         box = self.part(Part.makeBox(40, 30, 10))
         top = face_named(box.Shape, lambda f: abs(f.CenterOfMass.z - 10) < 1e-9)

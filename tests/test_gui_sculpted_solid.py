@@ -10,7 +10,7 @@ import os
 
 import numpy as np
 import pytest
-from freecad_support import run_freecad_gui
+from freecad_support import run_freecad_gui, run_freecadcmd
 from test_gui_real_input import NEEDS, SHOTS, Desktop, undo
 
 #: The part, made and saved by FreeCAD's GUI (a file saved by freecadcmd has no view data: FreeCAD
@@ -236,3 +236,71 @@ def test_a_top_picked_with_a_plane_is_sculpted_mirrored(tmp_path):
         d.shot("solid_mirrored_zebra")
     finally:
         d.close()
+
+
+#: A 40 x 40 x 20 box, made and saved by FreeCAD's GUI.
+BOX = """
+import json, os
+import FreeCAD, FreeCADGui, Part
+doc = FreeCAD.newDocument("Block")
+part = doc.addObject("Part::Box", "Box")
+part.Length, part.Width, part.Height = 40, 40, 20
+doc.recompute()
+doc.saveAs(PATH)
+json.dump({"volume": part.Shape.Volume}, open({answer}, "w"))
+os._exit(0)
+"""
+
+#: The saved SculptedSolid's BOP check (``check(True)`` raises where the solid cuts itself) and
+#: where its sculpted face lies.
+SELF_CHECK = """
+import FreeCAD, numpy as np
+doc = FreeCAD.openDocument(PATH)
+solid = next(o for o in doc.Objects if getattr(getattr(o, "Proxy", None), "Type", "") == "HapticSculpt::SculptedSolid")
+try:
+    solid.Shape.check(True)
+    error = ""
+except Exception as exc:
+    error = str(exc)
+mesh = np.asarray(solid.Sculpts[0].Proxy.live.snapshot().mesh).reshape(-1, 3)
+answer({"error": error, "low": mesh.min(axis=0).tolist(), "high": mesh.max(axis=0).tolist()})
+"""
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_a_mouse_drag_across_an_isometric_view_keeps_a_box_top_behind_its_sides(tmp_path):
+    """A drag across a box's top in an isometric view, towards a side: the rope follows the mouse in
+    the view's plane, and the top once bulged out through the side (a solid that cuts itself). Now
+    the top stays behind the sides' planes and FreeCAD's BOP check finds nothing. Screenshot:
+    real_solid_box_pushed.png."""
+    os.makedirs(SHOTS, exist_ok=True)
+    path = str(tmp_path / "box.FCStd")
+    part = run_freecad_gui(f"PATH = {path!r}\n" + BOX, str(tmp_path))
+    d = Desktop(str(tmp_path), "CAD", open_file=path)
+    try:
+        s = view_part(d, "Box")
+        centre = d.to_screen(s["docs"][s["active"]]["screen"]["Box"][0])  # (20, 20, 20): the top's centre
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.wait(lambda s: s["mouse_point"] is not None and abs(s["mouse_point"][2] - 20) < 0.5, "the mouse on the top")
+        d.xdo("click", "1")
+        d.wait(lambda s: [o for o, _ in s["selection"]] == ["Box"], "the top face selected")
+        d.press_button("SculptFace", lambda s: s["docs"][s["active"]]["solids"], "the SculptedSolid")
+        d.press_button("Session", lambda s: s["docs"][s["active"]]["sculpts"][0]["session"], "the session")
+        # down and right, 240 px each way: the rope follows the mouse into the top and out through the
+        # right-hand side (without walls the top bulged out through that side, and the BOP check
+        # found it cutting itself)
+        d.drag([centre] + [(centre[0] + 20 * k, centre[1] + 20 * k) for k in range(1, 13)], seconds=0.8)
+        d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
+        d.click_button("Session")
+        s = d.wait(lambda s: not s["docs"][s["active"]]["sculpts"][0]["session"], "the session to stop")
+        d.shot("solid_box_pushed")
+        pulled = solid(s)
+        assert pulled["valid"] and pulled["solids"] == 1 and not pulled["error"], pulled
+        assert abs(pulled["volume"] - part["volume"]) > 1.0, "the stroke changed the part"
+        d.xdo("key", "ctrl+s")  # (saved in place: the file was opened)
+        d.wait(lambda s: not s["docs"][s["active"]]["gui_modified"], "the document saved")
+    finally:
+        d.close()
+    check = run_freecadcmd(f"PATH = {path!r}\n" + SELF_CHECK, str(tmp_path))
+    assert check["error"] == "", check["error"]
+    assert min(check["low"][:2]) >= -1e-6 and max(check["high"][:2]) <= 40 + 1e-6, check  # behind the four sides

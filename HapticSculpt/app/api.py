@@ -119,9 +119,10 @@ def _checked_resolution(controls: Any, degree: Any, mesh: Any) -> tuple[tuple[in
 
 
 def _sculpt_state(made: Any, mesh: tuple[int, int], material: str, held: Sequence[int] = (),
-                  symmetry: dict[str, Any] | None = None, links: Sequence[Any] = ()) -> sculpt_state.SculptState:
+                  symmetry: dict[str, Any] | None = None, links: Sequence[Any] = (),
+                  walls: Sequence[Any] = ()) -> sculpt_state.SculptState:
     """The state of a new sculpt of ``made`` (a SourceSurface) sampled at ``mesh``, poles ``held``
-    and ``links`` linked, mirror ``symmetry`` (face_net.Mirror.settings()) or none."""
+    and ``links`` linked, behind ``walls`` (face_walls), mirror ``symmetry`` (face_net.Mirror.settings()) or none."""
     nu, nv = made.surface.controls
     if mesh[0] < nu or mesh[1] < nv:
         raise ValueError(f"mesh: must be at least the control resolution {(nu, nv)}, got {mesh}")
@@ -130,6 +131,8 @@ def _sculpt_state(made: Any, mesh: tuple[int, int], material: str, held: Sequenc
     surface.bending_map.set_uniform(FAIR_BENDING)
     if held or links:
         surface.hold_poles(list(held), list(links))
+    if walls:
+        surface.set_walls(list(walls))
     if symmetry is not None:
         surface.set_symmetry(symmetry["direction"], symmetry["point"], symmetry["normal"])
     return sculpt_state.capture(surface)

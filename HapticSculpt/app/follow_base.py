@@ -21,6 +21,7 @@ from . import face_in_solid, sculpt_state
 from .face_chain import FaceChain, chain_of
 from .curve_constraint import PROPERTY, records_of
 from .face_net import face_held, face_source, mirror_of, seam_links
+from .face_walls import face_walls
 from .sculpt_properties import face_of, read_state, write_state
 
 #: Grid (per direction) on which the displacement is sampled and fitted.
@@ -89,6 +90,7 @@ def follow_base(obj: Any, shape: Any) -> bool:
     held = face_held(made, edges, kinds, mirror_of(obj))
     links = seam_links(made, chain, kinds, held)
     poles = carried_poles(old_source, sculpted, new_source, held)
+    walls = face_walls(shape, list(obj.SculptFaces), edges, kinds, poles, held + [link[0] for link in links])
     mesh = tuple(old.settings["mesh"])
     carried = core.BSplineSurface(poles.reshape(*new_source.controls, 3), new_source.degree, new_source.knots_u,
                                   new_source.knots_v, new_source.weights)
@@ -103,7 +105,7 @@ def follow_base(obj: Any, shape: Any) -> bool:
                   RestLengths=rest)
     dropped = len(old.settings.get("constraints", [])) + len(records_of(sculpt))
     settings = dict(old.settings, controls=list(new_source.controls), held_poles=held, constraints=[],
-                    linked_poles=[[p, [list(m) for m in masters]] for p, masters in links],
+                    linked_poles=[[p, [list(m) for m in masters]] for p, masters in links], walls=walls,
                     reference=moved.settings["reference"])
     # (restoring validates before anything is written, and puts the linked poles onto their masters)
     state = sculpt_state.capture(sculpt_state.restore(sculpt_state.SculptState(arrays, settings)))

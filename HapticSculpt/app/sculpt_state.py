@@ -3,7 +3,7 @@
 This is what a FreeCAD document stores (float lists are saved as binary doubles, JSON floats are
 written with ``repr``), so ``restore(capture(s))`` reproduces ``s`` bit for bit: poles, velocities,
 knots, weights, sampling, rest lengths, the bending reference, material maps, constraints (with their ids), held and
-linked poles, mirror symmetry, laws, plasticity, tool and integrator settings. No FreeCAD import here.
+linked poles, walls, mirror symmetry, laws, plasticity, tool and integrator settings. No FreeCAD import here.
 """
 from __future__ import annotations
 
@@ -117,6 +117,7 @@ def capture(surface: core.DynamicSurface) -> SculptState:
         "constraints": constraints,
         "held_poles": list(surface.held_poles),
         "linked_poles": [_link_settings(link) for link in surface.linked_poles],
+        "walls": [[list(point), list(normal), list(poles)] for point, normal, poles in surface.walls],
         "symmetry": _symmetry_settings(surface),
     }
     return SculptState(arrays, settings)
@@ -231,6 +232,11 @@ def restore(state: SculptState) -> core.DynamicSurface:
         surface.hold_poles(held, links)
     except ValueError as exc:
         raise ValueError(f"SculptSettings.held_poles: {exc}") from exc
+    walls = s.get("walls", [])
+    try:
+        surface.set_walls([(list(point), list(normal), [int(p) for p in poles]) for point, normal, poles in walls])
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"SculptSettings.walls: expected [[point, normal, [pole, ...]], ...]: {exc}") from exc
     sym = s.get("symmetry")
     if sym is not None:
         if not isinstance(sym, dict) or sym.get("direction") not in (0, 1):

@@ -13,6 +13,7 @@ from . import curve_api, face_chain, face_in_solid, face_symmetry, sculpt_state
 from .api import _add_sculpt, _checked_resolution, _document, _material, _sculpt_state
 from .source_surface import SourceSurface
 from .face_net import TRIM_SPANS, Mirror, face_held, face_source, g2_net, mirror_of, seam_kinds, seam_links
+from .face_walls import face_walls
 from .sculpted_solid import (
     SculptedSolidFeature,
     attach_view_provider,
@@ -105,6 +106,9 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
     ``controls``/``degree`` are the least net per face (each face is converted exactly, then
     refined; trims inside a face get extra knots around them), ``mesh`` the mass points per face,
     ``material`` "clay" (strokes stay) or "elastic". One undo step; the base is hidden in the GUI.
+    Where a held edge meets a face that is not sculpted at a crease (a box's top and its sides),
+    the sculpt stays behind that face's plane (walls: see ``face_walls``), so a stroke toward a
+    side never folds it over the side into a solid that cuts itself.
     ``symmetry`` (one face only): None, or a mirror plane (``(point, normal)`` or a plane of the
     document) the face is symmetric in (with u or v reversed): the sculpt then stays exactly
     symmetric, a stroke acting mirrored on the other side.
@@ -145,7 +149,8 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
     asked = set(boundary) & seams if isinstance(boundary, dict) else set()
     kinds = seam_kinds(made, chain, kinds, asked)
     made, held, links = _holds(made, chain, edges, kinds, mirror, ", ".join(faces))
-    state = _sculpt_state(made, mesh, material, held, mirror.settings() if mirror else None, links)
+    walls = face_walls(shape, faces, edges, kinds, made.surface.poles, held + [link[0] for link in links])
+    state = _sculpt_state(made, mesh, material, held, mirror.settings() if mirror else None, links, walls)
     if doc.UndoMode == 0:
         doc.UndoMode = 1
     with transaction(doc, "Sculpt solid"):
@@ -165,10 +170,10 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
     return obj
 
 
-def _boundary_plan(obj: Any, boundary: Any) -> tuple[dict[str, str], Any, list[int], list[Any]]:
+def _boundary_plan(obj: Any, boundary: Any) -> tuple[dict[str, str], Any, list[int], list[Any], list[Any]]:
     """What :func:`set_boundary` would hold: every edge's kind, the net (its G2 seams made
-    curvature-continuous), the held poles and the seams' links (ValueError where it cannot hold,
-    saying why)."""
+    curvature-continuous), the held poles, the seams' links and the walls (ValueError where it
+    cannot hold, saying why)."""
     if not is_sculpted_solid(obj):
         raise TypeError(f"obj: expected a HapticSculpt SculptedSolid, got {getattr(obj, 'TypeId', type(obj).__name__)}")
     shape = base_solid(obj.Base)
@@ -182,7 +187,8 @@ def _boundary_plan(obj: Any, boundary: Any) -> tuple[dict[str, str], Any, list[i
     if isinstance(boundary, str):  # (a seam is as tangent as its faces let it be)
         kinds = seam_kinds(made, chain, kinds, set())
     made, held, links = _holds(made, chain, edges, kinds, mirror_of(obj), ", ".join(faces))
-    return kinds, made, held, links
+    walls = face_walls(shape, faces, edges, kinds, made.surface.poles, held + [link[0] for link in links])
+    return kinds, made, held, links, walls
 
 
 def can_hold(obj: Any, boundary: Any) -> bool:
@@ -198,7 +204,7 @@ def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
     """Changes how a SculptedSolid's edges are held (``boundary`` as in :func:`sculpt_solid`: one
     kind for all, or a dict from edge name to kind, the others kept). One undo step (not during a
     session: RuntimeError); returns the kind of every edge."""
-    kinds, made, held, links = _boundary_plan(obj, boundary)
+    kinds, made, held, links, walls = _boundary_plan(obj, boundary)
     sculpt = sculpt_of(obj)
     live = sculpt.Proxy.live
     if live.session is not None:
@@ -211,6 +217,7 @@ def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
     with transaction(obj.Document, "Hold edges"):
         surface.set_poles(poles.reshape(shape))
         surface.hold_poles(held, links)
+        surface.set_walls(walls)
         live.write(sculpt_state.capture(surface))
         write_curves()
         obj.Boundary = json.dumps(kinds)

@@ -124,6 +124,28 @@ void bindSolvers(py::module_& m) {
                 out.append(py::make_tuple(l.pole, l.masters, py::make_tuple(l.offset.x(), l.offset.y(), l.offset.z())));
             return out;
         }, "The linked poles: [(pole, [(master, weight), ...], (ox, oy, oz)), ...]")
+        .def("set_walls", [](DynamicSurface& s, const py::list& walls) {
+            std::vector<PoleWall> made;
+            made.reserve(walls.size());
+            for (const py::handle item : walls) {
+                const auto parts = item.cast<py::sequence>();
+                if (parts.size() != 3) throw py::value_error("walls: each wall is (point, normal, [pole, ...])");
+                made.push_back({vec3(parts[0].cast<std::vector<double>>(), "wall point"),
+                                vec3(parts[1].cast<std::vector<double>>(), "wall normal"), parts[2].cast<std::vector<int>>()});
+            }
+            s.setWalls(made);
+        }, py::arg("walls"),
+             "Walls: each (point, normal, [pole, ...]) is a plane the listed poles (index i*nv + j) stay behind "
+             "(on the side the normal faces away from); a step that carries a free pole out puts it back onto "
+             "the plane. A face sculpted in place stays behind the planes of the faces it meets at creases. "
+             "Replaces them all; [] removes them.")
+        .def_property_readonly("walls", [](const DynamicSurface& s) {
+            py::list out;
+            for (const PoleWall& w : s.walls())
+                out.append(py::make_tuple(py::make_tuple(w.point.x(), w.point.y(), w.point.z()),
+                                          py::make_tuple(w.normal.x(), w.normal.y(), w.normal.z()), w.poles));
+            return out;
+        }, "The walls: [((px, py, pz), (nx, ny, nz), [pole, ...]), ...], normals unit.")
         .def("set_symmetry", [](DynamicSurface& s, int direction, const std::vector<double>& point, const std::vector<double>& normal) {
             s.setSymmetry(direction, vec3(point, "symmetry point"), vec3(normal, "symmetry normal"));
         }, py::arg("direction"), py::arg("point"), py::arg("normal"),

@@ -28,6 +28,11 @@ public:
 
     /// Something outside a step changed the energy: the next guarded step starts a new ceiling.
     void reset() { valid_ = false; }
+    /// Something outside a step took energy out (`energy` is what is left): the ceiling comes down
+    /// to it, never up (a reset would let each such event raise it by the slack).
+    void lower(double energy) {
+        if (valid_) ceiling_ = std::min(ceiling_, energy);
+    }
     /// Before a step: starts the ceiling at `energy()` if there is none (only called when guarding).
     template <class Energy>
     void begin(Energy&& energy) {

@@ -124,6 +124,22 @@ void DynamicSurface::setSymmetry(int direction, const Vec3& point, const Vec3& n
     wake();
 }
 
+bool DynamicSurface::snapToConstraints() {
+    const bool mirrored = !mirror_.empty() && mirror_.project(state_.mutablePoles(), state_.v);
+    return (!held_.empty() && held_.snap(state_.mutablePoles(), state_.v)) || mirrored;
+}
+
+void DynamicSurface::setWalls(const std::vector<PoleWall>& walls) {
+    walls_.set(walls, state_.poles().rows());
+    if (walls_.project(state_.mutablePoles(), state_.v, [this](int p) { return held_.constrained(p); })) {
+        snapToConstraints();
+        state_.sampleMesh();
+    }
+    state_.avValid = false;
+    localGlobal_.restart();
+    wake();
+}
+
 void DynamicSurface::setVelocities(const Points& v) {
     if (v.rows() != state_.v.rows()) throw std::invalid_argument("velocities: wrong number of rows");
     if (!v.allFinite()) throw std::invalid_argument("velocities: contain NaN or Inf");
@@ -197,7 +213,7 @@ void DynamicSurface::setCursor(const Cursor& c) {
         if (material_.springs.plasticity.enabled) {
             material_.springs.resetRest(state_.d);
             material_.bending.follow(state_.d, 1.0);
-            guard_.reset();  // (the potential energy just dropped: a new ceiling)
+            guard_.lower(kineticEnergy() + potentialEnergy());  // (the potential energy just dropped)
         }
         localGlobal_.restart();
         touch();
@@ -256,11 +272,18 @@ StepReport DynamicSurface::step(double dt) {
         r.reason = "the step would produce NaN or Inf; state kept (reduce dt or stiffness)";
         return r;
     }
-    // Symmetry first: the held set is symmetric, so snapping the held poles back keeps it.
-    const bool mirrored = !mirror_.empty() && mirror_.project(state_.mutablePoles(), state_.v);
-    if ((!held_.empty() && held_.snap(state_.mutablePoles(), state_.v)) || mirrored) {
+    // Walls, then symmetry (symmetric walls keep a symmetric net behind them), then the held set
+    // (symmetric, so snapping the held poles back keeps the symmetry).
+    const bool walled = !walls_.empty() &&
+                        walls_.project(state_.mutablePoles(), state_.v, [this](int p) { return held_.constrained(p); });
+    if (snapToConstraints() || walled) {
         state_.sampleMesh();
         state_.avValid = false;
+    }
+    if (walled) {
+        localGlobal_.restart();        // (BDF2's history would carry the pole back out)
+        verlet_.clearStepPotential();  // (Verlet's potential and forces were the net's before the
+        verlet_.invalidate();          // wall moved it)
     }
     // The work of the applied forces over the step (forces held over the step).
     const double work = tracksWork ? forces_.appliedWork(state_.d, state_.meshAtStart) : 0.0;
@@ -303,6 +326,9 @@ bool DynamicSurface::guardsEnergy(double dt, bool verlet) const {
     // The symmetry's projection is not energy-neutral where something is not symmetric (a penalty
     // constraint on one side, a painted map): the guard takes out what it would put in.
     if (!mirror_.empty()) return true;
+    // Walls put a pole back against the springs that carried it out: the guard takes out what
+    // they would put in (as it is for a real wall, whose reaction does no work).
+    if (!walls_.empty()) return true;
     // Point, tangent and normal constraints project onto convex sets, so they keep the guarantee.
     if (solver_.kind != IntegratorKind::LocalGlobal || material_.springs.law.kind != LawKind::Linear ||
         constraints().anyNonConvex())

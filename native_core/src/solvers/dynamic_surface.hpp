@@ -13,6 +13,7 @@
 #include "dynamics/held_poles.hpp"
 #include "dynamics/material.hpp"
 #include "dynamics/mirror_symmetry.hpp"
+#include "dynamics/pole_walls.hpp"
 #include "dynamics/sleep_monitor.hpp"
 #include "dynamics/surface_state.hpp"
 #include "solvers/integrator_explicit.hpp"
@@ -71,6 +72,11 @@ public:
     /// net exactly symmetric; direction -1 removes it.
     void setSymmetry(int direction, const Vec3& point, const Vec3& normal);
     const MirrorSymmetry& symmetry() const { return mirror_; }
+    /// Walls (pole_walls.hpp): half-spaces the listed poles stay in; a step that carries a free
+    /// pole out puts it back onto the wall. Replaces them all (empty: none); throws
+    /// std::invalid_argument naming "walls". Poles outside their walls now are put back at once.
+    void setWalls(const std::vector<PoleWall>& walls);
+    const std::vector<PoleWall>& walls() const { return walls_.walls(); }
     /// Mesh index nearest to parameter (u, v), and the parameters of a mesh index.
     int meshIndexAt(double u, double v) const;
     std::pair<double, double> meshParameters(int index) const;
@@ -197,6 +203,8 @@ private:
     StepModel model() {
         return {state_, material_, forces_, held_, mirror_, systems_, scratch_, solver_};
     }
+    /// Puts the poles exactly symmetric and the held and linked ones back; whether any moved.
+    bool snapToConstraints();
     bool guardsEnergy(double dt, bool verlet) const;
     /// Back to the state step() started from (refused steps); velocities kept or zeroed.
     void restoreStepStart(bool keepVelocity);
@@ -211,6 +219,7 @@ private:
     SurfaceForces forces_;
     HeldPoles held_;
     MirrorSymmetry mirror_;
+    PoleWalls walls_;
     SolverSettings solver_;
     SystemCache systems_;
     Scratch scratch_;
