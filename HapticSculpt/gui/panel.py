@@ -34,7 +34,7 @@ def tool_sliders(tool: str) -> list[tuple[str, str, float, float]]:
     out = []
     for name, p in core.TOOL_INFO[tool]["parameters"].items():
         default = p["default"] if p["default"] > 0 else 1.0
-        out.append((f"tool.{tool}.{name}", f"{tool} {name.replace('_', ' ')}", default / TOOL_RANGE,
+        out.append((f"tool.{tool}.{name}", f"{tool} {p['label']}", default / TOOL_RANGE,
                     default * TOOL_RANGE))
     return out
 

@@ -24,11 +24,12 @@ py::dict parameterDict(const ParameterInfo& p) {
     py::dict d;
     d["default"] = p.value;
     d["allow_zero"] = p.allowZero;
+    d["label"] = *p.label ? p.label : p.name;
     d["doc"] = p.doc;
     return d;
 }
 
-/// TOOL_INFO[name]: title, tip, order, falloff (bool), parameters {name: {default, allow_zero, doc}}, readouts {name: doc}.
+/// TOOL_INFO[name]: title, tip, order, falloff (bool), parameters {name: {default, allow_zero, doc, label}}, readouts {name: doc}.
 py::dict toolInfo() {
     py::dict all;
     for (const std::string& name : toolNames()) {

@@ -51,6 +51,7 @@ struct ParameterInfo {
     double value = 0;  ///< the default
     bool allowZero = false;
     const char* doc = "";
+    const char* label = "";  ///< a slider's few words, with the unit (the name where empty)
 };
 
 /// A value a tool reports about its grab (read-only).

@@ -21,8 +21,8 @@ constexpr ToolInfo kInfo{"flatten", "Flatten",
                          "Flatten: presses the surface within its radius flat, toward its tangent plane where "
                          "it grabs, at its mean height there",
                          4, true,
-                         {{{"radius", 10.0, false, "radius of the region pressed flat"},
-                           {"stiffness", 10.0, false, "spring stiffness per point toward the plane"}}},
+                         {{{"radius", 10.0, false, "radius of the region pressed flat", "radius (mm)"},
+                           {"stiffness", 10.0, false, "spring stiffness per point toward the plane", "stiffness"}}},
                          {{{"selected", "how many mass points the grab presses"}}}};
 
 /// The mesh's unit normal at point `k` (central differences along the net; one-sided at its edges).

@@ -10,7 +10,7 @@ namespace {
 enum { Stiffness };
 constexpr ToolInfo kInfo{"orientation", "Orientation",
                          "Orientation: five springs turn the surface's u and v directions toward the cursor frame", 2, false,
-                         {{{"stiffness", 10.0, false, "stiffness of the five springs"}}}};
+                         {{{"stiffness", 10.0, false, "stiffness of the five springs", "stiffness"}}}};
 
 // The five springs: offsets in the net, the cursor axis they follow (0 none, 1 x, 2 y) and its sign.
 constexpr int kDi[5] = {0, 1, -1, 0, 0}, kDj[5] = {0, 0, 0, 1, -1}, kAxis[5] = {0, 1, 1, 2, 2};

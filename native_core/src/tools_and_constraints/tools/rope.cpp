@@ -14,10 +14,10 @@ enum { Stiffness, StiffStiffness, Threshold, ReelTime };
 enum { RestLength, Gain };
 constexpr ToolInfo kInfo{"rope", "Rope", "Rope: grabs the nearest mass point; pulls, cannot push; reels in over 1 s",
                          0, false,
-                         {{{"stiffness", 10.0, false, "force per length below the threshold"},
-                           {"stiff_stiffness", 200.0, false, "force per length past the threshold"},
-                           {"threshold", 5.0, true, "extension beyond rest length where the rope turns stiff"},
-                           {"reel_time", 1.0, true, "seconds for the rest length to reel in to zero"}}},
+                         {{{"stiffness", 10.0, false, "force per length below the threshold", "stiffness"},
+                           {"stiff_stiffness", 200.0, false, "force per length past the threshold", "taut stiffness"},
+                           {"threshold", 5.0, true, "extension beyond rest length where the rope turns stiff", "slack (mm)"},
+                           {"reel_time", 1.0, true, "seconds for the rest length to reel in to zero", "reel time (s)"}}},
                          {{{"rest_length", "the rope's rest length now"},
                            {"gain", "its pull over its settings where it is tied: 1 + ROPE_PLATE_GAIN x the bending ratio there"}}}};
 

@@ -11,8 +11,8 @@ namespace {
 enum { Radius, Strength };
 constexpr ToolInfo kInfo{"smooth", "Smooth", "Smooth: a fairing brush toward lower curvature variation under the cursor",
                          3, true,
-                         {{{"radius", 10.0, false, "brush radius"},
-                           {"strength", 1.0, false, "fairing force per unit of U^3 x"}}}};
+                         {{{"radius", 10.0, false, "brush radius", "radius (mm)"},
+                           {"strength", 1.0, false, "fairing force per unit of U^3 x", "strength"}}}};
 
 // Umbrella operator: mean of the 4-neighbours minus the point.
 void umbrella(const Points& x, int g, int h, Points& out) {
