@@ -6,7 +6,7 @@ JOBS        ?= 2
 APT_PACKAGES := build-essential cmake ninja-build pkg-config libeigen3-dev pybind11-dev libgtest-dev \
                 python3-dev python3-numpy python3-scipy python3-pytest python3-hypothesis python3-matplotlib \
                 python3-venv python3-distributed freecad-python3 freecad libhidapi-dev libusb-1.0-0 libwebsockets-dev libsimdjson-dev python3-websockets xvfb xauth xdotool imagemagick debootstrap \
-                ccache
+                ccache dbus-daemon python3-dbus python3-gi
 SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan

@@ -123,6 +123,7 @@ def run_scene(controls, mesh, sim_dt, seconds, rate, load="none", **settings):
         "haptic_period_p99_ms": status["haptic_period_p99_ms"],
         "haptic_period_max_ms": status["haptic_period_max_ms"],
         "realtime_priority": status["realtime_priority"],
+        "realtime_how": status["realtime_how"],
         "latency_p50_ms": status["latency_p50_ms"],
         "latency_p99_ms": status["latency_p99_ms"],
         "sim_hz": status["sim_hz"],

@@ -1,6 +1,6 @@
 """A force device in FreeCAD's GUI, as a designer with a Novint Falcon meets it: a new patch, the
 Session button clicked with real X events, and the session takes the Falcon (the first attached
-force device) instead of the mouse: it homes, the grip's stroke pulls the surface (one undo step,
+force device) instead of the mouse, and its status line says the haptic loop runs real-time: it homes, the grip's stroke pulls the surface (one undo step,
 shown at once), Undo puts it back while the session runs on. The Falcon is the emulated one behind the fake libusb built with
 the C++ tests, loaded through the workbench's own run-time loading (HAPTICSCULPT_LIBUSB); the hand
 on its grip follows a script (HS_FAKE_FALCON_SCRIPT). Screenshot: build/screenshots/falcon_stroke.png."""
@@ -36,6 +36,8 @@ def test_the_session_takes_the_falcon_and_its_stroke_is_one_undo_step(tmp_path, 
         before = undo(d.state())[0]
         s = d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
         assert sculpt(s)["device"] == "falcon", "the session did not take the attached Falcon"
+        # the HUD's status line says how the haptic loop runs (the test runs as root: SCHED_FIFO directly)
+        d.wait(lambda s: any("real-time (root)" in o["status_text"] for o in s["overlays"]), "the loop's priority shown")
         s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the Falcon's stroke as an undo step", 40)
         lifted = np.array(sculpt(s)["poles"]).reshape(-1, 3)[:, 2].max()
         assert lifted > 5.0, f"the grip's stroke did not pull the surface ({lifted} mm)"

@@ -63,6 +63,7 @@ class Overlay:
         self.mode = ""  # what the workbench is doing besides (the airbrush), shown in the HUD
         self.stripe_mode = "reflection"  # zebra: "reflection" (view-dependent) or "isophote" (world-fixed)
         self.stripes = 12.0  # zebra: bands over a half turn
+        self.status_text = ""  # the HUD's status line, as last drawn
         self.stripe_direction = (0.0, 0.0, 1.0)  # isophote: the direction the bands' angle is taken to
         self.stripe_angle = 0.0  # reflection: the light strips' angle from the view's up direction (degrees)
         self.per_pixel = True  # zebra per pixel where the driver runs GLSL (False: per mesh vertex)
@@ -239,7 +240,8 @@ class Overlay:
             self.frames += 1
             return
         sliders = self.panel.values(self.obj) if self.panel_visible else []
-        self.hud.update(legend, sliders, self._status(s), zebra_bands=int(self.stripes))
+        self.status_text = self._status(s)
+        self.hud.update(legend, sliders, self.status_text, zebra_bands=int(self.stripes))
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
 
@@ -355,6 +357,8 @@ class Overlay:
         session = self._session()
         if session is not None:
             parts.append(f"sculpting with the {session.device_name or 'mouse'}")
+            if session.device_name not in ("", "mouse") and session.priority:
+                parts.append(session.priority)
         if self.display == "zebra":
             turn = (f"stripes at {self.stripe_angle:g} deg" if self.stripe_mode == "reflection"
                     else "to ({:.2g}, {:.2g}, {:.2g})".format(*self.stripe_direction))

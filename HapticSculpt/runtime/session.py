@@ -71,6 +71,7 @@ class Session:
         self._obj: Any = None
         self._device: Any = None
         self._error = ""
+        self._priority_said = False
         self._timer: Any = None
         self._frame_base: Any = None  # knots, weights, degrees for GUI frames (they do not change)
         self._previewed = False  # a held stroke's frames previewed on the objects built from the sculpt
@@ -102,7 +103,9 @@ class Session:
         ``record_seconds`` > 0 logs every haptic tick (for :meth:`recording` and benchmarks).
         ``realtime`` asks for real-time priority (SCHED_FIFO) for the haptic thread, which holds its
         1 ms period while other programs load the machine; Linux grants it to root or within an
-        rtprio limit (README), else the thread runs as before (``status()["realtime_priority"]``)."""
+        rtprio limit (README), else the thread asks RealtimeKit (rtkit-daemon, on the system bus, as
+        audio applications do), else it runs as before: ``status()["realtime_priority"]``, and
+        ``status()["realtime_how"]`` says which way it got it, or why it got none."""
         if self._runtime is not None:
             raise RuntimeError("session: already started; stop it first")
         if not is_sculpt(obj):
@@ -127,6 +130,7 @@ class Session:
                                       stop_when_finished=stop_when_finished, realtime=realtime)
         live.attach(self)  # from here on the runtime steps the surface, starting at rest
         self._runtime, self._obj, self._device, self._error = runtime, obj, native, ""
+        self._priority_said = False
         self._latest_poles, self._latest_maps, self._edits, self.applied_edits = None, {}, {}, []
         self._previewed = False
         self._committed = False  # a stroke, spray or edit this run (else its end commits nothing)
@@ -144,6 +148,30 @@ class Session:
     def device_name(self) -> str:
         """The name of the device this session runs with ("" when it is not running)."""
         return self._device.name if self._device is not None and self._runtime is not None else ""
+
+    @property
+    def priority(self) -> str:
+        """How the haptic thread runs, in a few words for a status line: "real-time (RealtimeKit)",
+        "real-time (rtprio limit)", "real-time (root)", "no real-time priority" or "off"; "" until
+        the thread has said (``status()["realtime_how"]`` has the whole of it, and why not)."""
+        how = self.status().get("realtime_how", "") if self._runtime is not None else ""
+        if how.startswith("SCHED_FIFO"):
+            return "real-time (RealtimeKit)" if how.endswith("RealtimeKit") else f"real-time {how.split(' ', 2)[2]}"
+        return "no real-time priority" if how.startswith("none") else how
+
+    def _say_priority(self, runtime: Any) -> None:
+        """Once a session with a device that renders or reads at 1 kHz (not the mouse) knows its
+        priority, says it in the report view; without one, why, and what grants it."""
+        how = runtime.status().get("realtime_how", "")
+        if self._priority_said or not how or self._device is None or self._device.name == "mouse":
+            return
+        self._priority_said = True
+        import FreeCAD
+        if how.startswith("none"):
+            FreeCAD.Console.PrintWarning(f"HapticSculpt: the haptic loop has no real-time priority ({how[6:]}); "
+                                         "install rtkit (Debian: rtkit) or run sudo make install-realtime\n")
+        else:
+            FreeCAD.Console.PrintMessage(f"HapticSculpt: haptic loop at {how}\n")
 
     def stop(self, commit: bool = True) -> dict[str, Any]:
         """Zeroes the force, joins the threads, commits the remaining strokes (unless ``commit`` is
@@ -260,6 +288,8 @@ class Session:
             self.stop(commit=False)
             return 0
         n = self._commit_strokes(runtime, obj)
+        if _gui_up():
+            self._say_priority(runtime)
         if not runtime.running:
             self.stop()
         return n

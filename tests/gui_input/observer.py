@@ -376,6 +376,7 @@ def write(*_):
         state["mouse_point"] = None if ctl.mouse_point is None else [float(x) for x in ctl.mouse_point]
         state["overlays"] = [{"display": ov.display, "frames": ov.frames, "view_size": list(ov.view.getSize()),
                               "hud": ov.hud.boxes() if ov.hud is not None else {},
+                              "status_text": getattr(ov, "status_text", ""),
                               "sliders": ov.panel.values(ov.obj) if ov.panel_visible else [],
                               "stripes": ov.stripes, "active_view": ov.view is getattr(Gui.ActiveDocument, "ActiveView", None),
                               "view": id(ov.view), "object": ov.obj.Name, "cursor": ov.cursor_shown,

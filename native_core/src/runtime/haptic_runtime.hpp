@@ -56,6 +56,9 @@ struct RuntimeStatus {
     Vec3 force = Vec3::Zero();      ///< last rendered force
     double estimateAge = 0;         ///< s: age of the snapshot the last tick used
     bool realtimePriority = false;
+    /// How the haptic thread got real-time priority ("SCHED_FIFO 49 (rtprio limit)", "SCHED_FIFO 20
+    /// from RealtimeKit"), or why it got none ("none: ..."); "off" when not asked; "" until known.
+    std::string realtimeHow;
     std::string error;              ///< why the session stopped by itself ("" if it did not)
     // for the GUI overlay: the last finite cursor and the tool's contact point (rope: the grabbed
     // mesh point), as the haptic loop last saw them
@@ -192,6 +195,9 @@ public:
 
 private:
     void hapticLoop();
+    /// SCHED_FIFO for the calling (haptic) thread: directly where the rtprio limit allows, else from
+    /// RealtimeKit; says how, or why not (status().realtimeHow).
+    void takeRealtimePriority();
     void simLoop();
     double now() const;
     void fail(const char* message);
@@ -253,6 +259,8 @@ private:
     std::atomic<double> force_[3] = {0.0, 0.0, 0.0};
     std::atomic<double> stoppedAt_{0};
     std::atomic<bool> realtimeOk_{false}, failed_{false}, simIdle_{false};
+    std::string realtimeHow_;                 // written once by the haptic thread, then realtimeKnown_
+    std::atomic<bool> realtimeKnown_{false};
     std::array<char, 256> error_{};
 
     std::vector<HapticTick> ticks_;
