@@ -17,6 +17,8 @@ class HapticSculptWorkbench(Gui.Workbench):
         import FreeCAD
         package = os.path.dirname(importlib.util.find_spec("HapticSculpt").origin)
         self.__class__.Icon = os.path.join(package, "resources", "icons", "HapticSculpt.svg")
+        # Edit > Preferences > HapticSculpt (a Designer file: FreeCAD builds its widgets; no Qt here)
+        Gui.addPreferencePage(os.path.join(package, "resources", "ui", "preferences.ui"), "HapticSculpt")
         try:
             import HapticSculpt.gui  # noqa: F401  (its hooks: view providers, frame clock, stroke echo)
         except ImportError as exc:  # no native core: say what to do; the workbench stays listed

@@ -94,6 +94,31 @@ def test_pick_prefers_a_force_device(fakes):
     assert isinstance(devices.pick(libraries=LIBS), _core.DhdDevice)
 
 
+def test_a_session_runs_at_the_devices_fastest_rate_from_the_limits_table(fakes):
+    """A Falcon and a Touch: 1 kHz; a Force Dimension device (DHD names its model only once
+    opened: its rows' fastest, 4 kHz); a user's limit lowers it, never below 100 Hz; the
+    passivity bound the device takes is the one at that rate."""
+    dev, rate = devices.pick_with_rate(libraries=LIBS)
+    assert isinstance(dev, _core.FalconDevice) and rate == 1000.0
+    usb, hd, _ = fakes
+    usb.fake_usb_devices(0)
+    dev, rate = devices.pick_with_rate(libraries=LIBS)
+    assert isinstance(dev, _core.OpenHapticsDevice) and rate == 1000.0
+    hd.fake_hd_present(0)
+    dev, rate = devices.pick_with_rate(libraries=LIBS)
+    assert isinstance(dev, _core.DhdDevice) and rate == 4000.0
+    assert dev.capabilities["max_stiffness"] > 3.9 * devices.pick_with_rate(libraries=LIBS, max_rate=1000)[0] \
+        .capabilities["max_stiffness"]  # (K <= 2 b / T: four times the rate, four times as stiff)
+    assert devices.pick_with_rate(libraries=LIBS, max_rate=2000)[1] == 2000.0
+    assert devices.pick_with_rate(libraries=LIBS, max_rate=20)[1] == 100.0
+    assert devices.pick_with_rate(libraries=LIBS, rate=3000)[1] == 3000.0  # (a rate given is the rate)
+    assert devices.fastest_rate("omega.3") == 4000.0 and devices.fastest_rate("Touch X") == 1000.0
+    assert devices.fastest_rate("a device nobody knows") == 1000.0
+    for bad in (-1.0, float("nan")):
+        with pytest.raises(ValueError, match="max_rate"):
+            devices.pick_with_rate(libraries=LIBS, max_rate=bad)
+
+
 def test_the_haply_service_is_listed_and_picked_first(fakes):
     with MockInverseService(devices=("049D", "04BA")) as service:
         libraries = dict(LIBS, haply=service.address)

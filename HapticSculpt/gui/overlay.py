@@ -357,8 +357,8 @@ class Overlay:
         session = self._session()
         if session is not None:
             parts.append(f"sculpting with the {session.device_name or 'mouse'}")
-            if session.device_name not in ("", "mouse") and session.priority:
-                parts.append(session.priority)
+            if session.device_name not in ("", "mouse") and session.rate_and_priority:
+                parts.append(session.rate_and_priority)
         if self.display == "zebra":
             turn = (f"stripes at {self.stripe_angle:g} deg" if self.stripe_mode == "reflection"
                     else "to ({:.2g}, {:.2g}, {:.2g})".format(*self.stripe_direction))

@@ -41,6 +41,8 @@ AIRBRUSH_RADIUS = 0.08  # map coordinates (the unit square)
 AIRBRUSH_STRENGTH = 0.25  # per dab, at its centre
 ECHO_MAX = 200  # an echoed call longer than this goes into the StrokeLog (a person reads the console)
 VIEW_SCAN_SECONDS = 0.25  # how often new and closed 3D views are looked for
+#: Where the workbench's preferences live (Edit > Preferences > HapticSculpt: resources/preferences.ui).
+PREFERENCES = "User parameter:BaseApp/Preferences/Mod/HapticSculpt"
 #: Shown in the status bar when the workbench is chosen (the workbench selector keeps the keys).
 HELLO = ("HapticSculpt: click in the 3D view, then P / N / C toggle point, normal, curvature constraints at the "
          "mouse, M shows the material map; Start/stop sculpting grabs with the left button\n")
@@ -453,31 +455,34 @@ class Controller:
         obj = self.active_sculpt()
         if obj is None:
             raise RuntimeError("select the sculpt to sculpt (or create a patch first)")
+        rate = None  # (the core's default)
         if device is None:
-            device = self._attached_device(obj, devices)
+            device, rate = self._attached_device(obj, devices)
         if device is None:
             device = MouseDevice(yields=self.panel_at)
             device.attach_all([i.view for i in self.inputs] or [self.view()])
         self.mouse = device if isinstance(device, MouseDevice) else None
         session = Session()
         session.set_airbrush(self.painting, factor=AIRBRUSH_FACTOR)  # before the first tick can grab
-        self.session = session.start(obj, device, tool=obj.Proxy.live.snapshot().tool.name)
+        self.session = session.start(obj, device, tool=obj.Proxy.live.snapshot().tool.name, haptic_rate=rate)
         self._follow(self.view())
         return self.session
 
     @staticmethod
-    def _attached_device(obj: Any, devices: Any) -> Any | None:
+    def _attached_device(obj: Any, devices: Any) -> tuple[Any | None, float | None]:
         """A force device centred on the sculpt, its ~100 mm workspace scaled to the sculpt's size,
-        else a SpaceMouse; None when there is neither, or the one there fails to open (said in the
-        report view: the mouse takes over)."""
+        at its fastest rate from the limits table (4 kHz for a Force Dimension device) or the
+        preference's limit, else a SpaceMouse; None when there is neither, or the one there fails
+        to open (said in the report view: the mouse takes over). With the session's haptic rate."""
+        import FreeCAD
         box = obj.Shape.BoundBox
         centre = (box.Center.x, box.Center.y, box.Center.z)
+        limit = FreeCAD.ParamGet(PREFERENCES).GetFloat("MaxHapticRate", 0.0)
         try:
-            return devices.pick(origin=centre, scale=max(1.0, box.DiagonalLength / 100.0))
+            return devices.pick_with_rate(origin=centre, scale=max(1.0, box.DiagonalLength / 100.0), max_rate=limit)
         except (RuntimeError, ValueError) as e:
-            import FreeCAD
             FreeCAD.Console.PrintWarning(f"HapticSculpt: {e}; sculpting with the mouse\n")
-            return None
+            return None, None
 
     def stop_session(self) -> None:
         if self.session is not None:

@@ -170,7 +170,8 @@ def dhd(origin: Sequence[float] = (0.0, 0.0, 0.0), scale: float = 1.0, force_sca
 
 def list(firmware: str | None = None, libraries: dict[str, Any] | None = None) -> builtins.list[dict[str, Any]]:
     """What is attached, force devices first, each a dict with ``kind`` ("haply", "falcon",
-    "openhaptics", "dhd", "spacemouse", "hid"), ``name``, ``force`` (renders force), ``usable`` and, when it is not,
+    "openhaptics", "dhd", "spacemouse", "hid"), ``name``, ``model`` (its row in the limits table, "" if
+    unknown), ``force`` (renders force), ``usable`` and, when it is not,
     ``why`` (no permission, the Falcon's firmware file missing, the vendor's library missing, in
     use). ``libraries`` maps a kind to the library to load instead of the system's, and "haply" to
     the Inverse Service's "host:port"."""
@@ -185,7 +186,7 @@ def list(firmware: str | None = None, libraries: dict[str, Any] | None = None) -
         why = ("in use by another program" if d["in_use"] else
                "" if d["ready"] else "not ready (powered? see the Haply Hub)")
         out.append({"kind": "haply", "name": f"Haply Inverse3 {d['device_id']}", "device_id": d["device_id"],
-                    "force": True, "usable": not why, "why": why})
+                    "model": "Haply Inverse3", "force": True, "usable": not why, "why": why})
     try:
         falcons = _core.usb_falcons(library=_library(libraries.get("falcon"), "falcon"))
     except RuntimeError as e:  # no libusb: Falcons can only be seen through sysfs
@@ -204,22 +205,23 @@ def list(firmware: str | None = None, libraries: dict[str, Any] | None = None) -
                     why = (f"its firmware is not loaded (it must be, after each power-up): set ${FALCON_FIRMWARE_ENV} "
                            "to Novint's firmware file (see the README)")
         out.append({"kind": "falcon", "name": f"Novint Falcon (USB {f['bus']}:{f['address']})", "index": k,
-                    "force": True, "usable": not why, "why": why})
+                    "model": "Novint Falcon", "force": True, "usable": not why, "why": why})
     vendors = _usb_vendors()
     for kind, probe, name in (("openhaptics", _core.openhaptics_probe, "3D Systems Touch/Phantom (OpenHaptics)"),
                               ("dhd", _core.dhd_probe, "Force Dimension (DHD)")):
         p = probe(library=_library(libraries.get(kind), kind))
         if p["loaded"]:
             if p["attached"] > 0:
-                out.append({"kind": kind, "name": p["model"] or name, "force": True, "usable": True, "why": ""})
+                out.append({"kind": kind, "name": p["model"] or name, "model": p["model"], "force": True, "usable": True,
+                            "why": ""})
             elif _VENDOR_USB_IDS[kind] in vendors:
-                out.append({"kind": kind, "name": name, "force": True, "usable": False, "why": p["why"]})
+                out.append({"kind": kind, "name": name, "model": "", "force": True, "usable": False, "why": p["why"]})
         elif _VENDOR_USB_IDS[kind] in vendors:  # its device is there, its library is not
-            out.append({"kind": kind, "name": name, "force": True, "usable": False,
+            out.append({"kind": kind, "name": name, "model": "", "force": True, "usable": False,
                         "why": f"the vendor's library is not installed: {p['why']}"})
     for d in list_devices():
         access = not os.path.exists(d["path"]) or os.access(d["path"], os.R_OK | os.W_OK)  # (hidraw: a node)
-        out.append({"kind": d["kind"], "name": d["spacemouse"] or d["name"], "path": d["path"], "force": False,
+        out.append({"kind": d["kind"], "name": d["spacemouse"] or d["name"], "path": d["path"], "model": "", "force": False,
                     "usable": access,
                     "why": "" if access else "no permission to open it: install the udev rules (sudo make install-udev)"
                     })
@@ -237,26 +239,61 @@ def _sysfs_has(vendor: str, product: str) -> builtins.list[bool]:
     return hits
 
 
+#: The limits table's rows of each kind of force device (DHD names its model only once opened).
+KIND_MODELS = {"dhd": ("omega", "delta", "sigma", "lambda"), "openhaptics": ("Touch", "Phantom"),
+               "falcon": ("Novint Falcon",)}
+
+
+def fastest_rate(model: str, kind: str = "") -> float:
+    """The fastest servo rate (Hz) the limits table gives the device ``model`` (a row whose model
+    is a case-insensitive prefix of it: "omega.3" 4 kHz, a Falcon 1 kHz); for a model not named or
+    not in the table, the slowest of the fastest rates of its ``kind``'s rows (every Force Dimension row: 4 kHz); else
+    the haptic loop's default (a device the table does not know is not driven faster than tested)."""
+    rows = limits()
+    for row in rows:
+        if model and model.lower().startswith(row["model"].lower()):
+            return float(row["rates"][1])
+    family = [float(r["rates"][1]) for r in rows
+              if r["model"].lower().startswith(tuple(m.lower() for m in KIND_MODELS.get(kind, ())))]
+    return min(family) if family else float(_core.DEFAULTS["haptic_rate"])
+
+
 def pick(firmware: str | None = None, libraries: dict[str, Any] | None = None, **mapping: Any) -> Any | None:
     """The device a session should use: the first usable force device (Inverse3, Falcon,
     Touch/Phantom, Force Dimension), else the first usable SpaceMouse, else None (the caller takes
     the mouse).
     ``mapping``: origin, scale, force_scale, max_force, rate for a force device."""
+    return pick_with_rate(firmware, libraries, **mapping)[0]
+
+
+def pick_with_rate(firmware: str | None = None, libraries: dict[str, Any] | None = None, max_rate: float = 0.0,
+                   **mapping: Any) -> tuple[Any | None, float]:
+    """:func:`pick`, and the haptic rate (Hz) to run its session at: a force device's fastest from
+    the limits table (:func:`fastest_rate`), at most ``max_rate`` where that is > 0 (a user's
+    preference), unless ``mapping`` gives the rate; the loop's default for the others."""
     libraries = libraries or {}
+    default = float(_core.DEFAULTS["haptic_rate"])
+    if not max_rate >= 0:  # (NaN too)
+        raise ValueError(f"max_rate: must be >= 0 Hz (0: the device's fastest), got {max_rate}")
     for d in list(firmware, libraries):
         if not d["usable"]:
             continue
+        rate = float(mapping.get("rate", default))
+        if d["force"] and "rate" not in mapping:
+            rate = fastest_rate(d["model"], d["kind"])
+            rate = min(rate, max(float(max_rate), 100.0)) if max_rate > 0 else rate
+            mapping = dict(mapping, rate=rate)
         if d["kind"] == "haply":
-            return haply(d["device_id"], libraries.get("haply"), **mapping)
+            return haply(d["device_id"], libraries.get("haply"), **mapping), rate
         if d["kind"] == "falcon":
-            return falcon(d["index"], firmware, library=libraries.get("falcon"), **mapping)
+            return falcon(d["index"], firmware, library=libraries.get("falcon"), **mapping), rate
         if d["kind"] == "openhaptics":
-            return openhaptics(library=libraries.get("openhaptics"), **mapping)
+            return openhaptics(library=libraries.get("openhaptics"), **mapping), rate
         if d["kind"] == "dhd":
-            return dhd(library=libraries.get("dhd"), **mapping)
+            return dhd(library=libraries.get("dhd"), **mapping), rate
         if d["kind"] == "spacemouse":
-            return spacemouse(d["path"], origin=mapping.get("origin", (0.0, 0.0, 0.0)))
-    return None
+            return spacemouse(d["path"], origin=mapping.get("origin", (0.0, 0.0, 0.0))), default
+    return None, default
 
 
 def limits() -> builtins.list[dict[str, Any]]:

@@ -72,6 +72,7 @@ class Session:
         self._device: Any = None
         self._error = ""
         self._priority_said = False
+        self.haptic_rate = 0.0  #: Hz: the haptic loop's rate while it runs (it polls at 100 Hz while idle)
         self._timer: Any = None
         self._frame_base: Any = None  # knots, weights, degrees for GUI frames (they do not change)
         self._previewed = False  # a held stroke's frames previewed on the objects built from the sculpt
@@ -131,6 +132,7 @@ class Session:
         live.attach(self)  # from here on the runtime steps the surface, starting at rest
         self._runtime, self._obj, self._device, self._error = runtime, obj, native, ""
         self._priority_said = False
+        self.haptic_rate = float(haptic_rate)
         self._latest_poles, self._latest_maps, self._edits, self.applied_edits = None, {}, {}, []
         self._previewed = False
         self._committed = False  # a stroke, spray or edit this run (else its end commits nothing)
@@ -158,6 +160,12 @@ class Session:
         if how.startswith("SCHED_FIFO"):
             return "real-time (RealtimeKit)" if how.endswith("RealtimeKit") else f"real-time {how.split(' ', 2)[2]}"
         return "no real-time priority" if how.startswith("none") else how
+
+    @property
+    def rate_and_priority(self) -> str:
+        """The status line's words for the haptic loop: "4 kHz, real-time (root)"; "" until known."""
+        priority = self.priority
+        return f"{self.haptic_rate / 1000:g} kHz, {priority}" if priority else ""
 
     def _say_priority(self, runtime: Any) -> None:
         """Once a session with a device that renders or reads at 1 kHz (not the mouse) knows its

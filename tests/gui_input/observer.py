@@ -35,6 +35,8 @@ def _sculpts(doc):
                     "session": o.Proxy.live.session is not None if getattr(o.Proxy, "live", None) else False,
                     "device": o.Proxy.live.session.device_name
                     if getattr(o.Proxy, "live", None) and o.Proxy.live.session else "",
+                    "haptic_rate": o.Proxy.live.session.haptic_rate
+                    if getattr(o.Proxy, "live", None) and o.Proxy.live.session else 0.0,
                     "selected": o in Gui.Selection.getSelection(), "screen": _on_screen(o), "digest": digest(o),
                     "drawn_poles": _drawn_poles(o), "curves": _curves(o)})
     return out
