@@ -317,7 +317,7 @@ class TestSculptedSolid(SolidChecks):
         obj = hs.sculpt_solid(self.doc, box, [top])
         walls = obj.Sculpts[0].Proxy.live.surface.walls
         outward = {tuple(np.round(normal, 9)) for _, normal, _ in walls}
-        self.assertEqual(outward, {(-1, 0, 0), (1, 0, 0), (0, -1, 0), (0, 1, 0)})  # the four sides, nothing else
+        self.assertEqual(outward, {(-1, 0, 0), (1, 0, 0), (0, -1, 0), (0, 1, 0), (0, 0, -1)})  # the sides, the bottom
         pull(obj, (20, 20, 20), (-40, 0, -15), seconds=2.0)
         obj.Shape.check(True)  # (raises where the solid cuts itself)
         poles = np.asarray(obj.Sculpts[0].Proxy.live.snapshot().poles).reshape(-1, 3)
@@ -326,6 +326,28 @@ class TestSculptedSolid(SolidChecks):
         self.check_sculpted(obj, box, top)
         again = self.reopened(obj, "walls.FCStd")
         self.assertEqual(again.Sculpts[0].Proxy.live.surface.walls, walls)
+
+    def test_a_top_pushed_down_stops_short_of_the_bottom(self):
+        """A drag straight down a front view pushes a box's top towards its bottom: without the
+        bottom's wall it passed through it (a self-intersecting solid, seen by a fresh-eyes try);
+        now its poles stop 0.1 % of the part's size above it, and the face with them."""
+        box = self.part(Part.makeBox(40, 40, 20), "Box")
+        top = face_named(box.Shape, lambda f: abs(f.CenterOfMass.z - 20) < 1e-9)
+        unwalled = hs.sculpt_solid(self.doc, box, [top], name="Unwalled")
+        unwalled.Sculpts[0].Proxy.live.surface.set_walls([])
+        pull(unwalled, (20, 20, 20), (0, 0, -80), seconds=2.0)
+        self.assertLess(np.asarray(unwalled.Sculpts[0].Proxy.live.snapshot().mesh)[..., 2].min(), -1.0)
+        with self.assertRaises(Exception):
+            unwalled.Shape.check(True)
+        obj = hs.sculpt_solid(self.doc, box, [top])
+        pull(obj, (20, 20, 20), (0, 0, -80), seconds=2.0)
+        gap = 1e-3 * box.Shape.BoundBox.DiagonalLength
+        poles = np.asarray(obj.Sculpts[0].Proxy.live.snapshot().poles)[..., 2]
+        self.assertGreaterEqual(poles.min(), gap - 1e-9)
+        self.assertLess(poles.min(), gap + 1e-3)  # the inner poles went down to the wall
+        self.assertGreaterEqual(np.asarray(obj.Sculpts[0].Proxy.live.snapshot().mesh)[..., 2].min(), gap - 1e-9)
+        obj.Shape.check(True)
+        self.check_sculpted(obj, box, top)
 
     def test_run_and_constraints_accept_the_solid(self):
         box = self.part(Part.makeBox(40, 30, 10))

@@ -243,8 +243,8 @@ BOX = """
 import json, os
 import FreeCAD, FreeCADGui, Part
 doc = FreeCAD.newDocument("Block")
-part = doc.addObject("Part::Box", "Box")
-part.Length, part.Width, part.Height = 40, 40, 20
+part = doc.addObject("Part::Feature", "Box")
+part.Shape = Part.makeBox(40, 40, 20)
 doc.recompute()
 doc.saveAs(PATH)
 json.dump({"volume": part.Shape.Volume}, open({answer}, "w"))

@@ -10,6 +10,9 @@ edge moves with the face) and whose neighbour is not sculpted with it, at the po
 meet at more than :data:`CREASE_DEG` (a tangent neighbour's plane is the face's own: it would pin
 the face). A pole that starts outside a wall (a concave edge) is not held by it. Trims inside the
 rectangle (a hole) give no walls in this version.
+
+A face pushed into the part stops short of a plane on its far side (a box's bottom under its top):
+:func:`floor_walls`.
 """
 from __future__ import annotations
 
@@ -23,6 +26,8 @@ from . import face_in_solid
 CREASE_DEG = 10.0
 #: Points per edge where the neighbour's plane is taken.
 WALL_SAMPLES = 64
+#: How far short of a face below a face pushed down stops, in parts of the part's diagonal.
+FLOOR_GAP = 1e-3
 
 
 def _outward_normal(face: Any, point: Any) -> np.ndarray | None:
@@ -74,4 +79,42 @@ def face_walls(shape: Any, faces: Sequence[str], edges: list[face_in_solid.FaceE
         for k in np.unique(nearest[behind]):
             held_by = free[behind & (nearest == k)]
             walls.append((points_a[k].tolist(), normals_a[k].tolist(), [int(i) for i in held_by]))
+    return walls + floor_walls(shape, faces, net, free)
+
+
+def _plane(face: Any) -> tuple[np.ndarray, np.ndarray] | None:
+    """A planar face's (point, outward unit normal), else None."""
+    if "Plane" not in type(face.Surface).__name__:
+        return None
+    u0, u1, v0, v1 = face.ParameterRange
+    normal = _outward_normal(face, face.valueAt((u0 + u1) / 2, (v0 + v1) / 2))
+    c = face.CenterOfMass
+    return (np.array([c.x, c.y, c.z]), normal) if normal is not None else None
+
+
+def floor_walls(shape: Any, faces: Sequence[str], net: np.ndarray,
+                free: np.ndarray) -> list[tuple[list[float], list[float], list[int]]]:
+    """Walls on the far side: each planar face of the solid that faces away from the sculpted ones
+    (a box's bottom under its top) and has every free pole behind it, moved :data:`FLOOR_GAP` of the
+    part's size inwards, so a face pushed down stops short of the face below instead of passing
+    through it. A plane facing another way (a boss's top beside a sculpted top) is no wall: it is
+    not in the way of a push into the part."""
+    sculpted = [shape.getElement(f) for f in faces]
+    normals = [_outward_normal(f, f.CenterOfMass) for f in sculpted]
+    facing = [n for n in normals if n is not None]
+    if not facing:
+        return []
+    own = np.mean(facing, axis=0)
+    own /= np.linalg.norm(own) or 1.0
+    gap = FLOOR_GAP * shape.BoundBox.DiagonalLength
+    walls = []
+    for k, face in enumerate(shape.Faces):
+        if f"Face{k + 1}" in faces:
+            continue
+        plane = _plane(face)
+        if plane is None or float(plane[1] @ own) > -0.5:
+            continue
+        point = plane[0] - gap * plane[1]
+        if np.all((net[free] - point) @ plane[1] <= 0):
+            walls.append((point.tolist(), plane[1].tolist(), [int(i) for i in free]))
     return walls
