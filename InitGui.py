@@ -19,7 +19,10 @@ class HapticSculptWorkbench(Gui.Workbench):
         self.__class__.Icon = os.path.join(package, "resources", "icons", "HapticSculpt.svg")
         # Edit > Preferences > HapticSculpt (a Designer file: FreeCAD builds its widgets; no Qt here)
         Gui.addPreferencePage(os.path.join(package, "resources", "ui", "preferences.ui"), "HapticSculpt")
-        Gui.addIcon("preferences-hapticsculpt", self.__class__.Icon)  # (the group's icon, found by that name)
+        try:  # the group's icon, looked up by that name (FreeCAD 1.1 refuses an SVG path here: no icon)
+            Gui.addIcon("preferences-hapticsculpt", self.__class__.Icon)
+        except Exception:  # noqa: BLE001 - FreeCAD raises its own error type
+            pass
         try:
             import HapticSculpt.gui  # noqa: F401  (its hooks: view providers, frame clock, stroke echo)
         except ImportError as exc:  # no native core: say what to do; the workbench stays listed

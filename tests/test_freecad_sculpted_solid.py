@@ -195,6 +195,7 @@ class TestSculptedSolid(SolidChecks):
         self.doc.recompute()
         top = face_named(box.Shape, lambda f: abs(f.CenterOfMass.z - 10) < 1e-9)
         obj = hs.sculpt_solid(self.doc, box, [top])
+        self.assertNotIn("Touched", obj.State)
         self.assertAlmostEqual(obj.Shape.Volume, box.Shape.Volume, delta=1e-6)
         self.assertEqual(set(hs.boundary_of(obj).values()), {"G0"})
         pull(obj, (20, 15, 10), (0, 0, 8))
@@ -324,8 +325,10 @@ class TestSculptedSolid(SolidChecks):
         self.assertGreaterEqual(poles[:, 0].min(), -1e-9)
         self.assertLess(poles[:, 2].min(), 20 - 1.0)  # (it was pushed: a dent against the side)
         self.check_sculpted(obj, box, top)
+        self.assertNotIn("Touched", obj.State)  # (rebuilt with the stroke: no recompute mark, none saved)
         again = self.reopened(obj, "walls.FCStd")
         self.assertEqual(again.Sculpts[0].Proxy.live.surface.walls, walls)
+        self.assertNotIn("Touched", again.State)
 
     def test_a_top_pushed_down_stops_short_of_the_bottom(self):
         """A drag straight down a front view pushes a box's top towards its bottom: without the

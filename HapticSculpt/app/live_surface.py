@@ -331,11 +331,12 @@ def recompute_dependents(obj: Any) -> None:
     undo step restores them too. The sculpt and its SculptedSolids are up to date already (their
     shapes were just written): they are not recomputed again."""
     built = [p for p in obj.InList if hasattr(getattr(p, "Proxy", None), "sculpt_changed")]
+    for o in built:  # (rebuilt just now: not "touched", in the tree, in the file, after reopening)
+        o.purgeTouched()
     users = [u for o in [obj] + built for u in o.InList if u not in built]
     if not users:
         return
-    for o in [obj] + built:
-        o.purgeTouched()
+    obj.purgeTouched()
     for user in users:
         user.touch()
     obj.Document.recompute([o for o in obj.InListRecursive if o not in built])

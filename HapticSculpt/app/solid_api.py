@@ -166,6 +166,7 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
         obj.Resolution = json.dumps({"controls": list(controls), "degree": list(degree), "trim_spans": TRIM_SPANS})
         obj.SourcePoles = np.asarray(made.surface.poles, float).ravel().tolist()
         rebuild(obj)
+        obj.purgeTouched()  # (built from its base just now: nothing to recompute)
         attach_view_provider(obj)
     return obj
 
