@@ -101,7 +101,7 @@ void bindRuntime(py::module_& m) {
             d["force"] = Vec3(s.force);
             d["estimate_age_ms"] = s.estimateAge * 1e3;
             d["realtime_priority"] = s.realtimePriority;
-            d["realtime_how"] = s.realtimeHow;
+            d["realtime_how"] = r.realtimeHow();
             d["error"] = s.error;
             d["cursor"] = Vec3(s.cursor);
             d["orientation"] = std::vector<double>{s.orientation.w(), s.orientation.x(), s.orientation.y(), s.orientation.z()};

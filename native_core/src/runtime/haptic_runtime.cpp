@@ -313,6 +313,10 @@ void HapticRuntime::takeRealtimePriority() {
     realtimeKnown_.store(true, std::memory_order_release);
 }
 
+std::string HapticRuntime::realtimeHow() const {
+    return realtimeKnown_.load(std::memory_order_acquire) ? realtimeHow_ : std::string();
+}
+
 void HapticRuntime::hapticLoop() {
     takeRealtimePriority();
     // Wake-ups to the microsecond: a thread's timer slack (50 us by default) delays every one.
@@ -548,10 +552,7 @@ RuntimeStatus HapticRuntime::status() const {
     s.force = Vec3(force_[0].load(std::memory_order_relaxed), force_[1].load(std::memory_order_relaxed),
                    force_[2].load(std::memory_order_relaxed));
     s.estimateAge = estimateAge_.load(std::memory_order_relaxed);
-    if (realtimeKnown_.load(std::memory_order_acquire)) {
-        s.realtimePriority = realtimeOk_.load(std::memory_order_relaxed);
-        s.realtimeHow = realtimeHow_;
-    }
+    if (realtimeKnown_.load(std::memory_order_acquire)) s.realtimePriority = realtimeOk_.load(std::memory_order_relaxed);
     if (failed_.load(std::memory_order_acquire)) s.error = error_.data();
     return s;
 }

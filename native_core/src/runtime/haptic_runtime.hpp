@@ -56,9 +56,6 @@ struct RuntimeStatus {
     Vec3 force = Vec3::Zero();      ///< last rendered force
     double estimateAge = 0;         ///< s: age of the snapshot the last tick used
     bool realtimePriority = false;
-    /// How the haptic thread got real-time priority ("SCHED_FIFO 49 (rtprio limit)", "SCHED_FIFO 20
-    /// from RealtimeKit"), or why it got none ("none: ..."); "off" when not asked; "" until known.
-    std::string realtimeHow;
     std::string error;              ///< why the session stopped by itself ("" if it did not)
     // for the GUI overlay: the last finite cursor and the tool's contact point (rope: the grabbed
     // mesh point), as the haptic loop last saw them
@@ -163,6 +160,10 @@ public:
     /// True before start() and once stop() has joined the threads.
     bool joined() const { return !started_ || joined_; }
     RuntimeStatus status() const;
+    /// How the haptic thread got real-time priority ("SCHED_FIFO 49 (rtprio limit)", "SCHED_FIFO 20
+    /// from RealtimeKit"), or why it got none ("none: ..."); "off" when not asked; "" until known.
+    /// (Apart from status(), which allocates nothing: a caller polling it is not charged a string.)
+    std::string realtimeHow() const;
 
     /// Newest pole snapshot if one arrived since the last call (GUI thread).
     bool takePoles(Points& out);
@@ -196,7 +197,7 @@ public:
 private:
     void hapticLoop();
     /// SCHED_FIFO for the calling (haptic) thread: directly where the rtprio limit allows, else from
-    /// RealtimeKit; says how, or why not (status().realtimeHow).
+    /// RealtimeKit; says how, or why not (realtimeHow()).
     void takeRealtimePriority();
     void simLoop();
     double now() const;
