@@ -71,7 +71,7 @@ def test_flatten_presses_the_bump_flatter_in_one_undo_step(tmp_path):
                            "the slider panel with the flatten tool's two settings")
         calibrate(d)
         label, radius, _, f = overlay(s)["sliders"][6]
-        assert label == "flatten radius" and radius == 10.0, overlay(s)["sliders"][6]
+        assert label == "flatten radius (mm)" and radius == 10.0, overlay(s)["sliders"][6]
         x0, y0, x1, y1 = overlay(s)["hud"]["track7"]
         d.drag([d.to_screen([x0 + (f + (0.65 - f) * t) * (x1 - x0), (y0 + y1) / 2]) for t in np.linspace(0, 1, 8)],
                seconds=0.5)
@@ -103,7 +103,7 @@ def test_flatten_presses_the_bump_flatter_in_one_undo_step(tmp_path):
         d.press_button("ToolRope", lambda s: undo(s)[0] == "Tool: rope", "Rope from the drop-down")
         s = d.press_button("ToolFlatten", lambda s: undo(s)[:2] == ["Tool: flatten", "Tool: rope"],
                            "Flatten again from the drop-down")
-        d.wait(lambda s: overlay(s)["sliders"][6][0] == "flatten radius" and 15 < overlay(s)["sliders"][6][1] < 25,
+        d.wait(lambda s: overlay(s)["sliders"][6][0] == "flatten radius (mm)" and 15 < overlay(s)["sliders"][6][1] < 25,
                "the flatten radius kept across the change of tools")
     finally:
         d.close()
