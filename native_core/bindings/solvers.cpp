@@ -321,6 +321,27 @@ void bindSolvers(py::module_& m) {
                       setting(&DynamicSurface::solver, &DynamicSurface::setSolver, &SolverSettings::explicitWhenStable),
                       "local_global: take an explicit velocity Verlet step wherever it is provably stable for the "
                       "step (cheaper and more accurate there), the implicit step elsewhere (default on)")
+        .def_property("regional", [](const DynamicSurface& s) { return s.solver().region.enabled; },
+                      [](DynamicSurface& s, bool on) { SolverSettings v = s.solver(); v.region.enabled = on; s.setSolver(v); },
+                      "local_global: step only the region of poles a stroke moves (plus a margin), the rest held "
+                      "at rest until the motion reaches it; where the scene allows it (no symmetry, linked poles, "
+                      "penalty constraints or point forces; linear laws; a tool that says where it pushes)")
+        .def_property("region_margin", [](const DynamicSurface& s) { return s.solver().region.margin; },
+                      [](DynamicSurface& s, int n) { SolverSettings v = s.solver(); v.region.margin = n; s.setSolver(v); },
+                      "quiet poles kept free around the moving ones (1..1000)")
+        .def_property("region_wake", [](const DynamicSurface& s) { return s.solver().region.wake; },
+                      [](DynamicSurface& s, double f) { SolverSettings v = s.solver(); v.region.wake = f; s.setSolver(v); },
+                      "a pole counts as moving above this fraction of the fastest pole's speed (0..1)")
+        .def_property_readonly("active_region", [](const DynamicSurface& s) {
+            const ActiveRegion& r = s.activeRegion();
+            py::dict d;
+            d["whole"] = r.whole;
+            d["poles"] = py::make_tuple(r.poles.r0, r.poles.r1, r.poles.c0, r.poles.c1);
+            d["mesh"] = py::make_tuple(r.mesh.r0, r.mesh.r1, r.mesh.c0, r.mesh.c1);
+            d["changes"] = r.serial;
+            return d;
+        }, "what the last step moved: whole (bool), poles and mesh as (row0, row1, col0, col1) half-open "
+           "index ranges along u and v, and how many times the region changed")
         .def_property("cg_iterations", getting(&DynamicSurface::solver, &SolverSettings::cgIterations),
                       setting(&DynamicSurface::solver, &DynamicSurface::setSolver, &SolverSettings::cgIterations))
         .def_property("acceleration_limit", getting(&DynamicSurface::solver, &SolverSettings::accelerationLimit),

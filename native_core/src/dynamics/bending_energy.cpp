@@ -95,13 +95,25 @@ void BendingEnergy::setReference(const Points& reference) {
     ref_ = reference;
 }
 
-void BendingEnergy::follow(const Points& d, double fraction) {
+void BendingEnergy::follow(const Points& d, double fraction, const GridRect* window) {
+    if (window) {
+        window->forSpans([&](const auto& r) { r(ref_) += std::min(1.0, fraction) * (r(d) - r(ref_)); });
+        return;
+    }
     if (fraction >= 1) ref_ = d;
     else ref_ += fraction * (d - ref_);
 }
 
-double BendingEnergy::addForces(const Points& d, Points& f, double scale) const {
+double BendingEnergy::addForces(const Points& d, Points& f, double scale, const GridRect* window) const {
     if (!active()) return 0.0;
+    if (window) {
+        window->grown(2, g_).forSpans([&](const auto& r) { r(diff_) = r(d) - r(ref_); });
+        window->forRuns([&](Eigen::Index i, Eigen::Index n) {
+            prod_.middleRows(i, n).noalias() = K_.middleRows(i, n) * diff_;
+            f.middleRows(i, n) -= scale * prod_.middleRows(i, n);
+        });
+        return 0.0;
+    }
     diff_ = d - ref_;
     prod_.noalias() = K_ * diff_;
     f -= scale * prod_;

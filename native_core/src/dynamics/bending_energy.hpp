@@ -13,6 +13,7 @@
 #include <Eigen/Sparse>
 #include <vector>
 
+#include "common/grid_rect.hpp"
 #include "geometry/bspline_surface.hpp"
 #include "dynamics/material_map.hpp"
 
@@ -40,11 +41,13 @@ public:
     const Points& reference() const { return ref_; }
     /// Replaces the reference shape; throws std::invalid_argument naming "reference".
     void setReference(const Points& reference);
-    /// Plastic flow: the reference moves a `fraction` of the way to the shape d.
-    void follow(const Points& d, double fraction);
+    /// Plastic flow: the reference moves a `fraction` of the way to the shape d (with a `window`,
+    /// on its points only).
+    void follow(const Points& d, double fraction, const GridRect* window = nullptr);
 
-    /// f -= scale K_b (d - r); returns E_b. No allocation.
-    double addForces(const Points& d, Points& f, double scale = 1.0) const;
+    /// f -= scale K_b (d - r); returns E_b. No allocation. With a `window` (a rectangle of the
+    /// mesh), only its rows of f, reading d two points around it, and returns 0.
+    double addForces(const Points& d, Points& f, double scale = 1.0, const GridRect* window = nullptr) const;
     /// E_b at d.
     double energy(const Points& d) const;
     /// out += K_b y (the Hessian: the energy is quadratic). No allocation.

@@ -53,9 +53,10 @@ void projectRun(Law lw, int n, const double* __restrict xa, const double* __rest
 
 SpringMesh::SpringMesh(int g, int h, const Points& d) : g_(g), h_(h) {
     auto family = [&](int offset, int rows, int j0, int j1) {
+        const int rowStep = offset == 1 ? 0 : 1, colStep = offset - rowStep * h;
         for (int i = 0; i < rows; ++i) {
             if (j1 <= j0) continue;
-            runs_.push_back({static_cast<int>(a_.size()), i * h + j0, offset, j1 - j0});
+            runs_.push_back({static_cast<int>(a_.size()), i * h + j0, offset, j1 - j0, rowStep, colStep});
             for (int j = j0; j < j1; ++j) {
                 a_.push_back(i * h + j);
                 b_.push_back(i * h + j + offset);
@@ -146,18 +147,38 @@ void SpringMesh::addTangentStiffness(const Points& y, Points& out) const {
     }
 }
 
-double SpringMesh::addProjections(const Points& d, Points& out, double maxExtraStiffness, double scale, bool energy) const {
+template <class F>
+void SpringMesh::forRuns(const GridRect* window, F&& f) const {
+    for (const Run& run : runs_) {
+        if (!window) {
+            f(run.first, run.a0, run.offset, run.length);
+            continue;
+        }
+        const GridRect& w = *window;
+        const int row = run.a0 / h_, col = run.a0 % h_;
+        if (row < w.r0 || row + run.rowStep >= w.r1) continue;
+        const int j0 = std::max({0, w.c0 - col, w.c0 - col - run.colStep});
+        const int j1 = std::min({run.length, w.c1 - col, w.c1 - col - run.colStep});
+        if (j1 > j0) f(run.first + j0, run.a0 + j0, run.offset, j1 - j0);
+    }
+}
+
+double SpringMesh::addProjections(const Points& d, Points& out, double maxExtraStiffness, double scale, bool energy,
+                                  const GridRect* window) const {
     // Each spring's energy 1/2 k |x_a - x_b - t|^2 is minimised over |t| = target length;
     // a non-linear law changes the target length so that k (l - |t|) = g(k (l - r)).
     // Runs of one family in one row have contiguous endpoints a and a + offset: in structure-of-
     // arrays form every loop below is a plain vectorisable stream.
-    const Eigen::Index n = d.rows();
-    x_ = d.col(0);
-    y_ = d.col(1);
-    z_ = d.col(2);
-    fx_.setZero();
-    fy_.setZero();
-    fz_.setZero();
+    const GridRect all = GridRect::whole(g_, h_);
+    const GridRect& points = window ? *window : all;
+    points.forRuns([&](Eigen::Index i, Eigen::Index n) {
+        x_.segment(i, n) = d.col(0).segment(i, n);
+        y_.segment(i, n) = d.col(1).segment(i, n);
+        z_.segment(i, n) = d.col(2).segment(i, n);
+        fx_.segment(i, n).setZero();
+        fy_.segment(i, n).setZero();
+        fz_.segment(i, n).setZero();
+    });
     const double* X = x_.data();
     const double* Y = y_.data();
     const double* Z = z_.data();
@@ -171,50 +192,52 @@ double SpringMesh::addProjections(const Points& d, Points& out, double maxExtraS
     double* ce = ce_.data();
     double twiceEnergy = 0;
     withLaw(law, [&](auto lw) {
-        for (const Run& run : runs_) {
-            const double* xa = X + run.a0;
-            const double* ya = Y + run.a0;
-            const double* za = Z + run.a0;
-            const double* xb = xa + run.offset;
-            const double* yb = ya + run.offset;
-            const double* zb = za + run.offset;
-            const double* r = rest + run.first;
-            const double* kr = uniform ? nullptr : kv + run.first;
+        forRuns(window, [&](int first, int a0, int offset, int length) {
+            const double* xa = X + a0;
+            const double* ya = Y + a0;
+            const double* za = Z + a0;
+            const double* xb = xa + offset;
+            const double* yb = ya + offset;
+            const double* zb = za + offset;
+            const double* r = rest + first;
+            const double* kr = uniform ? nullptr : kv + first;
             if (energy) {
-                if (uniform) projectRun<true, true>(lw, run.length, xa, ya, za, xb, yb, zb, r, nullptr, kU, maxExtraStiffness, minL, cx, cy, cz, ce);
-                else projectRun<false, true>(lw, run.length, xa, ya, za, xb, yb, zb, r, kr, kU, maxExtraStiffness, minL, cx, cy, cz, ce);
-                twiceEnergy += Eigen::Map<const Eigen::VectorXd>(ce, run.length).sum();
+                if (uniform) projectRun<true, true>(lw, length, xa, ya, za, xb, yb, zb, r, nullptr, kU, maxExtraStiffness, minL, cx, cy, cz, ce);
+                else projectRun<false, true>(lw, length, xa, ya, za, xb, yb, zb, r, kr, kU, maxExtraStiffness, minL, cx, cy, cz, ce);
+                twiceEnergy += Eigen::Map<const Eigen::VectorXd>(ce, length).sum();
             } else {
-                if (uniform) projectRun<true, false>(lw, run.length, xa, ya, za, xb, yb, zb, r, nullptr, kU, maxExtraStiffness, minL, cx, cy, cz, ce);
-                else projectRun<false, false>(lw, run.length, xa, ya, za, xb, yb, zb, r, kr, kU, maxExtraStiffness, minL, cx, cy, cz, ce);
+                if (uniform) projectRun<true, false>(lw, length, xa, ya, za, xb, yb, zb, r, nullptr, kU, maxExtraStiffness, minL, cx, cy, cz, ce);
+                else projectRun<false, false>(lw, length, xa, ya, za, xb, yb, zb, r, kr, kU, maxExtraStiffness, minL, cx, cy, cz, ce);
             }
-            double* fxa = fx_.data() + run.a0;
-            double* fya = fy_.data() + run.a0;
-            double* fza = fz_.data() + run.a0;
-            for (int j = 0; j < run.length; ++j) { fxa[j] += cx[j]; fya[j] += cy[j]; fza[j] += cz[j]; }
-            double* fxb = fxa + run.offset;
-            double* fyb = fya + run.offset;
-            double* fzb = fza + run.offset;
-            for (int j = 0; j < run.length; ++j) { fxb[j] -= cx[j]; fyb[j] -= cy[j]; fzb[j] -= cz[j]; }
-        }
+            double* fxa = fx_.data() + a0;
+            double* fya = fy_.data() + a0;
+            double* fza = fz_.data() + a0;
+            for (int j = 0; j < length; ++j) { fxa[j] += cx[j]; fya[j] += cy[j]; fza[j] += cz[j]; }
+            double* fxb = fxa + offset;
+            double* fyb = fya + offset;
+            double* fzb = fza + offset;
+            for (int j = 0; j < length; ++j) { fxb[j] -= cx[j]; fyb[j] -= cy[j]; fzb[j] -= cz[j]; }
+        });
         return 0;
     });
-    for (Eigen::Index i = 0; i < n; ++i) {
-        out(i, 0) += scale * fx_[i];
-        out(i, 1) += scale * fy_[i];
-        out(i, 2) += scale * fz_[i];
-    }
+    points.forRuns([&](Eigen::Index i, Eigen::Index n) {
+        out.col(0).segment(i, n) += scale * fx_.segment(i, n);
+        out.col(1).segment(i, n) += scale * fy_.segment(i, n);
+        out.col(2).segment(i, n) += scale * fz_.segment(i, n);
+    });
     return energy && law.kind == LawKind::Linear ? 0.5 * twiceEnergy : 0.0;
 }
 
-void SpringMesh::applyPlasticity(const Points& d, double dt) {
+void SpringMesh::applyPlasticity(const Points& d, double dt, const GridRect* window) {
     const double creep = std::min(1.0, plasticity.rate * dt);
-    for (size_t s = 0; s < a_.size(); ++s) {
-        const double l = (d.row(a_[s]) - d.row(b_[s])).norm();
-        const double limit = plasticity.yieldStrain * rest0_[s];
-        const double e = l - rest_[s];
-        if (std::abs(e) > limit) rest_[s] += creep * (e - std::copysign(limit, e));
-    }
+    forRuns(window, [&](int first, int, int, int length) {
+        for (int s = first; s < first + length; ++s) {
+            const double l = (d.row(a_[s]) - d.row(b_[s])).norm();
+            const double limit = plasticity.yieldStrain * rest0_[s];
+            const double e = l - rest_[s];
+            if (std::abs(e) > limit) rest_[s] += creep * (e - std::copysign(limit, e));
+        }
+    });
 }
 
 void SpringMesh::addLaplacian(std::vector<Eigen::Triplet<double>>& t) const {

@@ -4,6 +4,7 @@
 #include <Eigen/Sparse>
 #include <vector>
 
+#include "common/grid_rect.hpp"
 #include "geometry/bspline_surface.hpp"
 #include "dynamics/material_map.hpp"
 #include "dynamics/response_law.hpp"
@@ -59,10 +60,12 @@ public:
     /// matrix does not hold is explicit, and stays stable only below about m / dt^2.
     /// With `energy`, also returns the elastic energy of a linear law (0 otherwise): for a linear law
     /// J t - L d is the spring force, and this is the vectorised force pass of the Verlet step.
+    /// With a `window` (a rectangle of the mesh), only the springs with both ends in it are taken
+    /// and only its rows of `out` are written: exact on the window shrunk by one point.
     double addProjections(const Points& d, Points& out, double maxExtraStiffness, double scale = 1.0,
-                          bool energy = false) const;
-    /// Plastic flow over a step of length dt.
-    void applyPlasticity(const Points& d, double dt);
+                          bool energy = false, const GridRect* window = nullptr) const;
+    /// Plastic flow over a step of length dt (with a `window`, of the springs with both ends in it).
+    void applyPlasticity(const Points& d, double dt, const GridRect* window = nullptr);
     /// Triplets of the weighted graph Laplacian sum_s k_s (e_a - e_b)(e_a - e_b)^T.
     void addLaplacian(std::vector<Eigen::Triplet<double>>& t) const;
     double energy(const Points& d) const;
@@ -81,7 +84,12 @@ private:
         int a0;      ///< mesh index of its first point a (b = a + offset)
         int offset;
         int length;
+        int rowStep, colStep;  ///< where b sits from a in the grid
     };
+    /// Calls f(first spring, its point a, count) for each run clipped to the springs with both
+    /// ends in `window` (all springs without one).
+    template <class F>
+    void forRuns(const GridRect* window, F&& f) const;
     std::vector<Run> runs_;
     // Structure-of-arrays scratch for the vectorised local step.
     mutable Eigen::VectorXd x_, y_, z_, fx_, fy_, fz_, cx_, cy_, cz_, ce_;

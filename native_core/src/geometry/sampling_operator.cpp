@@ -1,5 +1,6 @@
 #include "geometry/sampling_operator.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -145,6 +146,86 @@ void SamplingOperator::applyTransposed(const Points& f, Points& fp) const {
             double* o = fp.data() + 3 * (i * nv_ + vStart_[b]);
             for (int t = 0; t <= q_; ++t) { o[3 * t] += w[t] * src[0]; o[3 * t + 1] += w[t] * src[1]; o[3 * t + 2] += w[t] * src[2]; }
         }
+}
+
+GridRect SamplingOperator::meshOf(const GridRect& poles) const {
+    // (uStart_ and vStart_ grow with the sample: the samples a pole reaches are a contiguous range)
+    const auto range = [](const std::vector<int>& start, int degree, int first, int last, int& lo, int& hi) {
+        lo = static_cast<int>(start.size());
+        hi = 0;
+        for (int a = 0; a < static_cast<int>(start.size()); ++a)
+            if (start[a] <= last - 1 && start[a] + degree >= first) {
+                lo = std::min(lo, a);
+                hi = a + 1;
+            }
+    };
+    GridRect m;
+    m.stride = h_;
+    range(uStart_, p_, poles.r0, poles.r1, m.r0, m.r1);
+    range(vStart_, q_, poles.c0, poles.c1, m.c0, m.c1);
+    return m;
+}
+
+GridRect SamplingOperator::polesOf(const GridRect& mesh) const {
+    if (mesh.empty()) return {0, 0, 0, 0, nv_};
+    return {uStart_[mesh.r0], uStart_[mesh.r1 - 1] + p_ + 1, vStart_[mesh.c0], vStart_[mesh.c1 - 1] + q_ + 1, nv_};
+}
+
+void SamplingOperator::applyTo(const Points& p, Points& d, const GridRect& mesh) const {
+    if (mesh.empty()) return;
+    // tmp(i, b) for the net rows i the mesh rows reach and the columns b of the rectangle
+    const int iFirst = uStart_[mesh.r0], iLast = uStart_[mesh.r1 - 1] + p_;
+    const int width = 3 * (mesh.c1 - mesh.c0);
+    for (int i = iFirst; i <= iLast; ++i)
+        for (int b = mesh.c0; b < mesh.c1; ++b) {
+            const double* w = &vBasis_[static_cast<size_t>(b) * (q_ + 1)];
+            const double* pp = p.data() + 3 * (i * nv_ + vStart_[b]);
+            double x = 0, y = 0, z = 0;
+            for (int t = 0; t <= q_; ++t) { x += w[t] * pp[3 * t]; y += w[t] * pp[3 * t + 1]; z += w[t] * pp[3 * t + 2]; }
+            double* o = tmp_.data() + 3 * (i * h_ + b);
+            o[0] = x; o[1] = y; o[2] = z;
+        }
+    for (int a = mesh.r0; a < mesh.r1; ++a) {
+        const double* w = &uBasis_[static_cast<size_t>(a) * (p_ + 1)];
+        double* o = d.data() + 3 * (a * h_ + mesh.c0);
+        const double* t0 = tmp_.data() + 3 * (uStart_[a] * h_ + mesh.c0);
+        for (int k = 0; k < width; ++k) o[k] = w[0] * t0[k];
+        for (int t = 1; t <= p_; ++t) {
+            const double* tt = t0 + 3 * t * h_;
+            for (int k = 0; k < width; ++k) o[k] += w[t] * tt[k];
+        }
+    }
+}
+
+void SamplingOperator::applyTransposedTo(const Points& f, Points& fp, const GridRect& poles, const GridRect& mesh) const {
+    if (poles.empty() || mesh.empty()) return;
+    // tmp(i, b) = sum over the rectangle's rows a of Au(a, i) f(a, b), for the net rows i of `poles`
+    const int width = 3 * (mesh.c1 - mesh.c0);
+    for (int i = poles.r0; i < poles.r1; ++i) std::fill_n(tmp_.data() + 3 * (i * h_ + mesh.c0), width, 0.0);
+    for (int a = mesh.r0; a < mesh.r1; ++a) {
+        const double* w = &uBasis_[static_cast<size_t>(a) * (p_ + 1)];
+        const double* src = f.data() + 3 * (a * h_ + mesh.c0);
+        for (int t = 0; t <= p_; ++t) {
+            const int i = uStart_[a] + t;
+            if (i < poles.r0 || i >= poles.r1) continue;
+            double* o = tmp_.data() + 3 * (i * h_ + mesh.c0);
+            for (int k = 0; k < width; ++k) o[k] += w[t] * src[k];
+        }
+    }
+    for (int i = poles.r0; i < poles.r1; ++i) {
+        double* row = fp.data() + 3 * (i * nv_);
+        std::fill(row + 3 * poles.c0, row + 3 * poles.c1, 0.0);
+        for (int b = mesh.c0; b < mesh.c1; ++b) {
+            const double* w = &vBasis_[static_cast<size_t>(b) * (q_ + 1)];
+            const double* src = tmp_.data() + 3 * (i * h_ + b);
+            for (int t = 0; t <= q_; ++t) {
+                const int j = vStart_[b] + t;
+                if (j < poles.c0 || j >= poles.c1) continue;
+                double* o = row + 3 * j;
+                o[0] += w[t] * src[0]; o[1] += w[t] * src[1]; o[2] += w[t] * src[2];
+            }
+        }
+    }
 }
 
 const std::vector<CsrMatrix>& SamplingOperator::derivativeOperators(const BSplineSurface& s) const {

@@ -3,6 +3,7 @@
 #include <Eigen/Sparse>
 #include <vector>
 
+#include "common/grid_rect.hpp"
 #include "geometry/bspline_surface.hpp"
 
 namespace hs {
@@ -29,6 +30,8 @@ public:
     int h() const { return h_; }
     int rows() const { return g_ * h_; }
     int cols() const { return nu_ * nv_; }
+    int nu() const { return nu_; }
+    int nv() const { return nv_; }
     double u(int a) const { return u_[a]; }
     double v(int b) const { return v_[b]; }
     const std::vector<double>& us() const { return u_; }
@@ -37,6 +40,19 @@ public:
 
     void apply(const Points& p, Points& d) const;           ///< d = A p
     void applyTransposed(const Points& f, Points& fp) const;  ///< fp = A^T f
+
+    // --- rectangles (regional steps; non-rational surfaces only, where A = Au (x) Av) ---------
+    bool separable() const { return separable_; }
+    /// The mesh points whose basis reaches a pole of the rectangle `poles` (a rectangle of the
+    /// nu x nv net): all that move when only those poles do.
+    GridRect meshOf(const GridRect& poles) const;
+    /// The poles whose basis reaches a point of the rectangle `mesh`.
+    GridRect polesOf(const GridRect& mesh) const;
+    /// The rows `mesh` (a rectangle of the g x h mesh) of d = A p; the other rows are not written.
+    void applyTo(const Points& p, Points& d, const GridRect& mesh) const;
+    /// The rows `poles` of fp = A^T f with f read on `mesh` only (meshOf(poles) or more); the other
+    /// rows of fp are not written.
+    void applyTransposedTo(const Points& f, Points& fp, const GridRect& poles, const GridRect& mesh) const;
 
     /// Derivative operators (d/du, d/dv, d2/du2, d2/dudv, d2/dv2 of the basis at the samples),
     /// built on the first call only: curvature is paid for only when requested.

@@ -30,6 +30,7 @@ void SolverSettings::validate() const {
     requirePositive(accelerationLimit, "acceleration_limit", true);
     requireInRange(maxHalvings, "max_halvings", 0, 30);
     requirePositive(energyTolerance, "energy_tolerance", true);
+    region.validate();
 }
 
 void DynamicSurface::setSolver(const SolverSettings& s) { configure(solver_, s); }
@@ -240,14 +241,19 @@ StepReport DynamicSurface::step(double dt) {
     const bool localGlobal = solver_.kind == IntegratorKind::LocalGlobal;
     const bool verlet = localGlobal && verlet_.stable(m, dt);
     const bool guard = guardsEnergy(dt, verlet);
+    chooseRegion(localGlobal && !verlet && !guard && regionalScene());
+    const ActiveRegion& region = region_.region();
+    const GridRect& P = region.poles;
     verlet_.clearStepPotential();
     if (!guard) guard_.reset();
     else guard_.begin([this] { return kineticEnergy() + potentialEnergy(); });
     // Where the step starts: for a refused step, the work of the applied forces and local/global's A v.
-    state_.polesAtStart = state_.poles();
-    state_.velocitiesAtStart = state_.v;
+    P.forSpans([&](const auto& q) {
+        q(state_.polesAtStart) = q(state_.poles());
+        q(state_.velocitiesAtStart) = q(state_.v);
+    });
     const bool tracksWork = forces_.hasExternal() || grabbed;
-    if (tracksWork || localGlobal) state_.meshAtStart = state_.d;
+    if (tracksWork || localGlobal) region.halo.forSpans([&](const auto& q) { q(state_.meshAtStart) = q(state_.d); });
     if (!localGlobal) {
         state_.avValid = false;
         localGlobal_.restart();
@@ -266,7 +272,9 @@ StepReport DynamicSurface::step(double dt) {
             break;
     }
     if (solver_.kind != IntegratorKind::Explicit) explicit_.invalidate();  // the state moved under its acceleration
-    if (!state_.poles().allFinite() || !state_.v.allFinite()) {
+    bool finite = true;
+    P.forSpans([&](const auto& q) { finite = finite && q(state_.poles()).allFinite() && q(state_.v).allFinite(); });
+    if (!finite) {
         restoreStepStart(true);
         r.refused = true;
         r.reason = "the step would produce NaN or Inf; state kept (reduce dt or stiffness)";
@@ -277,7 +285,7 @@ StepReport DynamicSurface::step(double dt) {
     const bool walled = !walls_.empty() &&
                         walls_.project(state_.mutablePoles(), state_.v, [this](int p) { return held_.constrained(p); });
     if (snapToConstraints() || walled) {
-        state_.sampleMesh();
+        sampleRegion();
         state_.avValid = false;
     }
     if (walled) {
@@ -286,21 +294,58 @@ StepReport DynamicSurface::step(double dt) {
         verlet_.invalidate();          // wall moved it)
     }
     // The work of the applied forces over the step (forces held over the step).
-    const double work = tracksWork ? forces_.appliedWork(state_.d, state_.meshAtStart) : 0.0;
+    const double work = tracksWork ? forces_.appliedWork(state_.d, state_.meshAtStart, region.halo) : 0.0;
     if (guard && !limitEnergy(work, r)) return r;
     work_ += work;
     SpringMesh& springs = material_.springs;
     if (springs.plasticity.enabled) {
-        springs.applyPlasticity(state_.d, dt);
+        springs.applyPlasticity(state_.d, dt, region.whole ? nullptr : &region.halo);
         // Between strokes the reference follows plastic flow (under a stroke it holds, so the
         // stroke's shape is fair; the release commits it).
-        if (!grabbed) material_.bending.follow(state_.d, std::min(1.0, springs.plasticity.rate * dt));
+        if (!grabbed)
+            material_.bending.follow(state_.d, std::min(1.0, springs.plasticity.rate * dt), region.whole ? nullptr : &region.mesh);
         verlet_.invalidate();  // the rest lengths moved under the forces Verlet carries over
     }
     time_ += dt;
     ++steps_;
     checkSleep();
     return r;
+}
+
+bool DynamicSurface::regionalScene() const {
+    return mirror_.empty() && held_.links().empty() && constraints().empty() && !forces_.hasExternal() &&
+           material_.springs.law.kind == LawKind::Linear && material_.dampingLaw.kind == LawKind::Linear;
+}
+
+void DynamicSurface::chooseRegion(bool allowed) {
+    GridRect reach;
+    const bool known = tool().reach(g(), h(), reach);
+    const double floorSpeed = sleep_.settings.tolerance * state_.size;
+    const Points* force = nullptr;
+    double floorForce = 0;
+    if (allowed && solver_.region.enabled && region_.wantsForces()) {
+        // After an edit: where the net is out of balance (the sleep test's force and measure).
+        forces_.potential(material_, state_.d);
+        state_.A.applyTransposed(forces_.total(), scratch_.poleForce);
+        held_.reduce(scratch_.poleForce);
+        force = &scratch_.poleForce;
+        floorForce = sleep_.settings.tolerance * material_.stiffnessMap.mean() * state_.size;
+    }
+    if (!region_.choose(state_.A, solver_.region, allowed, known, reach, state_.v, floorSpeed, force, floorForce)) return;
+    const ActiveRegion& region = region_.region();
+    if (region.whole) return;
+    // What falls outside stops where it is (it moved slower than the region chases), and
+    // local/global starts its history afresh from there.
+    for (Eigen::Index k = 0; k < state_.v.rows(); ++k)
+        if (!region.poles.containsIndex(k)) state_.v.row(k).setZero();
+    state_.avValid = false;
+    localGlobal_.restart();
+}
+
+void DynamicSurface::sampleRegion() {
+    const ActiveRegion& region = region_.region();
+    if (region.whole) state_.sampleMesh();
+    else state_.A.applyTo(state_.poles(), state_.d, region.mesh);
 }
 
 void DynamicSurface::prepare(double dt) {
@@ -362,7 +407,9 @@ bool DynamicSurface::limitEnergy(double work, StepReport& r) {
 }
 
 void DynamicSurface::checkSleep() {
-    if (!sleep_.watching(tool().grabbed()) || !sleep_.quietStep(state_.v.cwiseAbs().maxCoeff(), state_.size)) return;
+    double fastest = 0;  // (nothing outside the region moves)
+    region_.region().poles.forSpans([&](const auto& q) { fastest = std::max(fastest, q(state_.v).cwiseAbs().maxCoeff()); });
+    if (!sleep_.watching(tool().grabbed()) || !sleep_.quietStep(fastest, state_.size)) return;
     // Net force check, once, at the moment the surface would fall asleep.
     Points &dd = scratch_.meshVelocity, &fp = scratch_.poleForce;
     dd.setZero();
@@ -370,6 +417,7 @@ void DynamicSurface::checkSleep() {
     state_.A.applyTransposed(forces_.total(), fp);
     held_.reduce(fp);  // (the held poles' reactions are not motion)
     if (sleep_.settle(fp.cwiseAbs().maxCoeff(), material_.stiffnessMap.mean() * state_.size)) {
+        region_.forget();
         state_.v.setZero();
         state_.avValid = false;
         localGlobal_.restart();
@@ -388,12 +436,14 @@ double DynamicSurface::kineticEnergy() {
 }
 
 void DynamicSurface::restoreStepStart(bool keepVelocity) {
-    state_.mutablePoles() = state_.polesAtStart;
-    if (keepVelocity) state_.v = state_.velocitiesAtStart;
-    else state_.v.setZero();
+    region_.region().poles.forSpans([&](const auto& q) {  // (the step moved nothing else)
+        q(state_.mutablePoles()) = q(state_.polesAtStart);
+        if (keepVelocity) q(state_.v) = q(state_.velocitiesAtStart);
+        else q(state_.v).setZero();
+    });
     state_.avValid = false;
     localGlobal_.restart();
-    state_.sampleMesh();
+    sampleRegion();
     explicit_.invalidate();
     verlet_.invalidate();
 }

@@ -16,6 +16,7 @@
 #include "dynamics/pole_walls.hpp"
 #include "dynamics/sleep_monitor.hpp"
 #include "dynamics/surface_state.hpp"
+#include "solvers/active_region.hpp"
 #include "solvers/integrator_explicit.hpp"
 #include "solvers/integrator_implicit_cg.hpp"
 #include "solvers/integrator_local_global.hpp"
@@ -157,7 +158,7 @@ public:
     bool asleep() const { return sleep_.asleep(); }
     /// Something outside a step changed the state or the energy: the surface wakes, the carried
     /// accelerations are dropped and the energy guard starts a new ceiling.
-    void wake() { touch(); guard_.reset(); }
+    void wake() { touch(); guard_.reset(); region_.wholeNext(); }
     std::uint64_t stepCount() const { return steps_; }
     double time() const { return time_; }
     double workDone() const { return work_; }  ///< work of external and tool forces so far
@@ -166,6 +167,8 @@ public:
     /// Longest step local/global takes by its explicit Verlet branch in the current configuration
     /// (0 where it never does: switched off, non-linear laws, curvature constraints, smooth tool).
     double verletStepLimit();
+    /// What the last step moved: the whole net, or a region of it (active_region.hpp).
+    const ActiveRegion& activeRegion() const { return region_.region(); }
 
     /// Fair (fairing.cpp): relaxes the curvature variation where `weights` (one per mesh point, in
     /// [0, 1]) ask for it, by `strength` (>= 0) against staying put; held and linked poles and
@@ -201,8 +204,15 @@ private:
         wake();
     }
     StepModel model() {
-        return {state_, material_, forces_, held_, mirror_, systems_, scratch_, solver_};
+        return {state_, material_, forces_, held_, mirror_, systems_, scratch_, solver_, region_.region()};
     }
+    /// Whether a step of this scene may be regional: what it holds acts only where it is (no
+    /// symmetry, linked poles, penalty constraints or persistent forces, linear laws).
+    bool regionalScene() const;
+    /// Chooses the next step's region; where it changed, stops what falls outside it.
+    void chooseRegion(bool allowed);
+    /// The mesh from the poles, where the last step could have moved it.
+    void sampleRegion();
     /// Puts the poles exactly symmetric and the held and linked ones back; whether any moved.
     bool snapToConstraints();
     bool guardsEnergy(double dt, bool verlet) const;
@@ -229,6 +239,7 @@ private:
     VerletIntegrator verlet_;
     EnergyGuard guard_;
     SleepMonitor sleep_;
+    RegionChooser region_;
     std::uint64_t wakeKey_[5] = {0, 0, 0, 0, 0};  // the maps' and constraints' versions the last step saw
     double time_ = 0, work_ = 0;  // the clock, and the work of the applied forces
     std::uint64_t steps_ = 0;

@@ -43,7 +43,7 @@ void ExplicitIntegrator::substep(StepModel& m, double dt, int depth, StepReport&
     accelerate(m);
     const double amax = a_.cwiseAbs().maxCoeff();
     const double limit = m.settings.accelerationLimit > 0 ? m.settings.accelerationLimit : 0.1 * s.size / (dt * dt);
-    const double work = m.forces.appliedWork(s.d, before);
+    const double work = m.forces.appliedWork(s.d, before, m.region.halo);  // (always the whole mesh here)
     const double gained = energy_ - e0 - std::max(0.0, work);
     const bool ok = std::isfinite(amax) && amax <= limit && std::isfinite(energy_) &&
                     gained <= m.settings.energyTolerance * (e0 + std::abs(work)) +

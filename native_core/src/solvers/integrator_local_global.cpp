@@ -11,7 +11,6 @@
 // and v_n+1 = (x_n+1 - x^) / h, so it costs the same per step: one matrix, factored once.
 // Without history (first step, after an edit) BDF2 starts from x_n-1 = x_n - dt v_n + dt^2/2 a_n,
 // v_n-1 = v_n - dt a_n.
-#include <algorithm>
 #include "solvers/integrator_local_global.hpp"
 
 #include <algorithm>
@@ -42,20 +41,19 @@ LocalGlobalIntegrator::LocalGlobalIntegrator(Eigen::Index meshPoints, Eigen::Ind
 
 void LocalGlobalIntegrator::ensureImplicitTool(StepModel& m, int anchor) {
     ImplicitTool& t = tool_;
-    const SystemCache::Slot& slot = m.systems.current();
     const int partner = m.mirror.empty() ? anchor : m.mirror.mirrorPoint(anchor);
-    if (anchor == t.anchors[0] && partner == t.anchors[1] && slot.built == t.system) return;
+    if (anchor == t.anchors[0] && partner == t.anchors[1] && m.systemBuild() == t.system) return;
     t.anchors[0] = anchor;
     t.anchors[1] = partner;
     t.count = partner != anchor ? 2 : 1;
-    t.system = slot.built;
+    t.system = m.systemBuild();
     Points &unit = m.scratch.mesh2, &fp = m.scratch.poleForce;
     for (int k = 0; k < t.count; ++k) {  // z_k = S^-1 A^T e_anchor_k (the same in x, y, z: column 0)
         unit.setZero();
         unit.row(t.anchors[k]).setOnes();
         m.state.A.applyTransposed(unit, fp);
         m.held.reduce(fp);
-        slot.solver.solve(fp, t.z[k]);
+        m.solveSystem(fp, t.z[k]);
         m.held.expand(t.z[k]);
     }
     t.gram.setZero();
@@ -103,6 +101,25 @@ void LocalGlobalIntegrator::startHistory(StepModel& m, double dt) {
     }
 }
 
+void LocalGlobalIntegrator::settleOutside(StepModel& m) {
+    // Outside the region nothing moves: its poles' prediction is where they are, with no past
+    // motion, so every formula below gives them back unchanged and reads only the region.
+    SurfaceState& s = m.state;
+    const ActiveRegion& region = m.region;
+    for (Eigen::Index k = 0; k < s.poles().rows(); ++k)
+        if (!region.poles.containsIndex(k)) {
+            x_.row(k) = s.poles().row(k);
+            history_.p.row(k) = s.poles().row(k);
+            history_.v.row(k).setZero();
+        }
+    for (Eigen::Index k = 0; k < s.d.rows(); ++k)
+        if (!region.mesh.containsIndex(k)) {
+            history_.d.row(k) = s.d.row(k);
+            history_.av.row(k).setZero();
+            s.av.row(k).setZero();
+        }
+}
+
 StepReport LocalGlobalIntegrator::step(StepModel& m, double dt) {
     StepReport r;
     SurfaceState& s = m.state;
@@ -112,33 +129,48 @@ StepReport LocalGlobalIntegrator::step(StepModel& m, double dt) {
     const Eigen::VectorXd &gamma = material.damping(), &masses = material.masses();
     Points &tmp = m.scratch.mesh, &rhs = m.scratch.mesh2, &fp = m.scratch.poleForce, &inc = m.scratch.poleStep;
     Points& motion = m.scratch.meshVelocity;
+    // What the step moves: the poles P, the mesh points W they move, and W's halo H where forces
+    // are read (all of the net on a whole step: then each is one run).
+    const GridRect &P = m.region.poles, &W = m.region.mesh, &H = m.region.halo;
+    const bool regional = !m.region.whole;
     const bool bdf2 = m.settings.timeOrder == 2;
     const double h = systemStep(m.settings, dt);
-    m.ensureSystem(h, true);
+    m.ensureStepSystem(h);
     const Points& p = s.poles();
     if (!s.avValid) s.A.apply(s.v, s.av);
     const double w = bdf2 ? predictorWeight(m, dt, false) : 0.0;
     const Points* dBase = &s.d;  // x^ on the mesh
+    bool fresh = false;
+    if (bdf2 && (!history_.valid || history_.dt != dt)) {
+        startHistory(m, dt);
+        fresh = true;
+    }
+    if (regional && (fresh || m.region.serial != regionSerial_)) settleOutside(m);
+    regionSerial_ = m.region.serial;
     // y, the inertial prediction: x_ in control space, yMesh_ on the mesh (A y without a product by A)
     if (bdf2) {
-        if (!history_.valid || history_.dt != dt) startHistory(m, dt);
-        history_.xHat = (4.0 / 3.0) * p - (1.0 / 3.0) * history_.p;
-        x_ = history_.xHat + h * ((4.0 / 3.0) * s.v - (1.0 / 3.0) * history_.v);
-        history_.dHat = (4.0 / 3.0) * s.d - (1.0 / 3.0) * history_.d;
-        yMesh_ = history_.dHat + h * ((4.0 / 3.0) * s.av - (1.0 / 3.0) * history_.av);
+        P.forSpans([&](const auto& q) {
+            q(history_.xHat) = (4.0 / 3.0) * q(p) - (1.0 / 3.0) * q(history_.p);
+            q(x_) = q(history_.xHat) + h * ((4.0 / 3.0) * q(s.v) - (1.0 / 3.0) * q(history_.v));
+        });
+        H.forSpans([&](const auto& q) {
+            q(history_.dHat) = (4.0 / 3.0) * q(s.d) - (1.0 / 3.0) * q(history_.d);
+            q(yMesh_) = q(history_.dHat) + h * ((4.0 / 3.0) * q(s.av) - (1.0 / 3.0) * q(history_.av));
+        });
         dBase = &history_.dHat;
     } else {
-        x_ = p + dt * s.v;
-        yMesh_ = s.d + dt * s.av;
+        P.forSpans([&](const auto& q) { q(x_) = q(p) + dt * q(s.v); });
+        H.forSpans([&](const auto& q) { q(yMesh_) = q(s.d) + dt * q(s.av); });
     }
     // The tool pulls where the mesh is predicted at the step's end, as BDF2 wants its forces: taken
     // at the start, they made the rope scene first order. The tool is explicit, so its own slope
     // limits the prediction as the springs' does (the smooth tool's slope is unknown: none).
-    if (w > 0) motion = dt * s.av + (0.5 * dt) * (s.av - history_.av);  // the predicted motion over the step (mesh)
+    if (w > 0)  // the predicted motion over the step (mesh)
+        H.forSpans([&](const auto& q) { q(motion) = dt * q(s.av) + (0.5 * dt) * (q(s.av) - q(history_.av)); });
     const Tool& tool = forces.tool();
     const double wt = w > 0 && tool.grabbed() ? std::min(w, extrapolationWeight(dt * dt * m.toolSlope() / material.minMass())) : 0.0;
     if (wt > 0) {
-        tmp = s.d + wt * motion;
+        H.forSpans([&](const auto& q) { q(tmp) = q(s.d) + wt * q(motion); });
         m.applyTool(dt, r, tmp);
     } else {
         m.applyTool(dt, r, s.d);
@@ -160,10 +192,12 @@ StepReport LocalGlobalIntegrator::step(StepModel& m, double dt) {
         capacitance = (Eigen::Matrix2d::Identity() + toolC * implicit.gram).inverse();
     }
     // The parts of the right-hand side that do not depend on the iterate (see the loop).
-    base_ = (h * gamma).asDiagonal() * (*dBase - yMesh_);
-    if (forces.hasExternal()) base_ += (h * h) * forces.external();
-    if (forces.toolActive()) base_ += (h * h) * forces.fromTool();
-    if (material.dampingLaw.kind != LawKind::Linear) {
+    H.forRuns([&](Eigen::Index i, Eigen::Index n) {
+        base_.middleRows(i, n) = (h * gamma.segment(i, n)).asDiagonal() * (dBase->middleRows(i, n) - yMesh_.middleRows(i, n));
+        if (forces.hasExternal()) base_.middleRows(i, n) += (h * h) * forces.external().middleRows(i, n);
+        if (forces.toolActive()) base_.middleRows(i, n) += (h * h) * forces.fromTool().middleRows(i, n);
+    });
+    if (material.dampingLaw.kind != LawKind::Linear) {  // (never regional)
         // Extra non-linear damping, explicit, limited to h * extra / m <= 1 so it cannot destabilise.
         Points& springForce = forces.total();
         springForce.setZero();
@@ -177,8 +211,10 @@ StepReport LocalGlobalIntegrator::step(StepModel& m, double dt) {
     // The first iterate: y, or the end of the step predicted to O(dt^3) (predictorWeight).
     const Points* iterate = &yMesh_;
     if (w > 0) {
-        x_ += w * (p + dt * s.v + (0.5 * dt) * (s.v - history_.v) - x_);
-        tmp = yMesh_ + w * (s.d + motion - yMesh_);
+        P.forSpans([&](const auto& q) {
+            q(x_) += w * (q(p) + dt * q(s.v) + (0.5 * dt) * (q(s.v) - q(history_.v)) - q(x_));
+        });
+        H.forSpans([&](const auto& q) { q(tmp) = q(yMesh_) + w * (q(s.d) + q(motion) - q(yMesh_)); });
         iterate = &tmp;
     }
     // Each iteration solves for the increment from the iterate x (mesh d = A x):
@@ -187,50 +223,67 @@ StepReport LocalGlobalIntegrator::step(StepModel& m, double dt) {
     // puts M y (large) beside h^2 f (small): the solve's rounding, of the order of the positions,
     // then biases every step the same way, and BDF2 turns that into a drifting velocity (error
     // 4.7e-5 at a 1 us step in bench/time_vs_error.py's oscillation, growing as the step shrinks).
-    const PrefactoredSolver& system = m.systems.current().solver;
+    // A regional step reads the halo H and writes W's rows of the right-hand side, which are all
+    // that A^T takes onto the region's poles.
+    const GridRect* window = regional ? &H : nullptr;
+    const GridRect* rows = regional ? &W : nullptr;
     double change = 0;
     for (int it = 0; it < m.settings.iterations; ++it) {
         if (it > 0) {
-            s.A.apply(x_, tmp);
+            if (regional) s.A.applyTo(x_, tmp, H);
+            else s.A.apply(x_, tmp);
             iterate = &tmp;
         }
-        if (iterate == &yMesh_) rhs = base_;  // d = y
-        else rhs = base_ + (masses + h * gamma).asDiagonal() * (yMesh_ - *iterate);
-        m.material.springs.addProjections(*iterate, rhs, 0.25 * material.minMass() / (h * h), h * h);
-        material.bending.addForces(*iterate, rhs, h * h);  // quadratic: its force is J t - L d's part
-        if (!constraints.empty()) constraints.addProjections(*iterate, rhs, forces.terms(), h * h);
+        if (iterate == &yMesh_) H.forSpans([&](const auto& q) { q(rhs) = q(base_); });  // d = y
+        else
+            H.forRuns([&](Eigen::Index i, Eigen::Index n) {
+                rhs.middleRows(i, n) = base_.middleRows(i, n) + (masses.segment(i, n) + h * gamma.segment(i, n)).asDiagonal() *
+                                                                    (yMesh_.middleRows(i, n) - iterate->middleRows(i, n));
+            });
+        m.material.springs.addProjections(*iterate, rhs, 0.25 * material.minMass() / (h * h), h * h, false, window);
+        material.bending.addForces(*iterate, rhs, h * h, rows);  // quadratic: its force is J t - L d's part
+        if (!constraints.empty()) constraints.addProjections(*iterate, rhs, forces.terms(), h * h);  // (never regional)
         if (toolC > 0)
             for (int k = 0; k < implicit.count; ++k)
                 rhs.row(implicit.anchors[k]) -= toolC * (iterate->row(implicit.anchors[k]) - implicit.at[k].transpose());
-        s.A.applyTransposed(rhs, fp);
+        if (regional) s.A.applyTransposedTo(rhs, fp, P, W);
+        else s.A.applyTransposed(rhs, fp);
         m.held.reduce(fp);
-        system.solve(fp, inc);
+        m.solveSystem(fp, inc);
         m.held.expand(inc);
         if (toolC > 0) {  // inc -= Z (I + c G)^-1 c A_anchors inc, per coordinate
             const Vec3 moved0 = meshRow(s.A.matrix(), implicit.anchors[0], inc);
             const Vec3 moved1 = implicit.count == 2 ? meshRow(s.A.matrix(), implicit.anchors[1], inc) : Vec3::Zero();
-            for (int c = 0; c < 3; ++c) {
-                const Eigen::Vector2d weights = capacitance * (toolC * Eigen::Vector2d(moved0[c], moved1[c]));
-                for (int k = 0; k < implicit.count; ++k) inc.col(c) -= weights[k] * implicit.z[k].col(0);
-            }
+            Eigen::Vector2d weights[3];
+            for (int c = 0; c < 3; ++c) weights[c] = capacitance * (toolC * Eigen::Vector2d(moved0[c], moved1[c]));
+            P.forSpans([&](const auto& q) {
+                for (int c = 0; c < 3; ++c)
+                    for (int k = 0; k < implicit.count; ++k) q(inc).col(c) -= weights[c][k] * q(implicit.z[k]).col(0);
+            });
         }
-        change = inc.cwiseAbs().maxCoeff();
-        x_ += inc;
+        change = 0;
+        P.forSpans([&](const auto& q) {
+            change = std::max(change, q(inc).cwiseAbs().maxCoeff());
+            q(x_) += q(inc);
+        });
         ++r.iterations;
     }
     r.residual = change / s.size;
     if (bdf2) {
-        s.v = (x_ - history_.xHat) / h;
-        // History for the next step: the state this step started from.
-        history_.p = s.polesAtStart;
-        history_.v = s.velocitiesAtStart;
-        history_.d = s.meshAtStart;
+        P.forSpans([&](const auto& q) {
+            q(s.v) = (q(x_) - q(history_.xHat)) / h;
+            // History for the next step: the state this step started from.
+            q(history_.p) = q(s.polesAtStart);
+            q(history_.v) = q(s.velocitiesAtStart);
+        });
+        H.forSpans([&](const auto& q) { q(history_.d) = q(s.meshAtStart); });
         history_.av.swap(s.av);
     } else {
-        s.v = (x_ - p) / dt;
+        P.forSpans([&](const auto& q) { q(s.v) = (q(x_) - q(p)) / dt; });
     }
-    s.mutablePoles() = x_;
-    s.sampleMesh();
+    P.forSpans([&](const auto& q) { q(s.mutablePoles()) = q(x_); });
+    if (regional) s.A.applyTo(s.poles(), s.d, W);
+    else s.sampleMesh();
     if (toolC > 0) {
         // What the surface received is the linearised force at the step's end: the work the guard
         // counts takes it, and the reaction stays the exact opposite of the tool's own (not its
@@ -246,8 +299,8 @@ StepReport LocalGlobalIntegrator::step(StepModel& m, double dt) {
         }
     }
     // A v up to rounding, since A is linear, without a product by A
-    if (bdf2) s.av = (s.d - history_.dHat) / h;
-    else s.av = (s.d - s.meshAtStart) / dt;
+    if (bdf2) H.forSpans([&](const auto& q) { q(s.av) = (q(s.d) - q(history_.dHat)) / h; });
+    else H.forSpans([&](const auto& q) { q(s.av) = (q(s.d) - q(s.meshAtStart)) / dt; });
     s.avValid = true;
     history_.valid = bdf2;
     history_.dt = dt;

@@ -49,12 +49,16 @@ private:
     void ensureImplicitTool(StepModel& m, int anchor);
     /// The history of a step with none: synthesised from the current state and acceleration.
     void startHistory(StepModel& m, double dt);
+    /// On a regional step after the region changed or the history restarted: everything outside
+    /// the region at rest where it is (x_, history), so the step need not read it.
+    void settleOutside(StepModel& m);
 
     Bdf2History history_;
     Points x_;      // the iterate on the poles
     Points yMesh_;  // the inertial prediction on the mesh
     Points base_;   // the right-hand side's part that does not depend on the iterate
     ImplicitTool tool_;
+    std::uint64_t regionSerial_ = 0;  // the region the outside was last settled for
 };
 
 }  // namespace hs

@@ -6,7 +6,7 @@
 
 namespace hs {
 
-void PrefactoredSolver::factor(const Eigen::SparseMatrix<double>& m, const char* what) {
+void PrefactoredSolver::factor(const Eigen::SparseMatrix<double>& m, const char* what, int denseLimit) {
     ready_ = false;
     ldlt_.compute(m);
     if (ldlt_.info() != Eigen::Success)
@@ -24,7 +24,7 @@ void PrefactoredSolver::factor(const Eigen::SparseMatrix<double>& m, const char*
     n_ = static_cast<int>(m.rows());
     work_.resize(n_, 3);
     inverse_.resize(0, 0);
-    if (n_ <= kDenseLimit) {
+    if (n_ <= denseLimit) {
         inverse_ = ldlt_.solve(Eigen::MatrixXd::Identity(n_, n_));
         inverse_ = 0.5 * (inverse_ + inverse_.transpose()).eval();  // exactly symmetric
         bx_.resize(n_);

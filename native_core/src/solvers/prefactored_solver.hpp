@@ -11,8 +11,9 @@ namespace hs {
 
 class PrefactoredSolver {
 public:
-    /// Factors the symmetric positive definite matrix m; throws std::runtime_error naming `what` if it is not.
-    void factor(const Eigen::SparseMatrix<double>& m, const char* what);
+    /// Factors the symmetric positive definite matrix m, keeping its inverse up to `denseLimit`
+    /// unknowns; throws std::runtime_error naming `what` if it is not.
+    void factor(const Eigen::SparseMatrix<double>& m, const char* what, int denseLimit = kDenseLimit);
     bool ready() const { return ready_; }
     int size() const { return n_; }
     /// x = M^-1 b for the three columns at once; x and b may not alias.

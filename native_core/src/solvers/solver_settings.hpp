@@ -27,6 +27,22 @@ inline constexpr std::array<Named<IntegratorKind>, 3> kIntegratorNames{{
 /// terms' Laplacian (which bounds their Hessian for linear laws) and the tool's slope.
 constexpr double kVerletStability = 1.8;
 
+/// Regional steps (active_region.hpp): whether they are taken and how the region is chosen.
+struct RegionSettings {
+    bool enabled = false;  ///< take regional steps where the scene allows them
+    int margin = 4;        ///< quiet poles kept free around the moving ones
+    /// A pole moves when its speed exceeds this fraction of the fastest pole's (or the sleep
+    /// tolerance, whichever is larger): slower motion the region does not chase.
+    double wake = 1e-3;
+    static constexpr int kTile = 4;  ///< the region's sides fall on multiples of this many poles
+    /// A region of more than this fraction of the net is stepped as the whole net.
+    static constexpr double kWholeFraction = 0.6;
+    void validate() const {
+        requireInRange(margin, "region_margin", 1, 1000);
+        requireInRange(wake, "region_wake", 0.0, 1.0);
+    }
+};
+
 struct SolverSettings {
     IntegratorKind kind = IntegratorKind::LocalGlobal;
     int iterations = 1;              ///< local/global iterations per step
@@ -41,6 +57,7 @@ struct SolverSettings {
     int maxHalvings = 10;            ///< explicit: deepest recursion (at most 2^10 substeps a step)
     /// explicit: also halve while a substep gains more than this fraction of its energy beyond the work put in
     double energyTolerance = 0.01;
+    RegionSettings region;           ///< local/global: step only the region a stroke moves
     /// Throws std::invalid_argument naming the first bad field.
     void validate() const;
 };

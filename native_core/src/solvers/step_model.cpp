@@ -44,6 +44,7 @@ void StepModel::ensureSystem(double dt, bool factor) {
     Eigen::SparseMatrix<double> sys = A.transpose() * Sm * A;
     held.restrict(sys, true);
     slot.invDiag = sys.diagonal().cwiseInverse();  // Jacobi preconditioner
+    slot.matrix = sys;  // (regions cut theirs from it)
     if (factor) {
         ensureMass();  // throws first if the mesh does not see every control point
         try {
@@ -55,6 +56,26 @@ void StepModel::ensureSystem(double dt, bool factor) {
         }
     }
     systems.built(dt, factor, key);
+}
+
+void StepModel::ensureStepSystem(double dt) {
+    if (region.whole) {
+        ensureSystem(dt, true);
+        regionSystem = nullptr;
+        return;
+    }
+    ensureSystem(dt, false);
+    regionSystem = &systems.region(region.poles);
+}
+
+void StepModel::solveSystem(const Points& b, Points& x) {
+    if (!regionSystem) return systems.current().solver.solve(b, x);
+    SystemCache::RegionSlot& r = *regionSystem;
+    Eigen::Index k = 0;
+    region.poles.forRuns([&](Eigen::Index first, Eigen::Index n) { r.b.middleRows(k, n) = b.middleRows(first, n); k += n; });
+    r.solver.solve(r.b, r.x);
+    k = 0;
+    region.poles.forRuns([&](Eigen::Index first, Eigen::Index n) { x.middleRows(first, n) = r.x.middleRows(k, n); k += n; });
 }
 
 double StepModel::acceleration(Points& acc) {

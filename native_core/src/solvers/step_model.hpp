@@ -10,6 +10,7 @@
 #include "dynamics/material.hpp"
 #include "dynamics/mirror_symmetry.hpp"
 #include "dynamics/surface_state.hpp"
+#include "solvers/active_region.hpp"
 #include "solvers/solver_settings.hpp"
 #include "solvers/surface_forces.hpp"
 #include "solvers/system_cache.hpp"
@@ -34,6 +35,8 @@ struct StepModel {
     SystemCache& systems;
     Scratch& scratch;
     const SolverSettings& settings;
+    const ActiveRegion& region;  ///< what the step moves (the whole net, or a region of it)
+    SystemCache::RegionSlot* regionSystem = nullptr;  ///< the region's system, once ensured
 
     /// What the factored systems' structure depends on: the constraints' and the held poles'
     /// (both versions only grow, so the sum changes whenever either does).
@@ -46,6 +49,14 @@ struct StepModel {
     /// its factors, as the current slot of the cache; throws std::invalid_argument naming dt where
     /// dt is too long to factor.
     void ensureSystem(double dt, bool factor);
+    /// The system for dt, factored, as solveSystem() uses it: the whole net's (ensureSystem), or on
+    /// a regional step the region's, cut from the whole one (built but not factored).
+    void ensureStepSystem(double dt);
+    /// x = S^-1 b on the free poles, by the system of ensureStepSystem(): on a regional step only
+    /// the region's rows of b are read and of x written.
+    void solveSystem(const Points& b, Points& x);
+    /// Changes whenever the system solveSystem() uses is rebuilt.
+    std::uint64_t systemBuild() const { return regionSystem ? regionSystem->built : systems.current().built; }
     /// The tool's force on the mesh `at` (the current mesh, or a prediction of the step's end);
     /// returns whether the applied forces changed.
     bool applyTool(double dt, StepReport& r, const Points& at, double phase = 1.0) {

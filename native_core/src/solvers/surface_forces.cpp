@@ -27,11 +27,13 @@ void SurfaceForces::clearExternal() {
     hasExternal_ = false;
 }
 
-double SurfaceForces::appliedWork(const Points& d, const Points& before) const {
-    // (whole-array products, so the loop vectorises)
+double SurfaceForces::appliedWork(const Points& d, const Points& before, const GridRect& window) const {
+    // (whole runs of rows, so the loop vectorises)
     double work = 0;
-    if (hasExternal_) work += external_.cwiseProduct(d - before).sum();
-    if (toolActive_) work += fromTool_.cwiseProduct(d - before).sum();
+    window.forSpans([&](const auto& r) {
+        if (hasExternal_) work += r(external_).cwiseProduct(r(d) - r(before)).sum();
+        if (toolActive_) work += r(fromTool_).cwiseProduct(r(d) - r(before)).sum();
+    });
     return work;
 }
 
@@ -39,12 +41,16 @@ void SurfaceForces::setTool(const std::string& name) {
     auto t = makeTool(name);
     t->reserve(static_cast<size_t>(total_.rows()));
     tool_ = std::move(t);
+    fromTool_.setZero();
+    toolActive_ = false;
 }
 
 bool SurfaceForces::applyTool(const Points& at, int g, int h, double su, double sv, const MirrorSymmetry& mirror,
                               double dt, Reaction& reaction, double phase) {
     if (tool_->grabbed()) {
-        fromTool_.setZero();
+        // (only the rows it pushed last: a whole-mesh fill would cost a regional step its gain)
+        if (mirror.empty()) for (int i : tool_->pushed()) fromTool_.row(i).setZero();
+        else fromTool_.setZero();
         reaction = tool_->apply({at, g, h, su, sv}, cursor, dt, fromTool_, phase);
         if (!mirror.empty()) mirror.addMirrored(fromTool_);
         toolActive_ = true;

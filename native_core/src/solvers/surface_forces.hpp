@@ -31,13 +31,17 @@ public:
     bool toolActive() const { return toolActive_; }
     bool anyApplied() const { return hasExternal_ || toolActive_; }
     /// The work of the applied forces, held constant, over the mesh's motion from `before` to `d`.
-    double appliedWork(const Points& d, const Points& before) const;
+    double appliedWork(const Points& d, const Points& before, const GridRect& window) const;
 
     // --- the tool ---------------------------------------------------------------------------
     void setTool(const std::string& name);  ///< a tool of the catalogue (toolNames())
     Tool& tool() { return *tool_; }
     const Tool& tool() const { return *tool_; }
-    void swapTool(SurfaceForces& other) { std::swap(tool_, other.tool_); }
+    void swapTool(SurfaceForces& other) {
+        std::swap(tool_, other.tool_);
+        fromTool_.setZero();  // (its rows are cleared by the tool's last points: not this tool's)
+        other.fromTool_.setZero();
+    }
     Cursor cursor;
     /// The tool's force on the mesh `at` (reaction into `reaction`), mirrored; returns whether the
     /// applied forces changed (a held tool's change every step, a released one's once).

@@ -1,11 +1,15 @@
 // The factored control-space matrices and the versions of what they were built from: the mass
 // matrix A^T M A, and the system matrix A^T (M + dt D + dt^2 L) A for the two step lengths used
-// last (a session steps at its dt, and at twice it while catching up with real time).
+// last (a session steps at its dt, and at twice it while catching up with real time), and the
+// system of a few regions of the net (regional steps, active_region.hpp): the principal submatrix
+// of a system matrix on the region's poles, factored on its own.
 #pragma once
 #include <Eigen/SparseCore>
 #include <array>
 #include <cstdint>
+#include <vector>
 
+#include "common/grid_rect.hpp"
 #include "solvers/prefactored_solver.hpp"
 
 namespace hs {
@@ -19,6 +23,7 @@ public:
     /// One system matrix: its factors (if factored) and Jacobi diagonal.
     struct Slot {
         PrefactoredSolver solver;
+        Eigen::SparseMatrix<double> matrix;  ///< the system matrix, restricted to the free poles
         Eigen::VectorXd invDiag;
         Key key = {~0ull, ~0ull, ~0ull, ~0ull, ~0ull};
         double dt = -1;
@@ -41,7 +46,20 @@ public:
     void built(double dt, bool factored, const Key& key);
     const Slot& current() const { return slots_[current_]; }
 
+    /// The current slot's system on the poles of `poles` (the others held where they are),
+    /// factored on first use and kept for the last few regions; with its work buffers.
+    struct RegionSlot {
+        GridRect poles;
+        std::uint64_t system = 0;  ///< the build of the full system it was cut from
+        std::uint64_t built = 0, used = 0;
+        PrefactoredSolver solver;
+        Points b, x;  ///< the right-hand side and solution on the region's poles, in its order
+    };
+    RegionSlot& region(const GridRect& poles);
+    static constexpr int kRegionDenseLimit = 150;
+
 private:
+    std::array<RegionSlot, 4> regions_;
     PrefactoredSolver massSolver_;
     Eigen::SparseMatrix<double> massMatrix_;  // A^T M A, restricted to the free poles, as last factored
     std::uint64_t massVersion_ = ~0ull;

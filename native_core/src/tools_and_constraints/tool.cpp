@@ -1,5 +1,6 @@
 #include "tools_and_constraints/tool.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -73,6 +74,16 @@ void Tool::copySettings(const Tool& other) {
 void Tool::reserve(size_t n) {
     index_.reserve(n);
     force_.reserve(n);
+}
+
+GridRect boundingRect(const std::vector<int>& points, int h) {
+    if (points.empty()) return {0, 0, 0, 0, h};
+    GridRect r{points[0] / h, points[0] / h + 1, points[0] % h, points[0] % h + 1, h};
+    for (int p : points) {
+        r.r0 = std::min(r.r0, p / h); r.r1 = std::max(r.r1, p / h + 1);
+        r.c0 = std::min(r.c0, p % h); r.c1 = std::max(r.c1, p % h + 1);
+    }
+    return r;
 }
 
 int nearestPoint(const Points& d, const Vec3& x) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "common/grid_rect.hpp"
 #include "geometry/bspline_surface.hpp"
 #include "geometry/falloff.hpp"
 #include "tools_and_constraints/haptic_estimate.hpp"
@@ -116,6 +117,15 @@ public:
     /// The forces are those at `phase` of the way through the step on the clock (ramp, reel): 1 its
     /// end, as the implicit steps take them; 0.5 its middle, for Verlet's midpoint rule.
     Reaction apply(const MeshView& mesh, const Cursor& cursor, double dt, Points& f, double phase = 1.0);
+    /// The mesh points the tool may push until it is released, as a rectangle of the g x h mesh
+    /// (empty when it is not held); false where it cannot say (it may push anywhere).
+    virtual bool reach(int g, int h, GridRect& mesh) const {
+        (void)g;
+        mesh = {0, 0, 0, 0, h};
+        return !grabbed_;
+    }
+    /// The mesh points the last apply() pushed.
+    const std::vector<int>& pushed() const { return index_; }
     /// Mass point the tool is attached to (nearest point for the rope), -1 if none.
     virtual int anchor() const { return -1; }
     /// Steepest force per unit displacement on one mass point (infinite when unknown): how stiff
@@ -150,6 +160,9 @@ private:
     std::vector<int> index_;
     std::vector<Vec3> force_;
 };
+
+/// The smallest rectangle of a mesh with h columns holding the points `points`.
+GridRect boundingRect(const std::vector<int>& points, int h);
 
 /// Index of the mesh point nearest to x.
 int nearestPoint(const Points& d, const Vec3& x);

@@ -57,6 +57,11 @@ public:
     double slope() const override { return p(Stiffness); }  // stiffness x weight <= stiffness per point
     double readout(int i) const override { return i == Selected ? double(points_.size()) : 0.0; }
 
+    bool reach(int, int h, GridRect& mesh) const override {
+        mesh = grabbed_ ? boundingRect(points_, h) : GridRect{0, 0, 0, 0, h};
+        return true;
+    }
+
 protected:
     void computeForces(const MeshView& mesh, const Cursor& cursor) override {
         const Vec3 q = x0_ + normal_.dot(cursor.position - c0_) * normal_;

@@ -26,6 +26,10 @@ public:
         time_ = 0;
         grabbed_ = !points_.empty();
     }
+    bool reach(int, int h, GridRect& mesh) const override {
+        mesh = grabbed_ ? boundingRect(points_, h) : GridRect{0, 0, 0, 0, h};
+        return true;
+    }
     double slope() const override { return p(Stiffness); }  // stiffness x falloff weight <= stiffness per point
     double readout(int i) const override { return i == Selected ? double(points_.size()) : 0.0; }
 

@@ -25,6 +25,11 @@ public:
         grabbed_ = true;
     }
     int anchor() const override { return grabbed_ ? center_ : -1; }
+    bool reach(int g, int h, GridRect& mesh) const override {  // (the centre and its four neighbours)
+        mesh = grabbed_ ? GridRect{center_ / h, center_ / h + 1, center_ % h, center_ % h + 1, h}.grown(1, g)
+                        : GridRect{0, 0, 0, 0, h};
+        return true;
+    }
     double slope() const override { return p(Stiffness); }
 
 protected:

@@ -34,6 +34,10 @@ public:
         grabbed_ = true;
     }
     int anchor() const override { return grabbed_ ? point_ : -1; }
+    bool reach(int, int h, GridRect& mesh) const override {
+        mesh = grabbed_ ? GridRect{point_ / h, point_ / h + 1, point_ % h, point_ % h + 1, h} : GridRect{0, 0, 0, 0, h};
+        return true;
+    }
     double slope() const override { return gain_ * std::max(p(Stiffness), p(StiffStiffness)); }
     double anchorSlope() const override { return appliedScale_ * slopeNow_; }
     double readout(int i) const override { return i == RestLength ? restLengthAt(time_) : i == Gain ? gain_ : 0.0; }
