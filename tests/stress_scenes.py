@@ -260,6 +260,13 @@ def run_scene(seed: int, steps: int = STEPS) -> SceneResult:
                 point = normal * float(wall_rng.uniform(heights.min(), heights.max()) + 1e-3 * np.ptp(heights))
                 walls.append((point.tolist(), normal.tolist(), list(range(len(net)))))
             s.set_walls(walls)
+        # Regional steps in a third of the scenes (a stream of their own), with the smallest margin
+        # so that these small nets get regions smaller than themselves.
+        region_rng = np.random.default_rng([seed, 6])
+        if region_rng.random() < 0.33:
+            s.regional = True
+            s.region_margin = 1
+            s.region_wake = float(region_rng.choice([0.0, 1e-3, 1e-1, 1.0]))
         energy0 = _energy(s)
         work_in = 0.0
         last_work = s.work_done
