@@ -178,6 +178,49 @@ class TestToolSettings(DocumentTestCase):
                 self.assertEqual(getattr(made, key), p["default"], (name, key))
 
 
+class TestRegionalSteps(DocumentTestCase):
+    """hs.set_regional: a stroke near a corner of a large sculpt steps a region of it, the far
+    poles stay exactly where they were; the setting is one undo step, saved and reopened; bad
+    arguments are refused by name."""
+
+    def test_a_stroke_steps_a_region_and_the_setting_is_kept(self):
+        obj = hs.make_sculpt(self.doc, controls=(32, 32), mesh=(128, 128), size=(400.0, 400.0), name="Large")
+        self.doc.recompute()
+        hs.set_regional(obj, True, wake=0.05)
+        surface = obj.Proxy.surface
+        self.assertEqual((surface.regional, surface.region_wake, surface.region_margin), (True, 0.05, 4))
+        before = np.asarray(surface.poles).reshape(32, 32, 3).copy()
+        # (a short stroke: the elastic sheet's motion spreads, and past 0.1 s the region is the whole net)
+        dev = hs.ReplayDevice.stroke((-140.0, -140.0, 0.0), (-140.0, -140.0, 2.0), seconds=0.05, hold=0.0)
+        hs.run(obj, 0.05, device=dev, tool="rope")
+        surface = obj.Proxy.surface
+        region = surface.active_region
+        self.assertFalse(region["whole"])
+        r0, r1, c0, c1 = region["poles"]
+        after = np.asarray(surface.poles).reshape(32, 32, 3)
+        self.assertGreater(after[..., 2].max(), 0.2)
+        np.testing.assert_array_equal(after[r1:], before[r1:])  # beyond the region: untouched
+        np.testing.assert_array_equal(after[:, c1:], before[:, c1:])
+        path = f"{self.tmp}/regional.FCStd"
+        self.doc.saveAs(path)
+        got = report(self.tmp, path)["Large"]
+        self.assertEqual(got["error"], "")
+        settings = __import__("json").loads(got["settings"])
+        self.assertEqual((settings["regional"], settings["region_wake"]), (True, 0.05))
+        self.doc.undo()  # the stroke
+        self.doc.undo()  # the setting
+        self.assertFalse(obj.Proxy.surface.regional)
+
+    def test_bad_arguments_are_refused_by_name(self):
+        obj = hs.make_sculpt(self.doc)
+        for kwargs, name in (({"enabled": 1}, "enabled"), ({"wake": 2.0}, "wake"), ({"wake": "x"}, "wake"),
+                             ({"margin": 0}, "margin"), ({"margin": 2.5}, "margin")):
+            with self.assertRaises(ValueError) as caught:
+                hs.set_regional(obj, **kwargs)
+            self.assertIn(name, str(caught.exception))
+        self.assertFalse(obj.Proxy.surface.regional)
+
+
 class TestEditsCommitWhatChanged(DocumentTestCase):
     """An edit compares with what the document holds as the live surface last wrote it, instead of
     reading every state property back, and writes only what changed; a property written from
@@ -189,7 +232,7 @@ class TestEditsCommitWhatChanged(DocumentTestCase):
         states = [read_state(obj)]
         edits = [lambda: hs.set_uniform(obj, "stiffness", 300.0), lambda: hs.set_tool(obj, "magnet", radius=17.0),
                  lambda: stroke(obj), lambda: hs.set_uniform(obj, "bending", 2.0),
-                 lambda: hs.set_material(obj, "clay")]
+                 lambda: hs.set_material(obj, "clay"), lambda: hs.set_regional(obj, True, wake=0.05, margin=2)]
         for edit in edits:
             edit()
             states.append(read_state(obj))

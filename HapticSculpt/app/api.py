@@ -193,6 +193,29 @@ def material_of(obj: Any) -> str:
     return "clay" if _sculpt(obj, solids=True).Proxy.live.snapshot().plasticity[0] else "elastic"
 
 
+def set_regional(obj: Any, enabled: bool = True, wake: float | None = None, margin: int | None = None) -> None:
+    """Regional steps (docs/solver.md): a stroke steps only the region of poles it moves, plus
+    `margin` quiet poles (1..1000, default 4), the rest held at rest until the motion reaches it;
+    a pole counts as moving above `wake` (0..1, default 0.01) of the fastest one's speed. Faster on
+    large nets where a stroke stays local, at an error docs/benchmarks.md measures; off by default.
+    One undo step; a running session takes it at once."""
+    obj = _sculpt(obj, solids=True)
+    if not isinstance(enabled, bool):
+        raise ValueError(f"enabled: True or False, got {enabled!r}")
+    if wake is not None and not (isinstance(wake, (int, float)) and 0.0 <= wake <= 1.0):
+        raise ValueError(f"wake: a fraction in [0, 1], got {wake!r}")
+    if margin is not None and not (isinstance(margin, int) and not isinstance(margin, bool) and 1 <= margin <= 1000):
+        raise ValueError(f"margin: a whole number of poles in 1..1000, got {margin!r}")
+
+    def apply(s: core.DynamicSurface) -> None:
+        s.regional = enabled
+        if wake is not None:
+            s.region_wake = float(wake)
+        if margin is not None:
+            s.region_margin = margin
+    obj.Proxy.live.edit(apply, "Regional steps " + ("on" if enabled else "off"))
+
+
 def keep_shape(obj: Any) -> None:
     """Makes the current shape the rest shape, so an elastic sculpt stays as it is. One undo
     step; a running session takes it at once, also while the tool is held."""

@@ -103,6 +103,9 @@ def capture(surface: core.DynamicSurface) -> SculptState:
         "iterations": surface.iterations,
         "time_order": surface.time_order,
         "explicit_when_stable": surface.explicit_when_stable,
+        "regional": surface.regional,
+        "region_margin": surface.region_margin,
+        "region_wake": surface.region_wake,
         "cg_iterations": surface.cg_iterations,
         "acceleration_limit": surface.acceleration_limit,
         "max_halvings": surface.max_halvings,
@@ -259,7 +262,8 @@ def _float_list(s: dict[str, Any], key: str, n: int) -> list[float]:
 def _apply_settings(surface: core.DynamicSurface, s: dict[str, Any]) -> None:
     """Solver, laws, plasticity and tool; a missing key keeps the core's default (older files)."""
     try:
-        for key in ("integrator", "iterations", "time_order", "explicit_when_stable", "cg_iterations",
+        for key in ("integrator", "iterations", "time_order", "explicit_when_stable", "regional", "region_margin",
+                    "region_wake", "cg_iterations",
                     "acceleration_limit", "max_halvings",
                     "sleep_enabled", "sleep_tolerance", "constraint_stiffness_factor", "max_point_force"):
             if key in s:
