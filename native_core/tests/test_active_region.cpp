@@ -29,13 +29,13 @@ std::unique_ptr<DynamicSurface> patch(bool regional, double wake = 1e-2) {
 }
 
 /// A rope grabbed 15 % in from a corner and pulled up 50 mm/s for `pull` s (then held) for `steps`
-/// steps of 1 ms.
-void pullNearCorner(DynamicSurface& s, int steps, double pull = 0.2) {
+/// steps of 1 ms from step `first` of the stroke.
+void pullNearCorner(DynamicSurface& s, int steps, double pull = 0.2, int first = 0) {
     Cursor c;
     c.position = Vec3(-140, -140, 0);
     c.grab = true;
     for (int k = 0; k < steps; ++k) {
-        c.position.z() = 50 * std::min(k * 1e-3, pull);
+        c.position.z() = 50 * std::min((first + k) * 1e-3, pull);
         s.setCursor(c);
         s.step(1e-3);
     }
@@ -70,6 +70,21 @@ TEST(ActiveRegion, ARegionGrowsWhenItsMovingNeighboursPullTheNextPoles) {
     // The motion spread from the rope's poles: the region took in poles it had held.
     EXPECT_TRUE(later.whole || later.poles.count() > first.count());
     EXPECT_GT(later.serial, 1u);
+}
+
+TEST(ActiveRegion, AnEditMidStrokeDoesNotShrinkTheRegionUnderMovingPoles) {
+    // A region drops only poles at rest: choosing afresh after an edit (or a whole step) by the
+    // wake's share of the fastest speed stopped moving poles (seen: 0.66 mm off the whole run 25
+    // steps later, where keeping their motion stays 0.05 mm off).
+    auto s = patch(true, 0.3);
+    pullNearCorner(*s, 100);
+    const GridRect before = s->activeRegion().poles;
+    ASSERT_FALSE(s->activeRegion().whole);
+    s->setSolver(s->solver());  // (an edit: the region is chosen afresh)
+    pullNearCorner(*s, 1, 0.2, 100);
+    const GridRect after = s->activeRegion().poles;
+    EXPECT_TRUE(s->activeRegion().whole ||
+                (after.r0 <= before.r0 && after.r1 >= before.r1 && after.c0 <= before.c0 && after.c1 >= before.c1));
 }
 
 TEST(ActiveRegion, ARegionalStrokeStaysNearTheWholeOne) {

@@ -31,7 +31,9 @@ bool RegionChooser::choose(const SamplingOperator& A, const RegionSettings& sett
     searched.forRuns([&](Eigen::Index first, Eigen::Index n) {
         fastest = std::max(fastest, v.middleRows(first, n).cwiseAbs().maxCoeff());
     });
-    const double moving = std::max(floorSpeed, settings.wake * fastest);
+    // Out of a whole step, every pole faster than the sleep test's floor stays in: a region drops
+    // only poles at rest, never motion (growing, it adds poles the region held at rest).
+    const double moving = region_.whole ? floorSpeed : std::max(floorSpeed, settings.wake * fastest);
     GridRect want{nu, 0, nv, 0, nv};
     const auto include = [&](int i0, int i1, int j0, int j1) {
         want.r0 = std::min(want.r0, i0); want.r1 = std::max(want.r1, i1);

@@ -33,7 +33,7 @@ struct RegionSettings {
     int margin = 4;        ///< quiet poles kept free around the moving ones
     /// A pole moves when its speed exceeds this fraction of the fastest pole's (or the sleep
     /// tolerance, whichever is larger): slower motion the region does not chase.
-    double wake = 1e-3;
+    double wake = 1e-2;
     static constexpr int kTile = 4;  ///< the region's sides fall on multiples of this many poles
     /// A region of more than this fraction of the net is stepped as the whole net.
     static constexpr double kWholeFraction = 0.6;
