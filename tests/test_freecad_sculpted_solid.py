@@ -221,6 +221,20 @@ class TestSculptedSolid(SolidChecks):
         pull(obj, (0, 10, 15), (0, 5, 0))  # (not on the seam, which is held)
         self.check_sculpted(obj, cyl, side)  # (the ring pulled out at one side comes in at the other)
 
+    def test_a_cylinders_top_is_refined_until_a_stroke_moves_it(self):
+        """A disc's circle held every pole shaping its inside on the 8 x 8 net (a stroke moved
+        nothing); the net is refined until a quarter of them are free."""
+        cyl = self.part(Part.makeCylinder(20, 30), "Cylinder")
+        top = face_named(cyl.Shape, lambda f: isinstance(f.Surface, Part.Plane) and abs(f.CenterOfMass.z - 30) < 1e-9)
+        obj = hs.sculpt_solid(self.doc, cyl, [top])
+        controls = json.loads(obj.Resolution)["controls"]
+        self.assertGreater(min(controls), 8)
+        before = mass_point_near(obj, 0, 0).copy()  # (a view of the core's buffer)
+        pull(obj, (0, 0, 30), (0, 0, 6))
+        after = mass_point_near(obj, 0, 0)
+        self.assertGreater(after[2] - before[2], 1.5)  # the middle of the top rose (8 x 8: not at all)
+        self.check_sculpted(obj, cyl, top)
+
     def test_pad_top_with_a_pocketed_hole(self):
         import Sketcher
         body = self.doc.addObject("PartDesign::Body", "Body")
