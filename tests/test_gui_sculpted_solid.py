@@ -239,6 +239,45 @@ def test_a_top_picked_with_a_plane_is_sculpted_mirrored(tmp_path):
 
 
 #: A 40 x 40 x 20 box, made and saved by FreeCAD's GUI.
+
+CYLINDER = """
+import json, os
+import FreeCAD, FreeCADGui, Part
+doc = FreeCAD.newDocument("Can")
+part = doc.addObject("Part::Feature", "Cylinder")
+part.Shape = Part.makeCylinder(20, 30)
+doc.recompute()
+doc.saveAs(PATH)
+json.dump({"volume": part.Shape.Volume}, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_a_mouse_stroke_lifts_a_cylinders_top(tmp_path):
+    """A cylinder's top (a disc) clicked, sculpted and pulled up with the mouse: on the 8 x 8 net its
+    circle held every pole shaping its inside and the stroke moved nothing; now the net is refined
+    and the solid grows. Screenshot: real_solid_cylinder_top.png."""
+    os.makedirs(SHOTS, exist_ok=True)
+    path = str(tmp_path / "can.FCStd")
+    part = run_freecad_gui(f"PATH = {path!r}\n" + CYLINDER, str(tmp_path))
+    d = Desktop(str(tmp_path), "CAD", open_file=path)
+    try:
+        s = view_part(d, "Cylinder")
+        centre = d.to_screen(s["docs"][s["active"]]["screen"]["Cylinder"][0])  # (0, 0, 30): the top's centre
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.wait(lambda s: s["mouse_point"] is not None and abs(s["mouse_point"][2] - 30) < 0.5, "the mouse on the top")
+        d.xdo("click", "1")
+        d.wait(lambda s: [o for o, _ in s["selection"]] == ["Cylinder"], "the top face selected")
+        d.press_button("SculptFace", lambda s: s["docs"][s["active"]]["solids"], "the SculptedSolid")
+        s = stroke_in_session(d, centre, 8, 12, 0.8)
+        d.shot("solid_cylinder_top")
+        pulled = solid(s)
+        assert pulled["valid"] and pulled["solids"] == 1 and not pulled["error"], pulled
+        assert pulled["volume"] - part["volume"] > 20.0, (pulled["volume"], part["volume"])  # the top rose
+    finally:
+        d.close()
+
 BOX = """
 import json, os
 import FreeCAD, FreeCADGui, Part
