@@ -270,7 +270,16 @@ def test_a_mouse_stroke_lifts_a_cylinders_top(tmp_path):
         d.xdo("click", "1")
         d.wait(lambda s: [o for o, _ in s["selection"]] == ["Cylinder"], "the top face selected")
         d.press_button("SculptFace", lambda s: s["docs"][s["active"]]["solids"], "the SculptedSolid")
-        s = stroke_in_session(d, centre, 8, 12, 0.8)
+        hold = lambda s: "HapticSculpt_HoldEdges" not in s["toolbars"]["disabled"]  # noqa: E731 (enabled)
+        d.wait(hold, "Hold edges enabled")
+        d.press_button("Session", lambda s: s["docs"][s["active"]]["sculpts"][0]["session"], "the session")
+        # (a solid's edges change only between sessions: greyed out, not enabled and refusing)
+        d.wait(lambda s: not hold(s), "Hold edges greyed out during the session")
+        d.drag([centre] + [(centre[0], centre[1] - 8 * k) for k in range(1, 13)], seconds=0.8)
+        d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
+        d.click_button("Session")
+        s = d.wait(lambda s: not s["docs"][s["active"]]["sculpts"][0]["session"] and hold(s),
+                   "the session to stop and Hold edges enabled again")
         d.shot("solid_cylinder_top")
         pulled = solid(s)
         assert pulled["valid"] and pulled["solids"] == 1 and not pulled["error"], pulled

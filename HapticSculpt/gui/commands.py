@@ -299,6 +299,13 @@ class HoldEdges(_SculptCommand):
            "tangent planes too, G2 the curvature across them too, G3 its rate; each press goes free, G0, G1, "
            "G2, G3, free, skipping what the net cannot hold (a face sculpted in its solid: G0 to G3)")
 
+    def IsActive(self) -> bool:
+        # (a solid's edges change with a rebuilt net, which waits for the session to stop: greyed
+        # out meanwhile, where it used to stay enabled and refuse with a warning)
+        from ..app.sculpted_solid import solid_of
+        obj = _ctl().active_sculpt()
+        return obj is not None and not (solid_of(obj) is not None and obj.Proxy.live.session is not None)
+
     def Activated(self) -> None:
         from ..app.api import BOUNDARIES, boundary_poles, held_boundary
         from ..app.sculpted_solid import boundary_of, chain_of_solid, solid_of

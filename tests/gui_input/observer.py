@@ -282,6 +282,7 @@ def _toolbars():
     where that is, and the open drop-down or menu's entries."""
     mw = Gui.getMainWindow()
     bars, buttons, groups, open_menus = {}, {}, {}, {}
+    disabled: list = []  # (a drop-down's entries that are greyed out)
     for bar in mw.children():
         if not bar.inherits("QToolBar") or not bar.isVisible():  # (FreeCAD 1.0's are Gui::ToolBar)
             continue
@@ -298,6 +299,8 @@ def _toolbars():
                     hidden.append(name)
                 if tb.menu() is not None:
                     groups[name] = list(_entries(tb.menu()))
+                    disabled += [_command_name(a) for a in tb.menu().actions()
+                                 if not a.isSeparator() and a.isVisible() and not a.isEnabled()]
                     if tb.menu().isVisible():
                         open_menus[name] = _entries(tb.menu())
         bars[bar.objectName()] = {"rect": _rect(bar), "buttons": shown, "hidden": extension is not None,
@@ -309,7 +312,7 @@ def _toolbars():
             menus[title] = _rect(mw.menuBar(), mw.menuBar().actionGeometry(a))
             if a.menu().isVisible():
                 open_menus[title] = _entries(a.menu())
-    return {"bars": bars, "buttons": buttons, "groups": groups, "menus": menus, "open": open_menus,
+    return {"bars": bars, "buttons": buttons, "groups": groups, "disabled": disabled, "menus": menus, "open": open_menus,
             "commands": [c for c in Gui.listCommands() if c.startswith("HapticSculpt_")]}
 
 
