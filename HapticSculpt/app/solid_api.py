@@ -85,8 +85,8 @@ def _holds(made: Any, chain: face_chain.FaceChain, edges: list[face_in_solid.Fac
     return made, held, links
 
 
-#: A face whose trim holds more than 1 - this of the poles that shape its inside is refined before
-#: it is sculpted: a cylinder's top (a disc, radius 20) on the 8 x 8 net had 71 of its 100 poles
+#: A face with a trim inside its parameter rectangle (a disc's circle, a hole) that holds more than
+#: 1 - this of the poles that shape its inside is refined before it is sculpted: a cylinder's top (a disc, radius 20) on the 8 x 8 net had 71 of its 100 poles
 #: held by the circle and none free inside it, so a stroke moved nothing. Each pass takes 1.5 times
 #: the controls; the disc ends at 32 x 32, where a 6 mm rope pull lifts its middle 2.1 mm (a 40 mm
 #: box top: 2.3 mm; at 18 x 18, a quarter free: 1.0 mm).
@@ -186,6 +186,8 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
         made = face_source(base, chain, edges, controls, degree, TRIM_SPANS, mirror)
         net_kinds = seam_kinds(made, chain, kinds, asked)
         made, held, links = _holds(made, chain, edges, net_kinds, mirror, ", ".join(faces))
+        if not any(e.side is None for e in edges):
+            break  # (edges on the net's sides hold rows as asked: G2 holds three; no trim to refine for)
         free, inside = free_inside(made, held, links, shape, faces)
         grown = (min(MAX_REFINED_CONTROLS * per_face, controls[0] * 3 // 2), min(MAX_REFINED_CONTROLS, controls[1] * 3 // 2))
         if free >= MIN_FREE_INSIDE * inside or grown == controls:
