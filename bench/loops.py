@@ -34,7 +34,7 @@ from HapticSculpt import core  # noqa: E402
 from HapticSculpt.core import native as _core  # noqa: E402
 from HapticSculpt.runtime.replay_device import ReplayDevice  # noqa: E402
 
-SCENES = [((12, 12), (40, 40), 5e-4), ((32, 32), (128, 128), 1e-3)]
+SCENES = [((12, 12), (40, 40), 5e-4), ((32, 32), (128, 128), 1e-3), ((64, 64), (256, 256), 1e-3)]
 
 
 def trajectory(seconds: float) -> ReplayDevice:
@@ -88,9 +88,10 @@ class Load:
         self.hog.join()
 
 
-def run_scene(controls, mesh, sim_dt, seconds, rate, load="none", **settings):
+def run_scene(controls, mesh, sim_dt, seconds, rate, load="none", regional=False, **settings):
     surface = core.patch(controls, (3, 3), mesh, (100.0, 100.0))
     surface.damping_map.set_uniform(5.0)
+    surface.regional = regional
     native = trajectory(seconds).native
     runtime = _core.HapticRuntime(surface, native, haptic_rate=rate, sim_dt=sim_dt, log_seconds=seconds + 1,
                                   stop_when_finished=True, **settings)
@@ -114,7 +115,7 @@ def run_scene(controls, mesh, sim_dt, seconds, rate, load="none", **settings):
     ticks = runtime.ticks()
     periods = np.diff(ticks["t"]) * 1e3
     return {
-        "scene": f"{controls[0]}x{controls[1]}/{mesh[0]}x{mesh[1]}",
+        "scene": f"{controls[0]}x{controls[1]}/{mesh[0]}x{mesh[1]}" + (" reg" if regional else ""),
         "load": load,
         "overlay_frames": frames,
         "seconds": status["elapsed"],
@@ -174,18 +175,22 @@ def main() -> None:
     ap.add_argument("--max-lag", type=float, default=None, help="the runtime's max_lag (s) instead of its default")
     ap.add_argument("--no-catch-up", action="store_true",
                     help="a simulation behind real time drops the backlog instead of taking double steps")
+    ap.add_argument("--scenes", default="40,128,256", help="which scenes to run, by mesh side (40, 128, 256)")
+    ap.add_argument("--regional", action="store_true", help="also run each scene with regional steps (s.regional)")
     ap.add_argument("--no-realtime", action="store_true",
                     help="do not ask for real-time priority for the haptic thread (sessions ask by default)")
     args = ap.parse_args()
     os.makedirs(os.path.join(ROOT, "bench", "results"), exist_ok=True)
     results, data = [], []
-    for controls, mesh, sim_dt in SCENES:
+    wanted = {int(m) for m in args.scenes.split(",")}
+    for (controls, mesh, sim_dt), regional in [(scene, r) for scene in SCENES if scene[1][0] in wanted
+                                               for r in ((False, True) if args.regional else (False,))]:
         for load in args.loads.split(","):
             settings = {k: v for k, v in (("spin", args.spin), ("sim_nice", args.sim_nice), ("max_lag", args.max_lag))
                         if v is not None}
             settings["realtime"] = not args.no_realtime
             settings["catch_up"] = not args.no_catch_up
-            r, periods, errors = run_scene(controls, mesh, sim_dt, args.seconds, args.rate, load, **settings)
+            r, periods, errors = run_scene(controls, mesh, sim_dt, args.seconds, args.rate, load, regional, **settings)
             results.append(r)
             data.append((periods, errors))
     print(f"{'scene':<14}{'load':>8}{'rt':>3}{'haptic Hz':>10}{'p50 ms':>8}{'p99 ms':>8}{'max ms':>8}{'sim Hz':>9}"
@@ -199,10 +204,14 @@ def main() -> None:
     main_scene = dict(results[0])
     main_scene["scenes"] = results
     main_scene["machine"] = f"{os.cpu_count()} cores"
-    with open(os.path.join(ROOT, "bench", "results", "loops.json"), "w") as f:
+    # (a run of some scenes, or with regional steps, has files of its own: loops.json's top level
+    # is the 12x12/40x40 scene)
+    name = "loops" if args.scenes == "40,128,256" and not args.regional else \
+        "loops_" + args.scenes.replace(",", "_") + ("_regional" if args.regional else "")
+    with open(os.path.join(ROOT, "bench", "results", name + ".json"), "w") as f:
         json.dump(main_scene, f, indent=2)
-    plot(results, data, os.path.join(ROOT, "bench", "results", "loops.png"))
-    print("wrote bench/results/loops.json, bench/results/loops.png")
+    plot(results, data, os.path.join(ROOT, "bench", "results", name + ".png"))
+    print(f"wrote bench/results/{name}.json, bench/results/{name}.png")
 
 
 if __name__ == "__main__":

@@ -14,7 +14,11 @@ largest force (full scale, as haptic devices state theirs); beside it, the whole
 against the same stroke at dt / 8 (the default step's error against a converged one). Times are
 medians over the pull (a step after a region change included, the first 20 steps not).
 
-Prints a table and writes bench/results/scale.json and scale.png.
+A third table runs a region that never grows (region_wake 1: the far field frozen, not an
+accurate setting) on nets up to 512 x 512: what the regional machinery itself costs against the
+net's size, with the first step (which builds the whole system matrix) and peak memory.
+
+Prints the tables and writes bench/results/scale.json and scale.png.
 
     /usr/bin/python3 bench/scale.py [--sizes 32 64 128 256] [--big]   (--big adds 512 x 512)
 """
@@ -40,6 +44,7 @@ SWEEP = (1e-2, 3e-2, 1e-1, 3e-1)
 
 def stroke(mesh: int, kind: str, regional: bool, sub: int = 1, material: str = "clay", wake: float = WAKE) -> dict:
     """One stroke on an m x m patch; its per-step times, mesh at HOLD and END, and reactions."""
+    setup_start = time.perf_counter()
     s = core.patch((mesh // 4, mesh // 4), mesh=(mesh, mesh), size=(400.0, 400.0))
     if material == "clay":  # the GUI's default material (HapticSculpt.app.api)
         s.set_plasticity(*CLAY)
@@ -53,6 +58,7 @@ def stroke(mesh: int, kind: str, regional: bool, sub: int = 1, material: str = "
         start = np.array([0.0, 0.0, 0.0])
     else:
         start = np.array([-140.0, -140.0, 0.0])
+    setup = time.perf_counter() - setup_start
     dt = DT / sub
     steps = int(round(END / dt))
     times, forces, snaps = [], [], {}
@@ -72,7 +78,7 @@ def stroke(mesh: int, kind: str, regional: bool, sub: int = 1, material: str = "
     pull = np.asarray(times[int(0.02 / dt):int(PULL / dt)]) * sub
     return {"step_us": float(np.median(pull) * 1e6), "max_step_us": float(pull.max() * 1e6),
             "snaps": snaps, "forces": np.asarray(forces), "region": s.active_region,
-            "regional_fraction": regional_steps / steps,
+            "regional_fraction": regional_steps / steps, "first_step_ms": times[0] * sub * 1e3, "setup_s": setup,
             "rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
 
 
@@ -114,6 +120,26 @@ def sweep(mesh: int, material: str) -> list[dict]:
     return out
 
 
+def machinery(mesh: int) -> dict:
+    """The regional step's own scaling: a region that never grows (region_wake 1: the rope's reach
+    and the margin only, the far field frozen), clay, on nets up to 512 x 512: per-step cost,
+    the first step (it builds the whole system matrix), the net's set-up and the process's peak
+    memory (each size in a process of its own, so the peak is that size's)."""
+    import subprocess
+    code = f"""
+import json, resource, sys, time
+sys.path.insert(0, {os.path.join(ROOT, "bench")!r})
+import scale
+t0 = time.perf_counter()
+r = scale.stroke({mesh}, "local", True, wake=1.0, material="clay")
+print(json.dumps({{"mesh": {mesh}, "step_us": r["step_us"], "first_step_ms": r["first_step_ms"],
+                  "setup_s": r["setup_s"], "region": r["region"],
+                  "rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}}))
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    return json.loads(out.strip().splitlines()[-1])
+
+
 def plot(rows: list[dict], path: str) -> None:
     import matplotlib
     matplotlib.use("Agg")
@@ -142,7 +168,8 @@ def plot(rows: list[dict], path: str) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--sizes", type=int, nargs="+", default=[32, 64, 128, 256])
-    ap.add_argument("--big", action="store_true", help="add 512 x 512 (regional only has a chance there)")
+    ap.add_argument("--big", action="store_true", help="add 512 x 512 to the whole-against-regional table "
+                    "(the fixed-region table always has it)")
     ap.add_argument("--materials", nargs="+", choices=("clay", "elastic"), default=["clay", "elastic"],
                     help="clay (the GUI's default: plastic, damping 10), elastic (damping 1); bending 10 both")
     ap.add_argument("--no-reference", action="store_true", help="skip the dt/8 runs (the solver's own error)")
@@ -179,10 +206,20 @@ def main() -> None:
             print(f"{material:>8} {r['wake']:>6g} {r['whole_us']:>9.0f} {r['regional_us']:>12.0f} "
                   f"{r['regional_fraction']:>9.0%} {r['error_mm'][str(HOLD)]:>9.3g} {r['error_mm'][str(END)]:>9.3g} "
                   f"{r['force_error_p99']:>9.2%}", flush=True)
+    print("\nthe regional step's own scaling: a region that never grows (region_wake 1), clay:")
+    print(f"{'mesh':>5} {'region (poles)':>16} {'step us':>8} {'first step ms':>14} {'set-up s':>9} {'peak MB':>8}")
+    fixed = []
+    for mesh in sorted(set(args.sizes + [512])):
+        if mesh < 64:
+            continue
+        r = machinery(mesh)
+        fixed.append(r)
+        print(f"{mesh:>5} {'{}..{}x{}..{}'.format(*r['region']['poles']):>16} {r['step_us']:>8.0f} "
+              f"{r['first_step_ms']:>14.0f} {r['setup_s']:>9.2f} {r['rss_mb']:>8.0f}", flush=True)
     out = os.path.join(ROOT, "bench", "results")
     os.makedirs(out, exist_ok=True)
     with open(os.path.join(out, "scale.json"), "w") as f:
-        json.dump({"dt": DT, "wake": WAKE, "rows": rows, "sweep": swept}, f, indent=1)
+        json.dump({"dt": DT, "wake": WAKE, "rows": rows, "sweep": swept, "fixed_region": fixed}, f, indent=1)
     plot(rows, os.path.join(out, "scale.png"))
 
 
