@@ -68,6 +68,8 @@ native, NATIVE_ORIGIN = _load_native()
 BSplineSurface = native.BSplineSurface
 DynamicSurface = native.DynamicSurface
 MaterialMap = native.MaterialMap
+#: Nearest-point queries over a fixed cloud (a scan): ``PointTree(points).nearest(queries)``.
+PointTree = native.PointTree
 StepReport = native.StepReport
 Tool = native.Tool
 #: A tool by name, on its own (its settings checked as on a surface's tool): ``make_tool("flatten")``.
@@ -107,6 +109,6 @@ def patch(controls: tuple[int, int] = (8, 8), degree: tuple[int, int] = (3, 3),
     return DynamicSurface(BSplineSurface.plane(controls, degree, size), mesh)
 
 
-__all__ = ["BSplineSurface", "DynamicSurface", "MaterialMap", "StepReport", "Tool", "MAX_DEGREE", "ROPE_PLATE_GAIN",
+__all__ = ["BSplineSurface", "DynamicSurface", "MaterialMap", "PointTree", "StepReport", "Tool", "MAX_DEGREE", "ROPE_PLATE_GAIN",
            "INTEGRATORS", "TOOLS", "TOOL_INFO", "make_tool", "CONSTRAINTS", "FALLOFFS", "LAWS", "MAPS", "DEFAULTS", "tool_settings_of",
            "patch"]

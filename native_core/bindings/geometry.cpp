@@ -3,11 +3,15 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
+#include <cstdint>
 #include <optional>
 
 #include "geometry/falloff.hpp"
 #include "bindings.hpp"
 #include "geometry/bspline_surface.hpp"
+#include "geometry/point_tree.hpp"
+#include "geometry/surface_projection.hpp"
 #include "convert.hpp"
 
 namespace py = pybind11;
@@ -24,6 +28,12 @@ py::dict curvatureDict(const Curvature& c) {
     py::dict r;
     r["u"] = c.ku; r["v"] = c.kv; r["min"] = c.kmin; r["max"] = c.kmax; r["mean"] = c.mean; r["gauss"] = c.gauss;
     return r;
+}
+
+// An (n, 3) array of points (n >= 0) named `name`.
+Points cloudFrom(const DoubleArray& a, const char* name) {
+    if (a.ndim() != 2 || a.shape(1) != 3) throw std::invalid_argument(std::string(name) + ": expected an (n, 3) array");
+    return pointsFrom(a, static_cast<Eigen::Index>(a.shape(0)), name);
 }
 
 }  // namespace
@@ -91,8 +101,56 @@ void bindGeometry(py::module_& m) {
         }, py::arg("nu"), py::arg("nv"),
            "Exact points and unit normals on an nu x nv grid evenly spaced over the domain (two (nu, nv, 3) "
            "arrays), for displays that shade per pixel.")
+        .def("project", [](const BSplineSurface& s, DoubleArray points, int samplesPerSpan) {
+            const SurfaceProjection projection(s, samplesPerSpan);
+            const Points x = cloudFrom(points, "points");
+            if (!withinRange(x)) throw std::invalid_argument("points: must be finite and within +-1e9");
+            const py::ssize_t n = x.rows();
+            py::array_t<double> uv({n, py::ssize_t{2}}), foot({n, py::ssize_t{3}}), normal({n, py::ssize_t{3}}), dist(n);
+            py::array_t<bool> beyond(n);
+            {
+                py::gil_scoped_release release;
+                double *a = uv.mutable_data(), *f = foot.mutable_data(), *nn = normal.mutable_data(), *d = dist.mutable_data();
+                bool* b = beyond.mutable_data();
+                for (py::ssize_t i = 0; i < n; ++i) {
+                    const SurfaceFoot r = projection.project(x.row(i).transpose());
+                    a[2 * i] = r.u, a[2 * i + 1] = r.v;
+                    for (int c = 0; c < 3; ++c) f[3 * i + c] = r.point[c], nn[3 * i + c] = r.normal[c];
+                    d[i] = r.distance, b[i] = r.beyondEdge;
+                }
+            }
+            py::dict out;
+            out["uv"] = uv; out["foot"] = foot; out["normal"] = normal; out["distance"] = dist; out["beyond_edge"] = beyond;
+            return out;
+        }, py::arg("points"), py::arg("samples_per_span") = SurfaceProjection::kDefaultSamples,
+           "The closest point on the surface to each of points ((n, 3)): a dict of uv (n, 2), foot (n, 3), normal "
+           "(n, 3) (unit, du x dv), distance (n,) (signed: negative behind the normal) and beyond_edge (n,) (the "
+           "foot is on the domain's edge and the point lies beyond it).")
         .def("curvature", [](const BSplineSurface& s, double u, double v) { return curvatureDict(s.curvature(u, v)); },
              py::arg("u"), py::arg("v"), "Normal curvature along u and v, principal (min, max), mean and Gaussian.");
+
+    py::class_<PointTree>(m, "PointTree", "Nearest-point queries over a fixed cloud of 3D points (a k-d tree).")
+        .def(py::init([](DoubleArray points) { return PointTree(cloudFrom(points, "points")); }), py::arg("points"),
+             "points: (n, 3), n >= 1, finite.")
+        .def_property_readonly("size", &PointTree::size)
+        .def("nearest", [](const PointTree& t, DoubleArray queries) {
+            const Points x = cloudFrom(queries, "queries");
+            if (!withinRange(x)) throw std::invalid_argument("queries: must be finite and within +-1e9");
+            const py::ssize_t n = x.rows();
+            py::array_t<std::int64_t> index(n);
+            py::array_t<double> dist(n);
+            {
+                py::gil_scoped_release release;
+                std::int64_t* ix = index.mutable_data();
+                double* d = dist.mutable_data();
+                for (py::ssize_t i = 0; i < n; ++i) {
+                    double d2 = 0;
+                    ix[i] = t.nearest(x.row(i).transpose(), d2);
+                    d[i] = std::sqrt(d2);
+                }
+            }
+            return py::make_tuple(index, dist);
+        }, py::arg("queries"), "For each of queries ((n, 3)): the index of the nearest point and its distance.");
 }
 
 }  // namespace hs
