@@ -11,7 +11,7 @@ from __future__ import annotations
 from typing import Any
 
 from .. import core
-from . import sculpt_state
+from . import scan_deviation, sculpt_state
 from .live_surface import LiveSurface
 from .sculpt_properties import STATE_PROPERTIES, ensure_properties, face_of, read_state, set_error, write_state
 from .view_provider_hook import ViewProviderHook
@@ -60,6 +60,7 @@ class SculptFeature:
             message = f"{obj.Label}: stored sculpt state is invalid: {exc}"
             set_error(obj, message, self.live)
             raise ValueError(message) from exc
+        scan_deviation.refresh_property(obj)
 
     def onChanged(self, obj: Any, prop: str) -> None:
         """A state property changed from outside (Undo, Redo, a script): the live surface follows."""
