@@ -11,9 +11,12 @@ import math
 import os
 from typing import Any
 
+import numpy as np
+
 from . import scan_deviation, scan_target
 from .sculpt_feature import is_sculpt
-from .sculpted_solid import is_sculpted_solid, sculpt_of
+from .sculpt_properties import read_state
+from .sculpted_solid import is_sculpted_solid, sculpt_of, solid_of
 from .undo import transaction
 
 GROUP = "Scan"
@@ -48,10 +51,29 @@ def _ensure_properties(sculpt: Any) -> None:
     if "TargetTolerance" not in props:
         sculpt.addProperty("App::PropertyFloat", "TargetTolerance", GROUP, "Deviation (mm) a point may have "
                            "and count as within")
+    if "TargetSide" not in props:
+        sculpt.addProperty("App::PropertyInteger", "TargetSide", GROUP, "+1 or -1: the sign that makes a "
+                           "deviation positive outside a sculpted solid; 0 on a sheet (along its normal)")
+        sculpt.setEditorMode("TargetSide", 2)
     if scan_deviation.PROPERTY not in props:
         sculpt.addProperty("App::PropertyString", scan_deviation.PROPERTY, GROUP, "How far the target lies from "
                            "the surface (JSON: max_mm, mean_mm, p95_mm, within_pct, tolerance_mm, points)")
         sculpt.setEditorMode(scan_deviation.PROPERTY, 1)
+
+
+def _outward_side(sculpt: Any) -> int:
+    """+1 or -1 so that a deviation is positive outside the part on a sculpted solid's face (the
+    surface's normal turned outwards); 0 on a sheet, whose sign follows its normal du x dv."""
+    solid = solid_of(sculpt)
+    if solid is None or solid.Shape.isNull() or not solid.Shape.Solids:
+        return 0
+    import FreeCAD
+    surface = scan_deviation.core_surface(read_state(sculpt))
+    (u0, u1), (v0, v1) = surface.domain
+    u, v = (u0 + u1) / 2, (v0 + v1) / 2
+    step = 1e-3 * solid.Shape.BoundBox.DiagonalLength
+    probe = np.asarray(surface.evaluate(u, v)["point"]) + step * np.asarray(surface.normal(u, v))
+    return -1 if solid.Shape.isInside(FreeCAD.Vector(*probe), step * 1e-3, True) else 1
 
 
 def set_target(obj: Any, target: Any, weight: float = 1.0, tolerance: float = 0.1) -> Any:
@@ -92,6 +114,7 @@ def set_target(obj: Any, target: Any, weight: float = 1.0, tolerance: float = 0.
         sculpt.Target = target
         sculpt.TargetWeight = weight
         sculpt.TargetTolerance = tolerance
+        sculpt.TargetSide = _outward_side(sculpt)
         scan_deviation.refresh_property(sculpt)
     return target
 

@@ -60,30 +60,12 @@ def report(distances: np.ndarray, over: np.ndarray, tolerance: float, signed: bo
     }
 
 
-def outward_sign(sculpt: Any, surface: core.BSplineSurface) -> tuple[float, bool]:
-    """+1 or -1 so that positive is outside the part for a sculpted solid's face, +1 along the
-    normal for a sheet; and whether the side is the part's (True) or only the normal's."""
-    from .sculpted_solid import solid_of
-    solid = solid_of(sculpt)
-    if solid is None or not hasattr(solid, "Shape") or solid.Shape.isNull() or not solid.Shape.Solids:
-        return 1.0, False
-    import FreeCAD
-    (u0, u1), (v0, v1) = surface.domain
-    d = surface.evaluate((u0 + u1) / 2, (v0 + v1) / 2)
-    n = np.cross(d["du"], d["dv"])
-    n /= np.linalg.norm(n) or 1.0
-    step = 1e-3 * solid.Shape.BoundBox.DiagonalLength
-    probe = FreeCAD.Vector(*(np.asarray(d["point"]) + step * n))
-    return (-1.0 if solid.Shape.isInside(probe, step * 1e-3, True) else 1.0), True
-
-
 def measure(sculpt: Any, points: np.ndarray, tolerance: float) -> dict[str, Any]:
     """The report of ``points`` against the sculpt's surface as its properties hold it."""
     from .sculpt_properties import read_state
-    surface = core_surface(read_state(sculpt))
-    sign, signed = outward_sign(sculpt, surface)
-    distances, over = signed_distances(surface, points, sign)
-    return report(distances, over, tolerance, signed)
+    side = int(getattr(sculpt, "TargetSide", 0))  # +-1 on a sculpted solid's face (scan_api), 0 on a sheet
+    distances, over = signed_distances(core_surface(read_state(sculpt)), points, float(side or 1))
+    return report(distances, over, tolerance, side != 0)
 
 
 def thinned(points: np.ndarray, count: int = PROPERTY_POINTS) -> np.ndarray:
