@@ -152,3 +152,148 @@ def deviation_of(obj: Any, tolerance: float | None = None) -> dict[str, Any]:
         return scan_deviation.measure(sculpt, target.points, tol)
     except ValueError as exc:
         raise ValueError(f"{sculpt.Label}: {exc}") from None
+
+
+#: The net a fit refines up to when ``max_controls`` is not given (per direction).
+DEFAULT_MAX_CONTROLS = 48
+
+
+def _max_controls(value: Any, controls: tuple[int, int]) -> tuple[int, int]:
+    if value is None:
+        return (max(DEFAULT_MAX_CONTROLS, controls[0]), max(DEFAULT_MAX_CONTROLS, controls[1]))
+    pair = (value, value) if isinstance(value, int) and not isinstance(value, bool) else value
+    try:
+        a, b = pair
+    except (TypeError, ValueError):
+        raise TypeError(f"max_controls: expected a whole number or a pair, got {value!r}") from None
+    for x in (a, b):
+        if isinstance(x, bool) or not isinstance(x, int) or not 4 <= x <= 256:
+            raise ValueError(f"max_controls: whole numbers in 4..256, got {value!r}")
+    return int(a), int(b)
+
+
+def _refine_knots(surface: Any, r: dict[str, Any], tolerance: float, room: tuple[int, int]) -> tuple[list[float], list[float]]:
+    """Knots for the spans where the points out of the tolerance are (the midpoints of the spans
+    holding at least a quarter as many as the worst, a third of the spans at most per pass), at
+    most ``room`` per direction."""
+    bad = (r["weights"] > 0) & (np.abs(r["distance"]) > tolerance)
+    out: tuple[list[float], list[float]] = ([], [])
+    for d, knots in enumerate((surface.knots_u, surface.knots_v)):
+        breaks = np.unique(np.asarray(knots, float))
+        counts = np.histogram(r["uv"][bad, d], bins=breaks)[0]
+        if room[d] <= 0 or counts.max(initial=0) == 0:
+            continue
+        order = np.argsort(-counts, kind="stable")
+        chosen = [k for k in order if counts[k] >= 0.25 * counts.max()][: max(1, min(room[d], len(counts) // 3))]
+        out[d].extend(float(0.5 * (breaks[k] + breaks[k + 1])) for k in sorted(chosen))
+    return out
+
+
+def _refined(sculpt: Any, work: Any, extra: tuple[list[float], list[float]]) -> Any:
+    """A new working surface on ``work``'s net with knots ``extra`` inserted (exactly: the shape is
+    kept), its edges held as before and its curves held again; None where the sculpt's holds are
+    not its edges' (they could not be carried to the finer net)."""
+    from . import api, curve_api, sculpt_state
+    from .part_surface import part_bspline
+    from .source_surface import insert_knots, to_core
+    controls = tuple(work.surface.controls)
+    kinds = api.held_boundary(sculpt)
+    if sorted(work.held_poles) != sorted(set(api.boundary_poles(controls, kinds))) or work.symmetry is not None:
+        return None
+    bs = work.surface
+    poles = np.asarray(work.poles, float).reshape(controls[0], controls[1], 3)
+    weights = None if bs.weights is None else np.asarray(bs.weights, float)
+    part = part_bspline(poles, np.asarray(bs.knots_u), np.asarray(bs.knots_v), tuple(bs.degree), weights)
+    insert_knots(part, extra)
+    finer = to_core(part)
+    state = sculpt_state.capture(work)
+    new_controls = tuple(finer.controls)
+    mesh = tuple(state.settings["mesh"])
+    if mesh[0] < new_controls[0] or mesh[1] < new_controls[1]:
+        return None
+    state.settings.update(controls=list(new_controls), held_poles=[], linked_poles=[])
+    state.arrays.update(Poles=np.asarray(finer.poles, float).ravel(), Velocities=np.zeros(finer.poles.size),
+                        KnotsU=np.asarray(finer.knots_u, float), KnotsV=np.asarray(finer.knots_v, float),
+                        Weights=np.zeros(0) if finer.weights is None else np.asarray(finer.weights, float).ravel())
+    made = sculpt_state.restore(state)
+    held = api.boundary_poles(new_controls, kinds)
+    poles_now = np.asarray(made.poles, float).reshape(-1, 3)
+    moved, links, _ = curve_api.rehold(sculpt, made, held, [], poles_now)
+    made.set_poles(moved.reshape(new_controls[0], new_controls[1], 3))
+    made.hold_poles(held, links)
+    return made
+
+
+def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[str, Any]:
+    """Relaxes the surface of ``obj`` (a Sculpt or SculptedSolid) onto its target (``set_target``)
+    until at least 95 % of the target's points over the surface lie within ``tolerance`` (mm).
+
+    Each pass fits the poles to the points (least squares at the points' closest parameters,
+    repeated as they settle), weighing out the outliers (farther than 4 robust standard deviations
+    and twice the tolerance) and the points past the surface's edges; where there are no points
+    (a hole) the surface is bridged by its curvature variation. Held edges, seams, symmetry and
+    curve constraints hold exactly. Where the fit stays out of the tolerance, knots are inserted in
+    the spans where the points out of it are (exactly: the shape is kept) and it fits again, up to
+    ``max_controls`` poles per direction (a number or a pair; default 48, never fewer than the net
+    has). A sculpt whose held poles are not its edges', a symmetric one, and a sculpted solid's
+    face are fitted on their net as it is (the report says so).
+
+    One undo step; the fitted shape is the rest shape. Not during a session (RuntimeError).
+    Returns the report: ``met``, ``within_pct``, ``tolerance_mm``, ``controls``, ``points``,
+    ``outliers``, ``beyond_edge``, ``message`` (where and why it fell short) and ``rounds`` (one
+    per net: its controls, within_pct, max_mm, p95_mm, outliers, worst_uv)."""
+    from . import sculpt_state
+    from .scan_fit import WITHIN_GOAL, FitReport, fit_net
+    sculpt = _sculpt(obj)
+    tolerance = _number(tolerance, "tolerance", 1e-6, 1e6)
+    live = sculpt.Proxy.live
+    if live.session is not None:
+        raise RuntimeError(f"{sculpt.Label}: stop the sculpting session before fitting it")
+    target = scan_target.target_of(sculpt)
+    if target is None:
+        raise ValueError(f"obj: {sculpt.Label} has no target (hs.set_target)")
+    work = sculpt_state.restore(live.stored())
+    limit = _max_controls(max_controls, tuple(work.surface.controls))
+    points = target.points
+    if work.symmetry is not None:  # the symmetric fit of the points is the fit of them and their mirror image
+        direction, point, normal = work.symmetry
+        n = np.asarray(normal, float) / np.linalg.norm(normal)
+        points = np.vstack([points, points - 2.0 * ((points - np.asarray(point, float)) @ n)[:, None] * n])
+    solid = is_sculpted_solid(obj) or solid_of(sculpt) is not None
+    report = FitReport(tolerance, 0.0, False, tuple(work.surface.controls))
+    while True:
+        _, summary, r = fit_net(work, points, tolerance)
+        report.rounds.append(summary)
+        report.within_pct, report.controls = summary.within_pct, summary.controls
+        if summary.within_pct >= WITHIN_GOAL:
+            report.met = True
+            break
+        controls = tuple(work.surface.controls)
+        room = (limit[0] - controls[0], limit[1] - controls[1])
+        where = f"worst near (u, v) = ({summary.worst_uv[0]:.3f}, {summary.worst_uv[1]:.3f}), {summary.max_mm:.3g} mm off"
+        if solid:
+            report.message = f"a sculpted solid's face is fitted on its net as it is: {where}"
+            break
+        if room[0] <= 0 and room[1] <= 0:
+            report.message = f"stopped at max_controls {limit}: {where}"
+            break
+        finer = _refined(sculpt, work, _refine_knots(work.surface, r, tolerance, room))
+        if finer is None:
+            report.message = (f"not refined (its held poles are not its edges', it is symmetric, or its mesh has no "
+                              f"room for more poles): fitted on its net as it is; {where}")
+            break
+        if tuple(finer.surface.controls) == controls:
+            report.message = f"no span left to refine: {where}"
+            break
+        work = finer
+    over = ~r["beyond_edge"]
+    report.points = int(np.count_nonzero(over[: len(target.points)]))
+    report.beyond_edge = int(len(target.points) - report.points)
+    report.outliers = int(np.count_nonzero(over[: len(target.points)] & (r["weights"][: len(target.points)] == 0)))
+    work.relax()
+    state = sculpt_state.capture(work)
+    with transaction(sculpt.Document, "Fit to target"):
+        live.write(state)
+        live.document_changed()  # (the cached surface is not the fitted one: read it again)
+        scan_deviation.refresh_property(sculpt)
+    return report.as_dict()

@@ -97,7 +97,7 @@ def _refine(bs: Any, controls: tuple[int, int], degree: tuple[int, int]) -> None
                 bs.insertVKnot(mid, 1, 0.0)
 
 
-def _insert_knots(bs: Any, extra: tuple[Any, Any]) -> None:
+def insert_knots(bs: Any, extra: tuple[Any, Any]) -> None:
     """Exact refinement in place: one more knot at each of ``extra`` = (u values, v values) inside
     the domain that is not (within a millionth of a span) a knot already."""
     for direction, values in enumerate(extra):
@@ -112,7 +112,7 @@ def _insert_knots(bs: Any, extra: tuple[Any, Any]) -> None:
                 bs.insertVKnot(x, 1, 0.0)
 
 
-def _to_core(bs: Any) -> core.BSplineSurface:
+def to_core(bs: Any) -> core.BSplineSurface:
     nu, nv = bs.NbUPoles, bs.NbVPoles
     poles = np.array([[tuple(p) for p in row] for row in bs.getPoles()], dtype=float).reshape(nu, nv, 3)
     weights = np.array(bs.getWeights(), dtype=float).reshape(nu, nv)
@@ -181,9 +181,9 @@ def source_surface(source: Any, controls: tuple[int, int], degree: tuple[int, in
     bs = _exact_bspline(geom)
     if bs is not None and max(bs.UDegree, bs.VDegree) <= core.MAX_DEGREE:
         _refine(bs, controls, degree)
-        _insert_knots(bs, extra_knots)
+        insert_knots(bs, extra_knots)
         if max(bs.UDegree, bs.VDegree) <= core.MAX_DEGREE:
-            surface = _to_core(bs)
+            surface = to_core(bs)
             _, _, pts = _check_points(surface)
             return SourceSurface(surface, "exact", _distance_to(geom, pts), description)
     surface = _fit(geom, controls, degree)

@@ -101,11 +101,14 @@ void bindGeometry(py::module_& m) {
         }, py::arg("nu"), py::arg("nv"),
            "Exact points and unit normals on an nu x nv grid evenly spaced over the domain (two (nu, nv, 3) "
            "arrays), for displays that shade per pixel.")
-        .def("project", [](const BSplineSurface& s, DoubleArray points, int samplesPerSpan) {
+        .def("project", [](const BSplineSurface& s, DoubleArray points, int samplesPerSpan, std::optional<DoubleArray> start) {
             const SurfaceProjection projection(s, samplesPerSpan);
             const Points x = cloudFrom(points, "points");
             if (!withinRange(x)) throw std::invalid_argument("points: must be finite and within +-1e9");
             const py::ssize_t n = x.rows();
+            if (start && (start->ndim() != 2 || start->shape(0) != n || start->shape(1) != 2))
+                throw std::invalid_argument("start: expected an (n, 2) array of (u, v), one per point");
+            const double* from = start ? start->data() : nullptr;
             py::array_t<double> uv({n, py::ssize_t{2}}), foot({n, py::ssize_t{3}}), normal({n, py::ssize_t{3}}), dist(n);
             py::array_t<bool> beyond(n);
             {
@@ -113,7 +116,8 @@ void bindGeometry(py::module_& m) {
                 double *a = uv.mutable_data(), *f = foot.mutable_data(), *nn = normal.mutable_data(), *d = dist.mutable_data();
                 bool* b = beyond.mutable_data();
                 for (py::ssize_t i = 0; i < n; ++i) {
-                    const SurfaceFoot r = projection.project(x.row(i).transpose());
+                    const SurfaceFoot r = from ? projection.project(x.row(i).transpose(), from[2 * i], from[2 * i + 1])
+                                               : projection.project(x.row(i).transpose());
                     a[2 * i] = r.u, a[2 * i + 1] = r.v;
                     for (int c = 0; c < 3; ++c) f[3 * i + c] = r.point[c], nn[3 * i + c] = r.normal[c];
                     d[i] = r.distance, b[i] = r.beyondEdge;
@@ -122,8 +126,9 @@ void bindGeometry(py::module_& m) {
             py::dict out;
             out["uv"] = uv; out["foot"] = foot; out["normal"] = normal; out["distance"] = dist; out["beyond_edge"] = beyond;
             return out;
-        }, py::arg("points"), py::arg("samples_per_span") = SurfaceProjection::kDefaultSamples,
-           "The closest point on the surface to each of points ((n, 3)): a dict of uv (n, 2), foot (n, 3), normal "
+        }, py::arg("points"), py::arg("samples_per_span") = SurfaceProjection::kDefaultSamples, py::arg("start") = py::none(),
+           "The closest point on the surface to each of points ((n, 3)), from start ((n, 2) parameters: feet from "
+           "before the surface moved a little) where given: a dict of uv (n, 2), foot (n, 3), normal "
            "(n, 3) (unit, du x dv), distance (n,) (signed: negative behind the normal) and beyond_edge (n,) (the "
            "foot is on the domain's edge and the point lies beyond it).")
         .def("curvature", [](const BSplineSurface& s, double u, double v) { return curvatureDict(s.curvature(u, v)); },

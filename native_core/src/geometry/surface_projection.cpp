@@ -39,12 +39,27 @@ SurfaceProjection::SurfaceProjection(BSplineSurface surface, int samplesPerSpan)
       samples_(gridPoints(surface_, startU_, startV_), "surface samples") {}
 
 SurfaceFoot SurfaceProjection::project(const Vec3& x) const {
-    const double u0 = surface_.knotsU().domainStart(), u1 = surface_.knotsU().domainEnd();
-    const double v0 = surface_.knotsV().domainStart(), v1 = surface_.knotsV().domainEnd();
     double d2 = 0;
     const Eigen::Index k = samples_.nearest(x, d2);
     const Eigen::Index nv = static_cast<Eigen::Index>(startV_.size());
-    double u = startU_[k / nv], v = startV_[k % nv];
+    return descend(x, startU_[k / nv], startV_[k % nv]);
+}
+
+SurfaceFoot SurfaceProjection::project(const Vec3& x, double u, double v) const {
+    if (!std::isfinite(u) || !std::isfinite(v)) return project(x);
+    const SurfaceFoot warm = descend(x, u, v);
+    double d2 = 0;
+    const Eigen::Index k = samples_.nearest(x, d2);
+    if (warm.distance * warm.distance <= d2) return warm;
+    const Eigen::Index nv = static_cast<Eigen::Index>(startV_.size());
+    const SurfaceFoot cold = descend(x, startU_[k / nv], startV_[k % nv]);
+    return std::abs(cold.distance) < std::abs(warm.distance) ? cold : warm;
+}
+
+SurfaceFoot SurfaceProjection::descend(const Vec3& x, double u, double v) const {
+    const double u0 = surface_.knotsU().domainStart(), u1 = surface_.knotsU().domainEnd();
+    const double v0 = surface_.knotsV().domainStart(), v1 = surface_.knotsV().domainEnd();
+    u = std::clamp(u, u0, u1), v = std::clamp(v, v0, v1);
     SurfaceDerivatives d = surface_.evaluate(u, v, 2);
     double f = (d.s - x).squaredNorm();
     // Newton on f(u, v) = |S - x|^2 / 2 with the domain's bounds as an active set; a step that

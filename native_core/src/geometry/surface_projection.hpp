@@ -29,9 +29,14 @@ public:
 
     /// The closest point to x (allocates nothing).
     SurfaceFoot project(const Vec3& x) const;
+    /// The same, starting from (u, v) (a foot from before the surface moved a little): kept when it
+    /// is no farther than the nearest sample, else searched from that sample as above.
+    SurfaceFoot project(const Vec3& x, double u, double v) const;
     const BSplineSurface& surface() const { return surface_; }
 
 private:
+    SurfaceFoot descend(const Vec3& x, double u, double v) const;  // Newton from (u, v)
+
     BSplineSurface surface_;
     std::vector<double> startU_, startV_;  // the parameters of each sample, row-major (u slow)
     PointTree samples_;

@@ -174,6 +174,14 @@ public:
     /// [0, 1]) ask for it, by `strength` (>= 0) against staying put; held and linked poles and
     /// the mirror symmetry hold exactly. Zeroes velocities (as setPoles). Allocates (an edit).
     void fair(const Eigen::VectorXd& weights, double strength);
+    /// Fit (target_fit.cpp): the poles nearest the `targets` at parameters `uv` (one row each,
+    /// with the surface's `normals` there), weighted by `weights` (>= 0), the slide along the
+    /// surface by `tangential` (1e-6..1; 1 is plain least squares), with the mesh's curvature
+    /// variation at `smoothing` (0..1e6, relative to the points' weight) bridging where there are
+    /// no points; held and linked poles and the mirror symmetry hold exactly. Returns them; the
+    /// surface is unchanged. Allocates.
+    Points fitPoles(const Points& targets, const Eigen::MatrixX2d& uv, const Points& normals,
+                    const Eigen::VectorXd& weights, double tangential, double smoothing);
 
     // --- measures -----------------------------------------------------------------------------
     double kineticEnergy();

@@ -1,0 +1,138 @@
+// Fitting the surface to target points (a scan, issue 30): the poles that bring the surface
+// nearest the points at given parameters, with the curvature variation of the mesh (as Fair,
+// curvature_variation.hpp) to bridge where there are no points:
+//   min_p  sum_k w_k r_k^T (n_k n_k^T + a (I - n_k n_k^T)) r_k + tau p^T A^T C^T C A p,
+//   r_k = S(u_k, v_k; p) - t_k,
+// the distance along the surface's normal n_k at the point's foot weighed fully and the slide
+// along the surface by a (tangential < 1): the feet then follow the points in a few rounds where
+// plain least squares (a = 1) creeps (Wang, Pottmann and Liu's squared distance minimisation,
+// without its curvature term). tau = smoothing x trace(data) / (3 trace(A^T C^T C A)).
+// Solved for the increment in the free poles (P = T z, held_poles.hpp), T applied to each
+// coordinate: held poles stay, linked ones follow, the mirror symmetry is put back exactly. The
+// normal matrix is summed into a band of 3 x 3 blocks, (2p+1)(2q+1) per pole, so millions of
+// points cost no triplet list.
+#include <Eigen/SparseCholesky>
+
+#include <stdexcept>
+#include <vector>
+
+#include "solvers/curvature_variation.hpp"
+#include "solvers/dynamic_surface.hpp"
+
+namespace hs {
+
+namespace {
+
+// T (poles x free poles) of the held and linked poles, and T (x) I3 on (x, y, z) per pole.
+Eigen::SparseMatrix<double> coordinatewise(const HeldPoles& held, int poles) {
+    std::vector<int> column(poles, -1);
+    int free = 0;
+    for (int i = 0; i < poles; ++i)
+        if (!held.constrained(i)) column[i] = free++;
+    std::vector<Eigen::Triplet<double>> t;
+    for (int i = 0; i < poles; ++i)
+        if (column[i] >= 0)
+            for (int c = 0; c < 3; ++c) t.emplace_back(3 * i + c, 3 * column[i] + c, 1.0);
+    for (const PoleLink& l : held.links())
+        for (const auto& [master, weight] : l.masters)
+            if (column[master] >= 0)  // (a held master's increment is zero)
+                for (int c = 0; c < 3; ++c) t.emplace_back(3 * l.pole + c, 3 * column[master] + c, weight);
+    Eigen::SparseMatrix<double> T(3 * poles, 3 * free);
+    T.setFromTriplets(t.begin(), t.end());
+    return T;
+}
+
+}  // namespace
+
+Points DynamicSurface::fitPoles(const Points& targets, const Eigen::MatrixX2d& uv, const Points& normals,
+                                const Eigen::VectorXd& weights, double tangential, double smoothing) {
+    const Eigen::Index count = targets.rows();
+    if (uv.rows() != count || normals.rows() != count || weights.size() != count)
+        throw std::invalid_argument("targets: uv, normals and weights need one row per target point");
+    if (!withinRange(targets)) throw std::invalid_argument("targets: must be finite and within +-1e9");
+    if (!uv.allFinite()) throw std::invalid_argument("uv: must be finite");
+    if (!normals.allFinite()) throw std::invalid_argument("normals: must be finite");
+    if (!weights.allFinite() || (count > 0 && weights.minCoeff() < 0))
+        throw std::invalid_argument("weights: must be finite and >= 0");
+    requireInRange(tangential, "tangential", 1e-6, 1.0);
+    requireInRange(smoothing, "smoothing", 0.0, 1e6);
+    const BSplineSurface& S = surface();
+    const int nv = S.nv(), poles = S.nu() * nv, p = S.knotsU().degree(), q = S.knotsV().degree();
+    const int bw = 2 * p + 1, bh = 2 * q + 1;
+    using Block = Eigen::Matrix3d;
+    std::vector<Block, Eigen::aligned_allocator<Block>> band(static_cast<std::size_t>(poles) * bw * bh, Block::Zero());
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(3 * poles);
+    int index[(kMaxDegree + 1) * (kMaxDegree + 1)];
+    double value[(kMaxDegree + 1) * (kMaxDegree + 1)];
+    for (Eigen::Index k = 0; k < count; ++k) {
+        const double w = weights[k];
+        if (w == 0) continue;
+        Vec3 n = normals.row(k).transpose();
+        const double len = n.norm();
+        n = len > 0 ? Vec3(n / len) : Vec3::Zero();
+        const Block W = w * (n * n.transpose() + tangential * (Block::Identity() - n * n.transpose()));
+        const Vec3 Wt = W * targets.row(k).transpose();
+        int m = 0;
+        S.visitBasis(uv(k, 0), uv(k, 1), 1, [&](int i, double R, double, double, double, double, double) {
+            index[m] = i, value[m] = R, ++m;
+        });
+        for (int a = 0; a < m; ++a) {
+            const int ia = index[a], ra = ia / nv, ca = ia % nv;
+            rhs.segment<3>(3 * ia) += value[a] * Wt;
+            for (int b = 0; b < m; ++b) {
+                const int ib = index[b];
+                band[(static_cast<std::size_t>(ia) * bw + (ib / nv - ra + p)) * bh + (ib % nv - ca + q)] +=
+                    (value[a] * value[b]) * W;
+            }
+        }
+    }
+    std::vector<Eigen::Triplet<double>> entries;
+    double trace = 0;
+    for (int ia = 0; ia < poles; ++ia)
+        for (int di = 0; di < bw; ++di)
+            for (int dj = 0; dj < bh; ++dj) {
+                const Block& x = band[(static_cast<std::size_t>(ia) * bw + di) * bh + dj];
+                if (x.isZero(0)) continue;
+                const int ib = (ia / nv + di - p) * nv + (ia % nv + dj - q);
+                for (int r = 0; r < 3; ++r)
+                    for (int c = 0; c < 3; ++c)
+                        if (x(r, c) != 0) entries.emplace_back(3 * ia + r, 3 * ib + c, x(r, c));
+                if (ib == ia) trace += x.trace();
+            }
+    if (!(trace > 0)) throw std::invalid_argument("targets: no point with a weight > 0");
+    // The curvature variation acts on each coordinate alike; poles neither it nor a point reaches
+    // stay where they are (and the system factors).
+    std::vector<int> centre;
+    const Eigen::SparseMatrix<double> A = state_.A.matrix().toEigen();
+    const Eigen::SparseMatrix<double> CA = curvatureVariation(g(), h(), state_.spacingU, state_.spacingV, centre) * A;
+    const Eigen::SparseMatrix<double> F = CA.transpose() * CA;
+    const double variation = CA.squaredNorm();
+    const double tau = smoothing > 0 && variation > 0 ? smoothing * trace / (3 * variation) : 0.0;
+    for (int k = 0; k < F.outerSize(); ++k)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(F, k); it; ++it)
+            for (int c = 0; c < 3; ++c) entries.emplace_back(3 * it.row() + c, 3 * it.col() + c, tau * it.value());
+    for (int i = 0; i < 3 * poles; ++i) entries.emplace_back(i, i, 1e-10 * trace / (3 * poles));
+    Eigen::SparseMatrix<double> sys(3 * poles, 3 * poles);
+    sys.setFromTriplets(entries.begin(), entries.end());
+
+    const Points& P = state_.poles();
+    const Eigen::Map<const Eigen::VectorXd> flat(P.data(), 3 * poles);  // (x, y, z) per pole, row-major
+    rhs -= sys * flat;  // for the increment
+    const Eigen::SparseMatrix<double> T = coordinatewise(held_, poles);
+    Points fitted = P;
+    if (T.cols() > 0) {
+        const Eigen::SparseMatrix<double> reduced = T.transpose() * sys * T;
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(reduced);
+        if (ldlt.info() != Eigen::Success) throw std::runtime_error("fit: the fitting system does not factor");
+        const Eigen::VectorXd step = T * ldlt.solve(T.transpose() * rhs);
+        Eigen::Map<Eigen::VectorXd>(fitted.data(), 3 * poles) += step;
+    }
+    if (!mirror_.empty()) {
+        Points still = Points::Zero(poles, 3);
+        mirror_.project(fitted, still);
+    }
+    if (!fitted.allFinite()) throw std::runtime_error("fit: the fitting system gave non-finite poles");
+    return fitted;
+}
+
+}  // namespace hs
