@@ -33,7 +33,8 @@ struct HapticEstimate {
     double stiffness = 0, stiffStiffness = 0, threshold = 0, length0 = 0, reelTime = 0;
     // rope and orientation: contact points and their velocities (finite differences between steps)
     int points = 0;
-    Vec3 x[kMaxPoints], v[kMaxPoints];
+    Vec3 x[kMaxPoints] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+    Vec3 v[kMaxPoints] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};  // (zero until a second state gives them)
     /// orientation: target of point k is c + spacing[k] * (R axis[k]) (axis 0 = none, 1 = x, 2 = y)
     int axis[kMaxPoints] = {0, 0, 0, 0, 0};
     double spacing[kMaxPoints] = {0, 0, 0, 0, 0};
