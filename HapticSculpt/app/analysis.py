@@ -121,3 +121,38 @@ def map_colours(values: np.ndarray, shape: tuple[int, int]) -> tuple[np.ndarray,
     if hi <= lo:
         hi = lo + max(abs(lo), 1.0) * 1e-9
     return pseudo_colour(out, lo, hi)
+
+
+#: The deviation display's colours: within the tolerance, and the ends of the two sides beyond it.
+WITHIN_COLOUR = np.array([0.15, 0.8, 0.25])
+NO_SCAN_COLOUR = np.array([0.55, 0.55, 0.55])
+_ABOVE = np.array([[1.0, 0.95, 0.0], [1.0, 0.0, 0.0]])  # just past +tolerance .. the range's top
+_BELOW = np.array([[0.0, 0.9, 1.0], [0.0, 0.0, 1.0]])  # just past -tolerance .. the range's bottom
+
+
+def deviation_range(signed: np.ndarray, tolerance: float) -> tuple[float, float]:
+    """A range centred on zero covering the 98th percentile of |deviation| (outliers saturate), at
+    least twice the tolerance, so the band within it is always seen."""
+    finite = np.asarray(signed, float)
+    finite = finite[np.isfinite(finite)]
+    a = float(np.percentile(np.abs(finite), 98)) if finite.size else 0.0
+    a = max(a, 2.0 * tolerance)
+    return -a, a
+
+
+def deviation_colours(signed: np.ndarray, tolerance: float, rng: tuple[float, float] | None = None
+                      ) -> tuple[np.ndarray, tuple[float, float]]:
+    """Signed deviations (mm; NaN: no scan there) as colours: green within +-``tolerance``, yellow
+    to red beyond it on the positive side, cyan to blue on the negative, grey where there is no
+    scan; returns them (..., 3) and the range shown."""
+    d = np.asarray(signed, float)
+    lo, hi = rng if rng is not None else deviation_range(d, tolerance)
+    out = np.broadcast_to(WITHIN_COLOUR, d.shape + (3,)).copy()
+    span = max(hi - tolerance, 1e-12)
+    with np.errstate(invalid="ignore"):
+        above, below = d > tolerance, d < -tolerance
+    t = np.clip((np.abs(d) - tolerance) / span, 0.0, 1.0)[..., None]
+    out[above] = (_ABOVE[0] * (1 - t) + _ABOVE[1] * t)[above]
+    out[below] = (_BELOW[0] * (1 - t) + _BELOW[1] * t)[below]
+    out[~np.isfinite(d)] = NO_SCAN_COLOUR
+    return out, (lo, hi)

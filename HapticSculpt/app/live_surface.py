@@ -21,7 +21,7 @@ from typing import Any, Callable, Protocol, TypeVar
 import numpy as np
 
 from .. import core
-from . import sculpt_state
+from . import scan_deviation, sculpt_state
 from .sculpt_properties import face_of, read_state, set_error, write_state
 from .undo import transaction
 
@@ -207,6 +207,8 @@ class LiveSurface:
             self._stored = state
             if geometry or obj.Shape.isNull():
                 obj.Shape = face_of(state)
+            if geometry:
+                scan_deviation.refresh_property(obj)  # (in the same undo step as the shape)
         finally:
             self.writing = self._own_write = False
         self._shadow_stale = True

@@ -91,3 +91,20 @@ def refresh_property(sculpt: Any) -> None:
         text = json.dumps({"error": str(exc)})
     if sculpt.Deviation != text:
         sculpt.Deviation = text
+
+
+def mesh_deviation(mesh: np.ndarray, normals: np.ndarray, tree: Any, points: np.ndarray, side: int,
+                   reach: float) -> np.ndarray:
+    """The scan's signed distance at each point of a surface's mesh ((g, h, 3), its unit normals
+    alike): how far the nearest scan point lies along the normal (its offset along the surface is a
+    scan's sampling, not a deviation), times ``side`` as in :func:`measure`; NaN where the nearest
+    scan point lies more than ``reach`` along the surface (a hole in the scan, or past its edge)."""
+    flat = mesh.reshape(-1, 3)
+    index, distance = tree.nearest(flat)
+    offset = points[index] - flat
+    n = normals.reshape(-1, 3)
+    along = np.einsum("ij,ij->i", offset, n)
+    across = np.sqrt(np.maximum(distance ** 2 - along ** 2, 0.0))
+    signed = along * float(side or 1)
+    signed[across > reach] = np.nan
+    return signed.reshape(mesh.shape[:2])

@@ -118,6 +118,28 @@ def coloured_mesh(mesh: np.ndarray, colours: np.ndarray, quads: list[int] | None
     return sep
 
 
+def coloured_points(points: np.ndarray, colours: np.ndarray, size: float) -> Any:
+    """Points ((n, 3)) drawn ``size`` pixels wide, each in its colour ((n, 3))."""
+    from pivy import coin
+    sep = coin.SoSeparator()
+    style = coin.SoDrawStyle()
+    style.pointSize = size
+    sep.addChild(style)
+    mat = coin.SoMaterial()
+    mat.diffuseColor.setValues(0, len(colours), np.asarray(colours, float).tolist())
+    sep.addChild(mat)
+    binding = coin.SoMaterialBinding()
+    binding.value = coin.SoMaterialBinding.PER_VERTEX
+    sep.addChild(binding)
+    coords = coin.SoCoordinate3()
+    coords.point.setValues(0, len(points), np.asarray(points, float).tolist())
+    sep.addChild(coords)
+    cloud = coin.SoPointSet()
+    cloud.numPoints = len(points)
+    sep.addChild(cloud)
+    return sep
+
+
 def masked_quad_indices(inside: np.ndarray) -> list[int]:
     """Face indices (as :func:`quad_indices`) of the cells of a grid whose four corners are all
     ``inside`` (a g x h bool array: the points on a trimmed face)."""

@@ -1,6 +1,7 @@
 """Workbench commands (GUI only; registered from InitGui through FreeCADGui.addCommand)."""
 from __future__ import annotations
 
+import json
 from typing import Any
 
 import FreeCAD
@@ -31,12 +32,13 @@ GROUPS = {
                                      ["HapticSculpt_HoldEdges", "HapticSculpt_FollowCurve", "HapticSculpt_PointConstraint",
                                       "HapticSculpt_NormalConstraint", "HapticSculpt_CurvatureConstraint"], 0),
     "HapticSculpt_DisplayGroup": ("Displays", "Analysis displays: material map, curvature, combs, zebra stripes "
-                                  "and their settings",
+                                  "and their settings; a scan: set it as the target, show the deviation, fit to it",
                                   ["HapticSculpt_ShowMap", "HapticSculpt_ShowCurvature", "HapticSculpt_Combs",
                                    "HapticSculpt_ContinuityCheck",
                                    "HapticSculpt_CombDensity", "HapticSculpt_CombScale", "HapticSculpt_Zebra",
                                    "HapticSculpt_ZebraMode", "HapticSculpt_ZebraStripes",
-                                   "HapticSculpt_ZebraDirection"], 0),
+                                   "HapticSculpt_ZebraDirection", "HapticSculpt_SetTarget",
+                                   "HapticSculpt_ShowDeviation", "HapticSculpt_FitToTarget"], 0),
 }
 #: The toolbars: few buttons, so that all show at 1280 px beside FreeCAD's own. Output is a toolbar
 #: of its own: a toolbar squeezed by a narrow window keeps its first button, so Export STEP never
@@ -426,6 +428,99 @@ class FollowCurve:
                                      f"HapticSculpt: {target.Label} no longer follows it\n")
 
 
+def _target_selection() -> tuple[Any, Any] | None:
+    """(the sculpt or sculpted solid, the mesh or point cloud) when the selection is one of each,
+    or a mesh or cloud alone with a sculpt under the mouse or alone in the document; else None."""
+    from ..app.scan_target import is_target_object
+    from ..app.sculpt_feature import is_sculpt
+    from ..app.sculpted_solid import is_sculpted_solid
+    sel = Gui.Selection.getSelection()
+    scans = [o for o in sel if is_target_object(o)]
+    sculpts = [o for o in sel if is_sculpt(o) or is_sculpted_solid(o)]
+    if len(scans) != 1 or len(sculpts) > 1 or len(scans) + len(sculpts) != len(sel):
+        return None
+    target = sculpts[0] if sculpts else _ctl().active_sculpt()
+    return (target, scans[0]) if target is not None else None
+
+
+def _with_target() -> Any:
+    """The active sculpt if it has a target, else None."""
+    sculpt = _ctl().active_sculpt()
+    return sculpt if sculpt is not None and getattr(sculpt, "Target", None) is not None else None
+
+
+class SetTarget:
+    """The selected mesh or point cloud (an imported scan) becomes the sculpt's target; the
+    deviation display shows at once."""
+
+    def GetResources(self) -> dict[str, str]:
+        return {"Pixmap": icon("SetTarget"), "MenuText": "Set scan target",
+                "ToolTip": "Select a mesh or point cloud (a scan imported with File > Import: STL, OBJ, PLY) and "
+                           "the sculpt: the sculpt is measured against it, and the deviation shows in colour"}
+
+    def IsActive(self) -> bool:
+        return _target_selection() is not None
+
+    def Activated(self) -> None:
+        from ..app.sculpted_solid import sculpt_for
+        from .echo import ref, run_echoed
+        picked = _target_selection()
+        if picked is None:
+            return
+        sculpt, scan = picked
+        try:
+            run_echoed(f"HapticSculpt.set_target({ref(sculpt)}, {ref(scan)})")
+        except Exception as exc:  # noqa: BLE001 - doCommand raises what the call raised
+            FreeCAD.Console.PrintWarning(f"HapticSculpt: {scan.Label} cannot be {sculpt.Label}'s target: {exc}\n")
+            return
+        Gui.Selection.clearSelection()
+        _ctl().refresh(sculpt_for(sculpt))
+        _ctl().set_display("deviation")
+        report = json.loads(sculpt_for(sculpt).Deviation or "{}")
+        if "p95_mm" in report:
+            FreeCAD.Console.PrintMessage(f"HapticSculpt: {scan.Label} lies within {report['tolerance_mm']:g} mm of "
+                                         f"{sculpt.Label} at {report['within_pct']:.1f} % of its points (p95 "
+                                         f"{report['p95_mm']:.3g} mm, max {report['max_mm']:.3g} mm)\n")
+
+
+class ShowDeviation(_SculptCommand):
+    icon_name, menu = "ShowDeviation", "Show deviation"
+    tip = ("Toggle the deviation display: the scan's signed distance from the surface in colour, green within "
+           "the tolerance, yellow to red on the normal's side (outside a solid), cyan to blue on the other, grey "
+           "where there is no scan; on the scan's points too")
+
+    def IsActive(self) -> bool:
+        return _with_target() is not None
+
+    def Activated(self) -> None:
+        ov = _ctl().overlay()
+        if ov is not None:
+            _ctl().set_display("shading" if ov.display == "deviation" else "deviation")
+
+
+class FitToTarget(_SculptCommand):
+    icon_name, menu = "FitToTarget", "Fit to scan"
+    tip = ("Fit the surface to its scan target within its tolerance (TargetTolerance): outliers and holes are "
+           "ignored and bridged, held edges, seams, symmetry and curves kept, the net refined where it must be; "
+           "one undo step")
+
+    def IsActive(self) -> bool:
+        return _with_target() is not None and _ctl().session is None
+
+    def Activated(self) -> None:
+        from ..app.sculpted_solid import sculpt_for
+        from .echo import ref, run_echoed
+        sculpt = _with_target()
+        if sculpt is None:
+            return
+        run_echoed(f"report = HapticSculpt.fit_to_target({ref(sculpt)}, {float(sculpt.TargetTolerance)!r})")
+        _ctl().refresh(sculpt_for(sculpt))
+        report = json.loads(sculpt_for(sculpt).Deviation or "{}")
+        if "p95_mm" in report:
+            FreeCAD.Console.PrintMessage(f"HapticSculpt: fitted: {report['within_pct']:.1f} % of the scan within "
+                                         f"{report['tolerance_mm']:g} mm (p95 {report['p95_mm']:.3g} mm)\n")
+
+
 class _Tool(_SculptCommand):
     tool = "rope"
 
@@ -675,7 +770,8 @@ COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_NewClampedPatch": N
             "HapticSculpt_NormalConstraint": NormalConstraint, "HapticSculpt_CurvatureConstraint": CurvatureConstraint,
             "HapticSculpt_PaintMass": PaintMass, "HapticSculpt_PaintDamping": PaintDamping,
             "HapticSculpt_PaintStiffness": PaintStiffness, "HapticSculpt_PaintBending": PaintBending,
-            "HapticSculpt_ShowMap": ShowMap,
+            "HapticSculpt_ShowMap": ShowMap, "HapticSculpt_SetTarget": SetTarget,
+            "HapticSculpt_ShowDeviation": ShowDeviation, "HapticSculpt_FitToTarget": FitToTarget,
             "HapticSculpt_ShowCurvature": ShowCurvature, "HapticSculpt_Combs": Combs, "HapticSculpt_ContinuityCheck": ContinuityCheck, "HapticSculpt_Zebra": Zebra,
             "HapticSculpt_ZebraMode": ZebraMode, "HapticSculpt_ZebraStripes": ZebraStripes,
             "HapticSculpt_ZebraDirection": ZebraDirection,

@@ -28,7 +28,7 @@ TEXT = (1.0, 1.0, 1.0)
 HELD = (1.0, 0.6, 0.0)
 U_COLOUR, V_COLOUR = (0.0, 0.85, 0.0), (0.15, 0.35, 1.0)  # the paper's u green, v blue
 U_LABEL, V_LABEL = (0.4, 1.0, 0.4), (0.55, 0.7, 1.0)  # the same, light enough to read on any background
-UNITS = {"curvature": " 1/mm", "mean": " 1/mm", "gauss": " 1/mm^2"}
+UNITS = {"curvature": " 1/mm", "mean": " 1/mm", "gauss": " 1/mm^2", "deviation": " mm"}
 LINE = FONT_SIZE + 4  # a text line's height
 TRACK_ROW = 18  # a slider's track row under its text line
 TRACK_WIDTH = 220
@@ -82,10 +82,11 @@ class Hud:
         self._boxes = {}
 
     def update(self, legend: tuple[str, tuple[float, float]] | None, sliders: list[tuple[str, float, bool, float]],
-               status: str, zebra_bands: int = 12) -> None:
+               status: str, zebra_bands: int = 12, tolerance: float = 0.1) -> None:
         """Redraws the layer: ``legend`` = (display, (lo, hi)) or None; ``sliders`` = (label, value,
         held, knob position 0..1) per slider, shown while the panel is; ``status`` = the tool and
-        mode; ``zebra_bands``: the black and white bands the zebra legend shows (the stripe count)."""
+        mode; ``zebra_bands``: the black and white bands the zebra legend shows (the stripe count);
+        ``tolerance``: the deviation legend's band (mm)."""
         w, h = (int(x) for x in self.view.getSize())
         self.camera.position = (w / 2.0, h / 2.0, 1.0)
         self.camera.height = float(h)
@@ -95,7 +96,7 @@ class Hud:
         lines = _wrap(status, int((w - 2 * MARGIN - 2 * PAD) // CHAR_WIDTH)) if status else []
         floor = MARGIN + len(lines) * LINE + 2 * PAD + 8  # the legend stays above the status lines
         if legend is not None:
-            self._group("legend", lambda: self._legend(w, h, *legend, zebra_bands, floor), w, h)
+            self._group("legend", lambda: self._legend(w, h, *legend, zebra_bands, floor, tolerance), w, h)
         if sliders:
             self._group("sliders", lambda: self._sliders(w, h, sliders, floor), w, h)
         if lines:
@@ -173,9 +174,11 @@ class Hud:
         return sep
 
     # --- items --------------------------------------------------------------------------------------
-    def _legend(self, w: int, h: int, display: str, rng: tuple[float, float], zebra_bands: int, floor: float) -> None:
+    def _legend(self, w: int, h: int, display: str, rng: tuple[float, float], zebra_bands: int, floor: float,
+                tolerance: float = 0.1) -> None:
         """Colour bar(s) on the right edge below the cube's corner, range to their left, name above;
-        zebra: ``zebra_bands`` black and white bands, one per stripe the display shows."""
+        zebra: ``zebra_bands`` black and white bands, one per stripe the display shows; deviation:
+        the +-``tolerance`` band marked."""
         titles = 2 if display == "curvature" else 1  # text rows above the bar
         head = titles * (FONT_SIZE + 4) + 8
         x1 = w - MARGIN - PAD
@@ -191,6 +194,8 @@ class Hud:
         elif display == "zebra":
             bands = np.arange(int(zebra_bands) + 1) % 2  # (one more: _bar draws n - 1 quads for n colours)
             bars = [("", np.repeat(bands[:, None].astype(float), 3, axis=1), TEXT)]
+        elif display == "deviation":
+            bars = [("", analysis.deviation_colours(rng[0] + t * (rng[1] - rng[0]), tolerance, rng)[0], TEXT)]
         else:
             bars = [("", analysis.pseudo_colour(t, 0.0, 1.0)[0], TEXT)]
         x0 = x1 - len(bars) * BAR_WIDTH - (len(bars) - 1) * 6
@@ -203,8 +208,11 @@ class Hud:
         if display != "zebra":
             self._text(f"{rng[1]:.3g}{units}", x0 - 6, top - FONT_SIZE, TEXT, "legend_hi", w, right=True)
             self._text(f"{rng[0]:.3g}{units}", x0 - 6, bottom, TEXT, "legend_lo", w, right=True)
+        if display == "deviation" and rng[1] > rng[0]:  # the band within the tolerance, labelled at its middle
+            middle = bottom + (top - bottom) * (0.0 - rng[0]) / (rng[1] - rng[0])
+            self._text(f"+-{tolerance:.3g}{units}", x0 - 6, middle - FONT_SIZE / 2, TEXT, "legend_band", w, right=True)
         title = {"curvature": "curvature u / v", "mean": "mean curvature", "gauss": "Gaussian curvature",
-                 "zebra": f"zebra: {int(zebra_bands)} stripes"}.get(display, display)
+                 "zebra": f"zebra: {int(zebra_bands)} stripes", "deviation": "deviation from the scan"}.get(display, display)
         self._text(title, x1, top + 6 + (titles - 1) * (FONT_SIZE + 4), TEXT, "legend_title", w, right=True)
         self._boxes["legend_bar"] = (float(x0), float(bottom), float(x1), float(top))
 

@@ -29,7 +29,11 @@ from .hud import Hud
 from .panel import SliderPanel, sliders
 
 MAPS = ("mass", "damping", "stiffness", "bending")
-DISPLAYS = ("shading", *MAPS, "curvature", "mean", "gauss", "zebra")
+DISPLAYS = ("shading", *MAPS, "curvature", "mean", "gauss", "zebra", "deviation")
+#: Scan points the deviation display colours (evenly taken), and how often they are measured again
+#: while the surface moves (a session): the surface's own colours follow every frame.
+SCAN_POINTS_SHOWN = 60_000
+SCAN_REMEASURE_S = 0.5
 JACK_COLOURS = {"point": (1.0, 0.0, 0.0), "tangent": (1.0, 0.5, 0.0), "normal": (0.0, 0.3, 1.0), "curvature": (1.0, 1.0, 1.0)}
 #: Curves the surface follows, drawn on it: G0 (through) and G1 (with its normal).
 CURVE_COLOURS = {"G0": (0.0, 0.9, 1.0), "G1": (1.0, 0.6, 0.0)}
@@ -68,6 +72,7 @@ class Overlay:
         self.stripe_angle = 0.0  # reflection: the light strips' angle from the view's up direction (degrees)
         self.per_pixel = True  # zebra per pixel where the driver runs GLSL (False: per mesh vertex)
         self._sampled: tuple[bytes, np.ndarray, tuple[bytes, bytes], int] | None = None  # poles, points, texture, size
+        self._scan: tuple[bytes, float, Any] | None = None  # poles, when, the scan's coloured points
         self._trims: dict[tuple[int, int], list[int] | None] = {}  # grid size -> cells on the trimmed face
         self._curve_rows: tuple[str, list[tuple[str, Any]]] = ("", [])  # CurveConstraints text -> (kind, rows)
         self.hud: Hud | None = None  # the screen-space layer, made when the overlay first draws
@@ -206,8 +211,10 @@ class Overlay:
             scene.addChild(shapes.coloured_mesh(mesh, colours, self._cells(mesh.shape[:2], s.mesh_parameters_u,
                                                                            s.mesh_parameters_v)))
             legend = (self.display, rng)
+            if display == "deviation" and self._target() is not None:
+                scene.addChild(self._scan_points(s, rng))
         self.neighbours_drawn = 0
-        if display != "shading" and display not in MAPS:
+        if display != "shading" and display not in MAPS and display != "deviation":
             for node in self._neighbours(display, bool(glsl) and display == "zebra", legend[1] if legend else None):
                 scene.addChild(node)
                 self.neighbours_drawn += 1
@@ -241,7 +248,7 @@ class Overlay:
             return
         sliders = self.panel.values(self.obj) if self.panel_visible else []
         self.status_text = self._status(s)
-        self.hud.update(legend, sliders, self.status_text, zebra_bands=int(self.stripes))
+        self.hud.update(legend, sliders, self.status_text, zebra_bands=int(self.stripes), tolerance=self.tolerance())
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
 
@@ -363,6 +370,8 @@ class Overlay:
             turn = (f"stripes at {self.stripe_angle:g} deg" if self.stripe_mode == "reflection"
                     else "to ({:.2g}, {:.2g}, {:.2g})".format(*self.stripe_direction))
             parts.append(f"zebra: {self.stripe_mode}, {self.stripes:g} stripes, {turn}")
+        if self.display == "deviation":
+            parts.append(self._deviation_text())
         if self.combs:
             parts.append(f"combs: every {self.comb_every}, x{self.comb_gain:g}")
         if self.continuity:
@@ -371,8 +380,64 @@ class Overlay:
             parts.append(self.mode)
         return "  |  ".join(parts)
 
+    def _deviation_text(self) -> str:
+        """The stored deviation report in a line (as of the last recompute: after a stroke)."""
+        import json
+        text = getattr(self.obj, "Deviation", "")
+        if not text:
+            return "deviation: no scan target (select a mesh and the sculpt: Set scan target)"
+        report = json.loads(text)
+        if "error" in report:
+            return f"deviation: {report['error']}"
+        return (f"deviation: {report['within_pct']:.1f} % within +-{report['tolerance_mm']:g} mm, p95 "
+                f"{report['p95_mm']:.3g} mm, max {report['max_mm']:.3g} mm")
+
+    def _target(self) -> Any:
+        """The sculpt's scan target (points and k-d tree), or None (none set, or it cannot be read)."""
+        from ..app.scan_target import target_of
+        try:
+            return target_of(self.obj)
+        except ValueError:
+            return None
+
+    def tolerance(self) -> float:
+        """The deviation display's tolerance band (mm): the sculpt's TargetTolerance."""
+        return float(getattr(self.obj, "TargetTolerance", 0.1) or 0.1)
+
+    def _deviation(self, s: core.DynamicSurface, mesh: np.ndarray) -> tuple[np.ndarray, tuple[float, float]]:
+        """The scan's signed distance at each mesh point, coloured; grey everywhere without a scan."""
+        from ..app.scan_deviation import mesh_deviation
+        target = self._target()
+        tol = self.tolerance()
+        if target is None:
+            return analysis.deviation_colours(np.full(mesh.shape[:2], np.nan), tol, (-2 * tol, 2 * tol))
+        _, spacing_u, spacing_v = s.reference
+        reach = 2.0 * max(spacing_u, spacing_v) + 2.0 * tol
+        signed = mesh_deviation(mesh, analysis.vertex_normals(mesh), target.tree, target.points,
+                                int(getattr(self.obj, "TargetSide", 0)), reach)
+        return analysis.deviation_colours(signed, tol)
+
+    def _scan_points(self, s: core.DynamicSurface, rng: tuple[float, float]) -> Any:
+        """The scan's points (up to SCAN_POINTS_SHOWN) coloured by their signed deviation from the
+        surface on the surface's scale; measured again when the poles moved, at most every
+        SCAN_REMEASURE_S during a session."""
+        from ..app.scan_deviation import signed_distances, thinned
+        key = np.asarray(s.poles).tobytes()
+        now = time.monotonic()
+        if self._scan is not None and (self._scan[0] == key or now - self._scan[1] < SCAN_REMEASURE_S):
+            return self._scan[2]
+        target = self._target()
+        points = thinned(target.points, SCAN_POINTS_SHOWN)
+        distances, over = signed_distances(s.surface, points, float(int(getattr(self.obj, "TargetSide", 0)) or 1))
+        colours, _ = analysis.deviation_colours(np.where(over, distances, np.nan), self.tolerance(), rng)
+        node = shapes.coloured_points(points, colours, 3.0)
+        self._scan = (key, now, node)
+        return node
+
     def _colours(self, s: core.DynamicSurface, mesh: np.ndarray) -> tuple[np.ndarray, tuple[float, float]]:
         g, h = mesh.shape[:2]
+        if self.display == "deviation":
+            return self._deviation(s, mesh)
         if self.display in MAPS:
             return analysis.map_colours(self.obj.Proxy.live.map_values(self.display), (g, h))
         if self.display == "zebra":

@@ -38,7 +38,9 @@ def _sculpts(doc):
                     "haptic_rate": o.Proxy.live.session.haptic_rate
                     if getattr(o.Proxy, "live", None) and o.Proxy.live.session else 0.0,
                     "selected": o in Gui.Selection.getSelection(), "screen": _on_screen(o), "digest": digest(o),
-                    "drawn_poles": _drawn_poles(o), "curves": _curves(o)})
+                    "drawn_poles": _drawn_poles(o), "curves": _curves(o),
+                    "target": o.Target.Name if getattr(o, "Target", None) is not None else None,
+                    "deviation": json.loads(o.Deviation) if getattr(o, "Deviation", "") else {}})
     return out
 
 

@@ -1,0 +1,109 @@
+"""A scan as a designer uses it in FreeCAD's GUI, with real X events: a file with a clamped patch
+and a scanned bump imported as a mesh (FreeCAD's Mesh importer, as File > Import does); the scan
+and the patch picked (click, ctrl+click), "Set scan target" from the Scan drop-down: the deviation
+shows in colour on the patch and on the scan's points (the grey mesh hidden), with its legend;
+a mouse stroke in a session pulls the patch toward the scan and the deviation report falls; the
+display off again shows the mesh. Screenshots build/screenshots/real_scan_*.png."""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+from freecad_support import run_freecad_gui
+from test_gui_real_input import NEEDS, SHOTS, Desktop, sculpt, undo
+from test_gui_sculpted_solid import view_part
+
+from HapticSculpt.app.analysis import WITHIN_COLOUR
+
+SCAN = """
+import json, os
+import numpy as np
+import FreeCAD, FreeCADGui, Mesh
+import HapticSculpt as hs
+doc = FreeCAD.newDocument("Scan")
+sculpt = hs.make_sculpt(doc, material="clay", edges="held")
+n = 46
+xs = np.linspace(-45, 45, n)
+X, Y = np.meshgrid(xs, xs, indexing="ij")
+P = np.stack([X, Y, 8.0 * np.exp(-(X ** 2 + Y ** 2) / 250.0)], -1)
+tris = []
+for i in range(n - 1):
+    for j in range(n - 1):
+        a, b, c, e = (tuple(P[i, j]), tuple(P[i + 1, j]), tuple(P[i + 1, j + 1]), tuple(P[i, j + 1]))
+        tris += [[a, b, c], [a, c, e]]
+stl = os.path.join(os.path.dirname(PATH), "bump_scan.stl")
+Mesh.Mesh(tris).write(stl)
+Mesh.insert(stl, doc.Name)
+doc.recompute()
+doc.saveAs(PATH)
+json.dump({"scan": next(o.Name for o in doc.Objects if o.isDerivedFrom("Mesh::Feature"))}, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+def overlay(s: dict) -> dict:
+    return next(o for o in s["overlays"] if o["object"] == sculpt(s)["name"])
+
+
+def share(picture: np.ndarray, test) -> float:
+    return float(np.mean(test(picture)))
+
+
+def warm(picture: np.ndarray) -> np.ndarray:  # the positive side's yellow to red: red high, blue low
+    return (picture[..., 0] > 0.85) & (picture[..., 2] < 0.2) & (picture[..., 1] < 0.97)
+
+
+def within(picture: np.ndarray) -> np.ndarray:
+    return np.all(np.abs(picture - WITHIN_COLOUR) < 0.1, axis=2)
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_a_scan_set_as_target_shows_its_deviation_and_a_stroke_reduces_it(tmp_path):
+    os.makedirs(SHOTS, exist_ok=True)
+    path = str(tmp_path / "scan.FCStd")
+    made = run_freecad_gui(f"PATH = {path!r}\n" + SCAN, str(tmp_path))
+    scan = made["scan"]
+    d = Desktop(str(tmp_path), "CAD", open_file=path)
+    try:
+        s = view_part(d, "Sculpt")
+        # (the observer gives the patch's centre and the points 25 mm along x and y, in the view's
+        # pixels: the plane z = 0 maps affinely onto them in the orthographic view)
+        c, east, _, north, _ = (np.array(p, float) for p in sculpt(s)["screen"])
+        on_patch = lambda x, y: d.to_screen(list(c + (east - c) * x / 25 + (north - c) * y / 25))  # noqa: E731
+        top = on_patch(0.0, 0.0)  # the scan's crown lies above the patch's centre: the click finds it first
+        corner = on_patch(-48.5, -48.5)  # the patch, past the scan's edge (45 mm)
+        d.xdo("mousemove", str(top[0]), str(top[1]), "click", "1")
+        d.wait(lambda s: [o for o, _ in s["selection"]] == [scan], "the scan selected")
+        d.xdo("mousemove", str(corner[0]), str(corner[1]), "keydown", "ctrl", "click", "1", "keyup", "ctrl")
+        d.wait(lambda s: sorted(o for o, _ in s["selection"]) == sorted([scan, sculpt(s)["name"]]),
+               "the scan and the patch selected")
+        before_picture = d.shot("scan_before")
+        s = d.press_button("SetTarget", lambda s: sculpt(s)["target"] == scan and s["overlays"]
+                           and overlay(s)["display"] == "deviation", "the target set, the deviation shown")
+        assert undo(s)[0] == "Set target", undo(s)
+        before = sculpt(s)["deviation"]
+        assert 7.5 < before["max_mm"] < 8.5 and before["within_pct"] < 90, before  # the bump is not there yet
+        assert "legend_band" in overlay(s)["hud"], overlay(s)["hud"]  # the +-tolerance band labelled
+        assert "deviation:" in overlay(s)["status_text"], overlay(s)["status_text"]
+        picture = d.shot_changed("scan_deviation", before_picture, "the deviation colours")
+        assert share(picture, warm) > 0.01, "no yellow to red where the scan lies above the patch"
+        assert share(picture, within) > 0.005, "no green where they agree (the edges)"
+        # a stroke: the crown of the patch pulled up toward the scan's
+        centre = top  # (the scan's mesh is hidden now: the mouse finds the patch)
+        d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
+        d.drag([centre] + [(centre[0], centre[1] - 5 * k) for k in range(1, 7)], seconds=0.6)
+        d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
+        d.click_button("Session")
+        s = d.wait(lambda s: not sculpt(s)["session"] and sculpt(s)["deviation"].get("max_mm", 1e9)
+                   < 0.8 * before["max_mm"] and sculpt(s)["deviation"]["p95_mm"] < before["p95_mm"],
+                   "the session to stop with the deviation lower")
+        after = sculpt(s)["deviation"]
+        print("deviation before", before, "after", after)
+        pulled = d.shot("scan_sculpted")
+        assert share(pulled, warm) < share(picture, warm), "the stroke left as much red as before"
+        # the display off: the scan's mesh shows again
+        s = d.press_button("ShowDeviation", lambda s: overlay(s)["display"] == "shading", "the display off")
+        d.shot_changed("scan_off", pulled, "the display off")
+    finally:
+        d.close()
