@@ -2,8 +2,8 @@
 and a scanned bump imported as a mesh (FreeCAD's Mesh importer, as File > Import does); the scan
 and the patch picked (click, ctrl+click), "Set scan target" from the Scan drop-down: the deviation
 shows in colour on the patch and on the scan's points (the grey mesh hidden), with its legend;
-a mouse stroke in a session pulls the patch toward the scan and the deviation report falls; the
-display off again shows the mesh. Screenshots build/screenshots/real_scan_*.png."""
+a mouse stroke in a session pulls the patch toward the scan and the deviation report falls; "Fit to
+scan" brings 95 % of the scan within the tolerance; the display off again shows the mesh. Screenshots build/screenshots/real_scan_*.png."""
 from __future__ import annotations
 
 import os
@@ -102,8 +102,14 @@ def test_a_scan_set_as_target_shows_its_deviation_and_a_stroke_reduces_it(tmp_pa
         print("deviation before", before, "after", after)
         pulled = d.shot("scan_sculpted")
         assert share(pulled, warm) < share(picture, warm), "the stroke left as much red as before"
+        # Fit to scan: within the tolerance (0.1 mm) at 95 % of the scan's points at least
+        s = d.press_button("FitToTarget", lambda s: undo(s)[0] == "Fit to target", "the fit")
+        fitted = sculpt(s)["deviation"]
+        assert fitted["within_pct"] >= 95.0, fitted
+        fitted_picture = d.shot_changed("scan_fitted", pulled, "the fitted surface's colours")
+        assert share(fitted_picture, within) > 2 * share(pulled, within), "the fit did not turn the patch green"
         # the display off: the scan's mesh shows again
         s = d.press_button("ShowDeviation", lambda s: overlay(s)["display"] == "shading", "the display off")
-        d.shot_changed("scan_off", pulled, "the display off")
+        d.shot_changed("scan_off", fitted_picture, "the display off")
     finally:
         d.close()

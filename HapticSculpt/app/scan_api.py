@@ -156,6 +156,10 @@ def deviation_of(obj: Any, tolerance: float | None = None) -> dict[str, Any]:
 
 #: The net a fit refines up to when ``max_controls`` is not given (per direction).
 DEFAULT_MAX_CONTROLS = 48
+#: A cell's root mean square distance, as a share of the tolerance, beyond which its points are
+#: off because of the net, not the scan's noise (a scan within the tolerance at 95 % has noise of
+#: about half of it: its cells stay below).
+SYSTEMATIC = 0.6
 
 
 def _max_controls(value: Any, controls: tuple[int, int]) -> tuple[int, int]:
@@ -173,19 +177,30 @@ def _max_controls(value: Any, controls: tuple[int, int]) -> tuple[int, int]:
 
 
 def _refine_knots(surface: Any, r: dict[str, Any], tolerance: float, room: tuple[int, int]) -> tuple[list[float], list[float]]:
-    """Knots for the spans where the points out of the tolerance are (the midpoints of the spans
-    holding at least a quarter as many as the worst, a third of the spans at most per pass), at
-    most ``room`` per direction."""
-    bad = (r["weights"] > 0) & (np.abs(r["distance"]) > tolerance)
+    """Knots for the spans where the fit is off, not the scan's noise: the cells (a u span by a v
+    span) whose points out of the tolerance are at least a quarter of the worst cell's and whose
+    root mean square distance exceeds SYSTEMATIC of the tolerance (noise well within the tolerance
+    leaves it below; a shape the net cannot follow does not); the midpoints of their spans, a third
+    of the spans at most per pass, at most ``room`` per direction."""
+    from .scan_fit import span_cells
+    kept = r["weights"] > 0
+    d = r["distance"][kept]
+    bu, bv = (np.unique(np.asarray(k, float)) for k in (surface.knots_u, surface.knots_v))
+    cell = span_cells(surface, r["uv"][kept])
+    cells = (len(bu) - 1) * (len(bv) - 1)
+    count = np.bincount(cell, minlength=cells)
+    bad = np.bincount(cell, weights=(np.abs(d) > tolerance).astype(float), minlength=cells)
+    rms = np.sqrt(np.bincount(cell, weights=d * d, minlength=cells) / np.maximum(count, 1))
+    off = (bad >= 0.25 * bad.max(initial=0)) & (bad > 0) & (rms > SYSTEMATIC * tolerance)
     out: tuple[list[float], list[float]] = ([], [])
-    for d, knots in enumerate((surface.knots_u, surface.knots_v)):
-        breaks = np.unique(np.asarray(knots, float))
-        counts = np.histogram(r["uv"][bad, d], bins=breaks)[0]
-        if room[d] <= 0 or counts.max(initial=0) == 0:
+    for direction, (breaks, index) in enumerate(((bu, np.arange(cells) // (len(bv) - 1)),
+                                                  (bv, np.arange(cells) % (len(bv) - 1)))):
+        if room[direction] <= 0:
             continue
-        order = np.argsort(-counts, kind="stable")
-        chosen = [k for k in order if counts[k] >= 0.25 * counts.max()][: max(1, min(room[d], len(counts) // 3))]
-        out[d].extend(float(0.5 * (breaks[k] + breaks[k + 1])) for k in sorted(chosen))
+        score = np.bincount(index[off], weights=bad[off], minlength=len(breaks) - 1)
+        order = [k for k in np.argsort(-score, kind="stable") if score[k] > 0]
+        chosen = order[: max(1, min(room[direction], (len(breaks) - 1) // 3))] if order else []
+        out[direction].extend(float(0.5 * (breaks[k] + breaks[k + 1])) for k in sorted(chosen))
     return out
 
 
@@ -243,7 +258,7 @@ def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[
     ``outliers``, ``beyond_edge``, ``message`` (where and why it fell short) and ``rounds`` (one
     per net: its controls, within_pct, max_mm, p95_mm, outliers, worst_uv)."""
     from . import sculpt_state
-    from .scan_fit import WITHIN_GOAL, FitReport, fit_net
+    from .scan_fit import POINTS_PER_POLE, WITHIN_GOAL, FitReport, fit_net
     sculpt = _sculpt(obj)
     tolerance = _number(tolerance, "tolerance", 1e-6, 1e6)
     live = sculpt.Proxy.live
@@ -277,7 +292,23 @@ def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[
         if room[0] <= 0 and room[1] <= 0:
             report.message = f"stopped at max_controls {limit}: {where}"
             break
-        finer = _refined(sculpt, work, _refine_knots(work.surface, r, tolerance, room))
+        mesh = tuple(sculpt_state.capture(work).settings["mesh"])
+        room = (min(room[0], mesh[0] // 2 - controls[0]), min(room[1], mesh[1] // 2 - controls[1]))
+        if room[0] <= 0 and room[1] <= 0:
+            report.message = (f"stopped at {controls} controls: its {mesh[0]} x {mesh[1]} mesh samples at most half "
+                              f"as many (make the sculpt with a finer mesh for more): {where}")
+            break
+        over_surface = int(np.count_nonzero(~r["beyond_edge"]))
+        if (controls[0] + 1) * (controls[1] + 1) > over_surface / POINTS_PER_POLE:
+            report.message = (f"stopped at {controls} controls: {over_surface} points determine at most "
+                              f"{over_surface // POINTS_PER_POLE} poles ({POINTS_PER_POLE} a pole): {where}")
+            break
+        knots = _refine_knots(work.surface, r, tolerance, room)
+        if not knots[0] and not knots[1]:
+            report.message = (f"what is left out of the tolerance is the scan's noise (no span's points are off by "
+                              f"more than {SYSTEMATIC:g} of it in root mean square; p95 {summary.p95_mm:.3g} mm): {where}")
+            break
+        finer = _refined(sculpt, work, knots)
         if finer is None:
             report.message = (f"not refined (its held poles are not its edges', it is symmetric, or its mesh has no "
                               f"room for more poles): fitted on its net as it is; {where}")

@@ -30,6 +30,14 @@ SETTLED = 0.005
 TANGENTIAL = 0.02
 #: Robust standard deviations beyond which a point is an outlier.
 OUTLIER_SPREAD = 4.0
+#: Points far off in a span cell are outliers only while they are fewer than this share of its
+#: points (a scan's stray returns are about 1 %; a region the fit has not reached is most of its cell).
+CLUSTER = 0.1
+#: ... and at least this many (one stray point in a cell of few is not a region).
+CLUSTER_POINTS = 5
+#: Points over the surface per pole a net is refined to at most (fewer leave poles the scan does
+#: not determine: the fit would follow the noise, and the net slide along itself).
+POINTS_PER_POLE = 40
 #: Share of the points that must lie within the tolerance.
 WITHIN_GOAL = 95.0
 #: The curvature variation's weight, relative to the points'.
@@ -71,13 +79,31 @@ class FitReport:
                            for r in self.rounds]}
 
 
-def robust_weights(distance: np.ndarray, over: np.ndarray, tolerance: float) -> np.ndarray:
-    """1 for points over the surface that are not outliers, 0 for the others."""
+def robust_weights(distance: np.ndarray, over: np.ndarray, tolerance: float, cells: np.ndarray | None = None
+                   ) -> np.ndarray:
+    """1 for points over the surface that are not outliers, 0 for the others. An outlier lies
+    beyond OUTLIER_SPREAD robust standard deviations (and twice the tolerance) and is stray: in its
+    ``cells`` entry (a knot span cell per point) such points are fewer than CLUSTER of the points,
+    so a region the surface does not follow yet (a crown it is below) keeps pulling."""
     a = np.abs(distance)
     used = a[over]
     spread = 1.4826 * float(np.median(used)) if used.size else 0.0
     limit = max(OUTLIER_SPREAD * spread, 2.0 * tolerance)
-    return (over & (a <= limit)).astype(float)
+    far = over & (a > limit)
+    if cells is not None and far.any():
+        counts = np.bincount(cells[over], minlength=int(cells.max()) + 1)
+        far_counts = np.bincount(cells[far], minlength=len(counts))
+        clustered = (far_counts > CLUSTER * np.maximum(counts, 1)) & (far_counts >= CLUSTER_POINTS)
+        far &= ~clustered[cells]
+    return (over & ~far).astype(float)
+
+
+def span_cells(surface: core.BSplineSurface, uv: np.ndarray) -> np.ndarray:
+    """The knot span cell (u span x v span, row-major) each parameter pair lies in."""
+    bu, bv = (np.unique(np.asarray(k, float)) for k in (surface.knots_u, surface.knots_v))
+    iu = np.clip(np.searchsorted(bu, uv[:, 0], side="right") - 1, 0, len(bu) - 2)
+    iv = np.clip(np.searchsorted(bv, uv[:, 1], side="right") - 1, 0, len(bv) - 2)
+    return iu * (len(bv) - 1) + iv
 
 
 def fit_net(surface: core.DynamicSurface, points: np.ndarray, tolerance: float,
@@ -86,13 +112,13 @@ def fit_net(surface: core.DynamicSurface, points: np.ndarray, tolerance: float,
     Returns the poles, the round's summary and the last projection (with the weights)."""
     nu, nv = surface.surface.controls
     r = surface.surface.project(points)
-    w = robust_weights(r["distance"], ~r["beyond_edge"], tolerance)
+    w = robust_weights(r["distance"], ~r["beyond_edge"], tolerance, span_cells(surface.surface, r["uv"]))
     mean = math.inf
     for _ in range(rounds):
         fitted = surface.fit_poles(points, r["uv"], r["normal"], w, TANGENTIAL, smoothing)
         surface.set_poles(fitted.reshape(nu, nv, 3))
         r = surface.surface.project(points, start=r["uv"])
-        w = robust_weights(r["distance"], ~r["beyond_edge"], tolerance)
+        w = robust_weights(r["distance"], ~r["beyond_edge"], tolerance, span_cells(surface.surface, r["uv"]))
         kept = w > 0
         now = float(np.abs(r["distance"][kept]).mean()) if kept.any() else 0.0
         if mean - now < SETTLED * tolerance:

@@ -5,7 +5,10 @@
 
 #include <cmath>
 #include <cstdint>
+#include <algorithm>
 #include <optional>
+#include <thread>
+#include <vector>
 
 #include "geometry/falloff.hpp"
 #include "bindings.hpp"
@@ -28,6 +31,19 @@ py::dict curvatureDict(const Curvature& c) {
     py::dict r;
     r["u"] = c.ku; r["v"] = c.kv; r["min"] = c.kmin; r["max"] = c.kmax; r["mean"] = c.mean; r["gauss"] = c.gauss;
     return r;
+}
+
+// Runs body(begin, end) over [0, n) in as many slices as the machine has cores (one below 20000:
+// a thread costs more than it saves), each on its own thread: the queries are independent and
+// read-only, each slice writes its own rows.
+template <class Body>
+void slices(py::ssize_t n, Body&& body) {
+    const py::ssize_t cores = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
+    const py::ssize_t parts = n < 20000 ? 1 : cores;
+    std::vector<std::thread> threads;
+    for (py::ssize_t k = 1; k < parts; ++k) threads.emplace_back(body, n * k / parts, n * (k + 1) / parts);
+    body(py::ssize_t{0}, n / parts);
+    for (std::thread& t : threads) t.join();
 }
 
 // An (n, 3) array of points (n >= 0) named `name`.
@@ -115,13 +131,15 @@ void bindGeometry(py::module_& m) {
                 py::gil_scoped_release release;
                 double *a = uv.mutable_data(), *f = foot.mutable_data(), *nn = normal.mutable_data(), *d = dist.mutable_data();
                 bool* b = beyond.mutable_data();
-                for (py::ssize_t i = 0; i < n; ++i) {
-                    const SurfaceFoot r = from ? projection.project(x.row(i).transpose(), from[2 * i], from[2 * i + 1])
-                                               : projection.project(x.row(i).transpose());
-                    a[2 * i] = r.u, a[2 * i + 1] = r.v;
-                    for (int c = 0; c < 3; ++c) f[3 * i + c] = r.point[c], nn[3 * i + c] = r.normal[c];
-                    d[i] = r.distance, b[i] = r.beyondEdge;
-                }
+                slices(n, [&](py::ssize_t begin, py::ssize_t end) {
+                    for (py::ssize_t i = begin; i < end; ++i) {
+                        const SurfaceFoot r = from ? projection.project(x.row(i).transpose(), from[2 * i], from[2 * i + 1])
+                                                   : projection.project(x.row(i).transpose());
+                        a[2 * i] = r.u, a[2 * i + 1] = r.v;
+                        for (int c = 0; c < 3; ++c) f[3 * i + c] = r.point[c], nn[3 * i + c] = r.normal[c];
+                        d[i] = r.distance, b[i] = r.beyondEdge;
+                    }
+                });
             }
             py::dict out;
             out["uv"] = uv; out["foot"] = foot; out["normal"] = normal; out["distance"] = dist; out["beyond_edge"] = beyond;
@@ -148,11 +166,13 @@ void bindGeometry(py::module_& m) {
                 py::gil_scoped_release release;
                 std::int64_t* ix = index.mutable_data();
                 double* d = dist.mutable_data();
-                for (py::ssize_t i = 0; i < n; ++i) {
-                    double d2 = 0;
-                    ix[i] = t.nearest(x.row(i).transpose(), d2);
-                    d[i] = std::sqrt(d2);
-                }
+                slices(n, [&](py::ssize_t begin, py::ssize_t end) {
+                    for (py::ssize_t i = begin; i < end; ++i) {
+                        double d2 = 0;
+                        ix[i] = t.nearest(x.row(i).transpose(), d2);
+                        d[i] = std::sqrt(d2);
+                    }
+                });
             }
             return py::make_tuple(index, dist);
         }, py::arg("queries"), "For each of queries ((n, 3)): the index of the nearest point and its distance.");

@@ -6,16 +6,19 @@
 // the distance along the surface's normal n_k at the point's foot weighed fully and the slide
 // along the surface by a (tangential < 1): the feet then follow the points in a few rounds where
 // plain least squares (a = 1) creeps (Wang, Pottmann and Liu's squared distance minimisation,
-// without its curvature term). tau = smoothing x trace(data) / (3 trace(A^T C^T C A)).
+// without its curvature term). tau = smoothing x trace(data) / (3 trace(A^T C^T C A)), A the
+// sampling of a grid at least 3 points per span.
 // Solved for the increment in the free poles (P = T z, held_poles.hpp), T applied to each
 // coordinate: held poles stay, linked ones follow, the mirror symmetry is put back exactly. The
 // normal matrix is summed into a band of 3 x 3 blocks, (2p+1)(2q+1) per pole, so millions of
 // points cost no triplet list.
 #include <Eigen/SparseCholesky>
 
+#include <algorithm>
 #include <stdexcept>
 #include <vector>
 
+#include "geometry/sampling_operator.hpp"
 #include "solvers/curvature_variation.hpp"
 #include "solvers/dynamic_surface.hpp"
 
@@ -100,18 +103,21 @@ Points DynamicSurface::fitPoles(const Points& targets, const Eigen::MatrixX2d& u
                 if (ib == ia) trace += x.trace();
             }
     if (!(trace > 0)) throw std::invalid_argument("targets: no point with a weight > 0");
-    // The curvature variation acts on each coordinate alike; poles neither it nor a point reaches
-    // stay where they are (and the system factors).
+    // The curvature variation acts on each coordinate alike, measured on a grid of 3 samples per
+    // span at least (the sculpt's own mesh may see a finely refined net too coarsely to bridge a
+    // hole); poles neither it nor a point reaches stay where they are (and the system factors).
     std::vector<int> centre;
-    const Eigen::SparseMatrix<double> A = state_.A.matrix().toEigen();
-    const Eigen::SparseMatrix<double> CA = curvatureVariation(g(), h(), state_.spacingU, state_.spacingV, centre) * A;
+    const int gu = std::max(g(), 3 * S.nu()), gv = std::max(h(), 3 * S.nv());
+    const Eigen::SparseMatrix<double> A = SamplingOperator(S, gu, gv).matrix().toEigen();
+    const double su = state_.spacingU * (g() - 1) / (gu - 1), sv = state_.spacingV * (h() - 1) / (gv - 1);
+    const Eigen::SparseMatrix<double> CA = curvatureVariation(gu, gv, su, sv, centre) * A;
     const Eigen::SparseMatrix<double> F = CA.transpose() * CA;
     const double variation = CA.squaredNorm();
     const double tau = smoothing > 0 && variation > 0 ? smoothing * trace / (3 * variation) : 0.0;
     for (int k = 0; k < F.outerSize(); ++k)
         for (Eigen::SparseMatrix<double>::InnerIterator it(F, k); it; ++it)
             for (int c = 0; c < 3; ++c) entries.emplace_back(3 * it.row() + c, 3 * it.col() + c, tau * it.value());
-    for (int i = 0; i < 3 * poles; ++i) entries.emplace_back(i, i, 1e-10 * trace / (3 * poles));
+    for (int i = 0; i < 3 * poles; ++i) entries.emplace_back(i, i, 1e-8 * trace / (3 * poles));
     Eigen::SparseMatrix<double> sys(3 * poles, 3 * poles);
     sys.setFromTriplets(entries.begin(), entries.end());
 
