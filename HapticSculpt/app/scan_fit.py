@@ -37,7 +37,7 @@ CLUSTER = 0.1
 CLUSTER_POINTS = 5
 #: Points over the surface per pole a net is refined to at most (fewer leave poles the scan does
 #: not determine: the fit would follow the noise, and the net slide along itself).
-POINTS_PER_POLE = 40
+POINTS_PER_POLE = 12
 #: Share of the points that must lie within the tolerance.
 WITHIN_GOAL = 95.0
 #: The curvature variation's weight, relative to the points'.
