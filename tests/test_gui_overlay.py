@@ -279,8 +279,10 @@ def test_overlay_commands_keys_and_pictures(tmp_path):
     assert out["inactive"].pop("HapticSculpt_NewPatch") and out["inactive"].pop("HapticSculpt_NewClampedPatch")
     assert not any(v for k, v in out["inactive"].items()), out["inactive"]
     selection_based = {"HapticSculpt_SculptFace", "HapticSculpt_Thicken", "HapticSculpt_ExportStep",
-                       "HapticSculpt_FollowCurve"}
-    assert all(v for k, v in out["active"].items() if k not in selection_based), out["active"]
+                       "HapticSculpt_FollowCurve", "HapticSculpt_SetTarget"}
+    target_based = {"HapticSculpt_ShowDeviation", "HapticSculpt_FitToTarget"}  # (a sculpt with a scan target)
+    assert all(v for k, v in out["active"].items() if k not in selection_based | target_based), out["active"]
+    assert not any(out["active"][k] for k in target_based), out["active"]  # (this sculpt has none)
     assert out["constraints"] == ["curvature", "normal", "point"]
     assert out["painting"] == "stiffness" and out["painting_after"] is None
     assert out["paint_undo_steps"] == 1  # a whole airbrush stroke is one undo step
