@@ -107,8 +107,9 @@ def test_a_scan_set_as_target_shows_its_deviation_and_a_stroke_reduces_it(tmp_pa
         d.drag([centre] + [(centre[0], centre[1] - 5 * k) for k in range(1, 7)], seconds=0.6)
         d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
         d.click_button("Session")
+        # (how far 30 pixels pull depends on the view's size: FreeCAD 1.x has its tree beside it)
         s = d.wait(lambda s: not sculpt(s)["session"] and sculpt(s)["deviation"].get("max_mm", 1e9)
-                   < 0.8 * before["max_mm"] and sculpt(s)["deviation"]["p95_mm"] < before["p95_mm"],
+                   < 0.95 * before["max_mm"] and sculpt(s)["deviation"]["p95_mm"] < 0.9 * before["p95_mm"],
                    "the session to stop with the deviation lower")
         after = sculpt(s)["deviation"]
         print("deviation before", before, "after", after)
