@@ -245,12 +245,13 @@ def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[
 
     Each pass fits the poles to the points (least squares at the points' closest parameters,
     repeated as they settle), weighing out the outliers (farther than 4 robust standard deviations
-    and twice the tolerance) and the points past the surface's edges; where there are no points
+    and twice the tolerance, unless they gather in a span: a region the surface has not reached)
+    and the points past the surface's edges; where there are no points
     (a hole) the surface is bridged by its curvature variation. Held edges, seams, symmetry and
     curve constraints hold exactly. Where the fit stays out of the tolerance, knots are inserted in
-    the spans where the points out of it are (exactly: the shape is kept) and it fits again, up to
-    ``max_controls`` poles per direction (a number or a pair; default 48, never fewer than the net
-    has). A sculpt whose held poles are not its edges', a symmetric one, and a sculpted solid's
+    the spans whose points are off by more than the scan's noise (exactly: the shape is kept) and it
+    fits again, up to ``max_controls`` poles per direction (a number or a pair; default 48, never
+    fewer than the net has), half the mesh's points and one pole per 12 points. A sculpt whose held poles are not its edges', a symmetric one, and a sculpted solid's
     face are fitted on their net as it is (the report says so).
 
     One undo step; the fitted shape is the rest shape. Not during a session (RuntimeError).
@@ -271,7 +272,7 @@ def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[
     limit = _max_controls(max_controls, tuple(work.surface.controls))
     points = target.points
     if work.symmetry is not None:  # the symmetric fit of the points is the fit of them and their mirror image
-        direction, point, normal = work.symmetry
+        _, point, normal = work.symmetry
         n = np.asarray(normal, float) / np.linalg.norm(normal)
         points = np.vstack([points, points - 2.0 * ((points - np.asarray(point, float)) @ n)[:, None] * n])
     solid = is_sculpted_solid(obj) or solid_of(sculpt) is not None
