@@ -14,21 +14,16 @@ from typing import Any
 import numpy as np
 
 from . import scan_deviation, scan_target
-from .sculpt_feature import is_sculpt
+from .api import _sculpt as api_sculpt
 from .sculpt_properties import read_state
-from .sculpted_solid import is_sculpted_solid, sculpt_of, solid_of
+from .sculpted_solid import solid_of
 from .undo import transaction
 
 GROUP = "Scan"
 
 
 def _sculpt(obj: Any) -> Any:
-    if is_sculpted_solid(obj):
-        return sculpt_of(obj)
-    if not is_sculpt(obj):
-        raise TypeError(f"obj: expected a HapticSculpt Sculpt or SculptedSolid object, got "
-                        f"{getattr(obj, 'TypeId', type(obj).__name__)}")
-    return obj
+    return api_sculpt(obj, solids=True)
 
 
 def _number(value: Any, name: str, low: float, high: float) -> float:
@@ -275,10 +270,10 @@ def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[
         _, point, normal = work.symmetry
         n = np.asarray(normal, float) / np.linalg.norm(normal)
         points = np.vstack([points, points - 2.0 * ((points - np.asarray(point, float)) @ n)[:, None] * n])
-    solid = is_sculpted_solid(obj) or solid_of(sculpt) is not None
+    solid = solid_of(sculpt) is not None
     report = FitReport(tolerance, 0.0, False, tuple(work.surface.controls))
     while True:
-        _, summary, r = fit_net(work, points, tolerance)
+        summary, r = fit_net(work, points, tolerance)
         report.rounds.append(summary)
         report.within_pct, report.controls = summary.within_pct, summary.controls
         if summary.within_pct >= WITHIN_GOAL:

@@ -107,9 +107,9 @@ def span_cells(surface: core.BSplineSurface, uv: np.ndarray) -> np.ndarray:
 
 
 def fit_net(surface: core.DynamicSurface, points: np.ndarray, tolerance: float,
-            smoothing: float = SMOOTHING, rounds: int = ROUNDS) -> tuple[np.ndarray, FitRound, dict[str, Any]]:
+            smoothing: float = SMOOTHING, rounds: int = ROUNDS) -> tuple[FitRound, dict[str, Any]]:
     """Fits ``surface``'s poles to ``points`` on its net as it is (the surface is moved there).
-    Returns the poles, the round's summary and the last projection (with the weights)."""
+    Returns the net's summary and the last projection (with the weights)."""
     nu, nv = surface.surface.controls
     r = surface.surface.project(points)
     w = robust_weights(r["distance"], ~r["beyond_edge"], tolerance, span_cells(surface.surface, r["uv"]))
@@ -133,4 +133,4 @@ def fit_net(surface: core.DynamicSurface, points: np.ndarray, tolerance: float,
                        float(measured.max()) if measured.size else math.inf,
                        float(np.percentile(measured, 95)) if measured.size else math.inf,
                        int(np.count_nonzero(over & ~kept)), (float(r["uv"][worst, 0]), float(r["uv"][worst, 1])))
-    return np.asarray(surface.poles).reshape(-1, 3).copy(), summary, r | {"weights": w}
+    return summary, r | {"weights": w}
