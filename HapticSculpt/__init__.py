@@ -32,7 +32,7 @@ from .app.api import (
                       to_cadquery,
 )
 from .app.curve_api import add_curve_constraint, curve_constraints_of
-from .app.scan_api import clear_target, deviation_of, fit_to_target, set_target, target_object
+from .app.scan_api import clear_target, deviation_of, fit_to_target, pull_of, set_pull, set_target, target_object
 from .app.sculpted_solid import boundary_of, seam_report_of
 from .app.solid_api import sculpt_solid, set_boundary
 from .runtime.replay_device import CursorSample, ReplayDevice
@@ -45,6 +45,6 @@ __all__ = ["make_sculpt", "fair", "sculpt_solid", "set_boundary", "boundary_of",
            "curve_constraints_of", "remove_constraint", "hold_boundary", "held_boundary",
            "set_material", "material_of", "keep_shape", "set_regional",
            "set_tool", "set_uniform", "set_curvature_target", "paint", "record_state", "replay_stroke",
-           "set_target", "clear_target", "fit_to_target", "target_object", "deviation_of", "export_step", "thicken", "make_thickness",
+           "set_target", "clear_target", "set_pull", "pull_of", "fit_to_target", "target_object", "deviation_of", "export_step", "thicken", "make_thickness",
            "to_cadquery", "ReplayDevice", "CursorSample", "CursorSource", "RunReport", "Session", "stop_all",
            "__version__"]

@@ -76,7 +76,9 @@ class TestScanTarget(DocumentTestCase):
         self.doc = FreeCAD.openDocument(path)
         sculpt = self.doc.getObject(sculpt_name)
         self.assertEqual(sculpt.Target.Name, name)
-        self.assertEqual((sculpt.TargetWeight, sculpt.TargetTolerance), (2.0, 0.5))
+        self.assertEqual(sculpt.TargetTolerance, 0.5)
+        pull = hs.pull_of(sculpt)  # (the weight is the pull's strength, in the sculpt state)
+        self.assertEqual((pull["enabled"], pull["strength"], pull["target"]), (True, 2.0, True))
         self.assertEqual(sculpt.Deviation, stored)
         self.assertEqual(hs.deviation_of(sculpt)["points"], 3000)
 
@@ -195,7 +197,7 @@ class TestScanTarget(DocumentTestCase):
 
     def test_the_deviation_property_follows_a_stroke(self):
         rng = np.random.default_rng(2)
-        hs.set_target(self.sculpt, np.c_[rng.uniform(-45, 45, (2000, 2)), np.zeros(2000)])
+        hs.set_target(self.sculpt, np.c_[rng.uniform(-45, 45, (2000, 2)), np.zeros(2000)], weight=0.0)  # (no pull back)
         self.assertAlmostEqual(self.deviation_property()["max_mm"], 0.0, places=9)
         pull(self.sculpt, 6.0)
         self.doc.recompute()

@@ -319,13 +319,13 @@ def set_tool(obj: Any, tool: str, falloff: str | None = None, **settings: float)
 
 
 def set_uniform(obj: Any, map: str, value: float) -> None:
-    """Sets material map ``map`` ("mass", "damping", "stiffness", "bending") to ``value`` everywhere
-    (the slider panel's edit; damping and bending may be 0: off; bending is a ratio to the
-    stiffness, FAIR_BENDING for fair strokes: every new sculpt's). One undo step; a running
-    session takes it at once."""
+    """Sets material map ``map`` ("mass", "damping", "stiffness", "bending", "pull") to ``value``
+    everywhere (the slider panel's edit; damping, bending and pull may be 0: off; bending is a ratio
+    to the stiffness, FAIR_BENDING for fair strokes: every new sculpt's; pull scales the pull
+    toward the target, 1 by default). One undo step; a running session takes it at once."""
     obj = _sculpt(obj, solids=True)
     sculpt_state.map_property(map)  # validates the name
-    off = map in ("damping", "bending")
+    off = map in ("damping", "bending", "pull")
     value = _finite(value, "value", nonnegative=off, positive=not off)
     obj.Proxy.live.edit(lambda s: getattr(s, map + "_map").set_uniform(value), f"Set {map}")
 

@@ -21,7 +21,7 @@ from typing import Any, Callable, Protocol, TypeVar
 import numpy as np
 
 from .. import core
-from . import scan_deviation, sculpt_state
+from . import scan_deviation, scan_target, sculpt_state
 from .sculpt_properties import face_of, read_state, set_error, write_state
 from .undo import transaction
 
@@ -269,6 +269,23 @@ class LiveSurface:
         self._shadow_stale = True
         self._head = None
 
+    def target_changed(self) -> None:
+        """The ``Target`` link changed: the surface pulls toward the new target (none) from now on;
+        a running session takes it at once, carrying its motion on (no undo step of its own: the
+        link's is the one)."""
+        if self._session is None:
+            if self._surface is not None and not self._stale:
+                self._with_target(self._surface)
+            return
+        if not self._session.running:
+            return
+        prepared = self._configured()
+        poles = self._session.newest_poles()
+        if poles is not None:
+            prepared.set_poles(np.asarray(poles, float).reshape(np.asarray(prepared.poles).shape))
+        self._session.post_edit(prepared, None, "", restore=False, keep_maps=True, keep_shape=False)
+        self._shadow_stale = True
+
     def restore_into_session(self) -> None:
         """Hands the document's state (after Undo or Redo) to the running session, at rest."""
         if self._session is None:
@@ -280,7 +297,9 @@ class LiveSurface:
     # --- helpers ----------------------------------------------------------------------------------
     def _configured(self) -> core.DynamicSurface:
         """A new surface configured as the last edit left it (the document's, before any)."""
-        return sculpt_state.restore(self._head) if self._head is not None else self._from_document()
+        if self._head is None:
+            return self._from_document()
+        return self._with_target(sculpt_state.restore(self._head))
 
     def _from_document(self) -> core.DynamicSurface:
         obj = self._obj
@@ -291,6 +310,15 @@ class LiveSurface:
             set_error(obj, message, self)
             raise ValueError(message) from exc
         set_error(obj, "", self)
+        return self._with_target(surface)
+
+    def _with_target(self, surface: core.DynamicSurface) -> core.DynamicSurface:
+        """``surface`` pulling toward the scan the ``Target`` link names (no target: no pull)."""
+        try:
+            target = scan_target.target_of(self._obj)
+        except ValueError:
+            target = None  # (a deleted or emptied target: the Deviation property and deviation_of say so)
+        surface.set_pull_target(target.tree if target is not None else None, scan_target.PULL_REACH * surface.size)
         return surface
 
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from . import sculpt_state
 
-_MAPS = ("MassMap", "DampingMap", "StiffnessMap", "BendingMap")
+_MAPS = ("MassMap", "DampingMap", "StiffnessMap", "BendingMap", "PullMap")
 _SPARSE_SHARE = 0.5  # an array with fewer changed entries than this share is stored as (index, value)
 
 

@@ -1,9 +1,11 @@
-"""Scripting API of scan targets (issue 30): give a sculpt a scan to be measured against, and read
-how far the scan lies from it.
+"""Scripting API of scan targets (issue 30): give a sculpt a scan to be measured against and pulled
+toward, read how far the scan lies from it, fit it.
 
 The target is a document object the Sculpt's ``Target`` property links to (:mod:`scan_target`);
-``TargetWeight`` and ``TargetTolerance`` are numbers beside it and ``Deviation`` is the report
-(JSON, read-only) kept up to date at each recompute (:mod:`scan_deviation`).
+``TargetTolerance`` is a number beside it and ``Deviation`` is the report (JSON, read-only) kept up
+to date at each recompute (:mod:`scan_deviation`). The pull (data springs toward the target, in
+sessions and ``hs.run``) is part of the sculpt state: on or off, its strength, and the ``pull`` map
+painted like the other material maps.
 """
 from __future__ import annotations
 
@@ -40,9 +42,6 @@ def _ensure_properties(sculpt: Any) -> None:
     if "Target" not in props:
         sculpt.addProperty("App::PropertyLink", "Target", GROUP, "The scan the surface is measured against "
                            "(a mesh or point cloud in the document)")
-    if "TargetWeight" not in props:
-        sculpt.addProperty("App::PropertyFloat", "TargetWeight", GROUP, "How strongly the target pulls the "
-                           "surface (0: not at all)")
     if "TargetTolerance" not in props:
         sculpt.addProperty("App::PropertyFloat", "TargetTolerance", GROUP, "Deviation (mm) a point may have "
                            "and count as within")
@@ -72,16 +71,17 @@ def _outward_side(sculpt: Any) -> int:
 
 
 def set_target(obj: Any, target: Any, weight: float = 1.0, tolerance: float = 0.1) -> Any:
-    """Sets the scan ``obj`` (a Sculpt or SculptedSolid) is measured against, and returns its
-    document object. ``target``: a ``Mesh::Feature`` or ``Points::Feature`` of the document
-    (linked), a path to an STL, OBJ or PLY file (read into a new Mesh or Points object), or an
-    (n, 3) array of points (up to 20 million; kept in a new Points object). The target's
-    ``Placement`` positions it. ``weight`` (0..1e6) is how strongly it pulls the surface;
-    ``tolerance`` (mm, > 0) is the deviation a point may have to count as within.
+    """Sets the scan ``obj`` (a Sculpt or SculptedSolid) is measured against and pulled toward,
+    and returns its document object. ``target``: a ``Mesh::Feature`` or ``Points::Feature`` of the
+    document (linked), a path to an STL, OBJ or PLY file (read into a new Mesh or Points object), or
+    an (n, 3) array of points (up to 20 million; kept in a new Points object). The target's
+    ``Placement`` positions it. ``weight`` (0..1e6) is the strength of its pull (see
+    :func:`set_pull`; 0 switches it off); ``tolerance`` (mm, > 0) is the deviation a point may have
+    to count as within.
 
-    One undo step (the new object and the link together); saved with the document. ValueError or
-    TypeError naming the argument for an empty, non-finite, missing or unreadable target, and
-    nothing changes. Returns the target object."""
+    One undo step (the new object, the link and the pull together); saved with the document.
+    ValueError or TypeError naming the argument for an empty, non-finite, missing or unreadable
+    target, and nothing changes. Returns the target object."""
     sculpt = _sculpt(obj)
     weight = _number(weight, "weight", 0.0, 1e6)
     tolerance = _number(tolerance, "tolerance", 1e-9, 1e6)
@@ -103,19 +103,56 @@ def set_target(obj: Any, target: Any, weight: float = 1.0, tolerance: float = 0.
     # The properties are added outside the undo step: FreeCAD's redo of a link added and set in one
     # transaction with the object it links to restores a link to the deleted object.
     _ensure_properties(sculpt)
-    with transaction(doc, "Set target"):
-        if made is not None:
-            target = scan_target.add_target_object(doc, made, f"{sculpt.Name}Target")
-        sculpt.Target = target
-        sculpt.TargetWeight = weight
+    chosen = []
+
+    def link() -> None:
+        linked = scan_target.add_target_object(doc, made, f"{sculpt.Name}Target") if made is not None else target
+        sculpt.Target = linked
         sculpt.TargetTolerance = tolerance
         sculpt.TargetSide = _outward_side(sculpt)
         scan_deviation.refresh_property(sculpt)
-    return target
+        chosen.append(linked)
+
+    live = sculpt.Proxy.live
+    if live.session is None:
+        live.edit(lambda s: s.set_pull(weight > 0, weight if weight > 0 else s.pull["strength"]), "Set target",
+                  inside=link)
+    else:  # (the session commits the pull's change when it took it: its own undo step)
+        with transaction(doc, "Set target"):
+            link()
+        if weight != live.snapshot().pull["strength"] or (weight > 0) != live.snapshot().pull["enabled"]:
+            set_pull(sculpt, weight > 0, weight if weight > 0 else None)
+    return chosen[0]  # (the link's change hands the surface its new target: SculptFeature.onChanged)
+
+
+def set_pull(obj: Any, enabled: bool | None = None, strength: float | None = None) -> None:
+    """Switches the pull toward the target on or off and sets its ``strength`` (0..1e6; None keeps
+    either). At strength 1 a mesh point pulled alone settles on the scan in about 1/40 s, and the
+    pull outweighs the sheet's own stiffness over a feature a few mesh cells wide; the ``pull`` map
+    (``hs.paint(obj, "pull", ...)``) scales it where it is painted, 0 nowhere. The pull acts in
+    sessions and ``hs.run``: each mesh point hangs on a critically damped spring to the nearest
+    scan point within a tenth of the surface's size, dropped where that point lies past the
+    scan's edge or across a hole. One undo step; during a session it takes effect at once."""
+    sculpt = _sculpt(obj)
+    if enabled is not None and not isinstance(enabled, bool):
+        raise TypeError(f"enabled: expected True, False or None, got {type(enabled).__name__}")
+    if strength is not None:
+        strength = _number(strength, "strength", 0.0, 1e6)
+    live = sculpt.Proxy.live
+    current = live.snapshot().pull
+    on = current["enabled"] if enabled is None else enabled
+    value = current["strength"] if strength is None else strength
+    live.edit(lambda s: s.set_pull(on, value), "Pull toward target" if on else "Stop pulling toward target")
+
+
+def pull_of(obj: Any) -> dict[str, Any]:
+    """The pull toward the target: ``enabled``, ``strength``, ``target`` (whether one is set),
+    ``reach`` (mm), ``active`` (it pulls), ``anchored`` (mesh points it holds now)."""
+    return dict(_sculpt(obj).Proxy.live.snapshot().pull)
 
 
 def clear_target(obj: Any) -> None:
-    """Removes the target link (the target object stays in the document). One undo step."""
+    """Removes the target link (the target object stays in the document); the pull stops. One undo step."""
     sculpt = _sculpt(obj)
     if "Target" not in sculpt.PropertiesList or sculpt.Target is None:
         return

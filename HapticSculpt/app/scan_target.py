@@ -18,6 +18,9 @@ from .. import core
 
 #: Most points a target may have (a 2-million-point scan fits with room).
 MAX_POINTS = 20_000_000
+#: How far (a share of the surface's size, its bounding-box diagonal) a scan point may be from the
+#: mesh and still pull it: a patch placed near a scan finds it, another part of the scan does not.
+PULL_REACH = 0.1
 #: What :func:`add_target_object` reads.
 SUFFIXES = (".stl", ".obj", ".ply")
 

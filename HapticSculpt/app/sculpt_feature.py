@@ -63,12 +63,15 @@ class SculptFeature:
         scan_deviation.refresh_property(obj)
 
     def onChanged(self, obj: Any, prop: str) -> None:
-        """A state property changed from outside (Undo, Redo, a script): the live surface follows."""
+        """A state property changed from outside (Undo, Redo, a script): the live surface follows;
+        so does its pull when the ``Target`` link changed."""
         live = getattr(self, "live", None)
         if live is not None and prop in STATE_PROPERTIES:
             live.property_written()
             if not live.writing:
                 live.document_changed()
+        elif live is not None and prop == "Target":
+            live.target_changed()
 
     def onDocumentRestored(self, obj: Any) -> None:
         """Opening a file: add properties older files lack, then load the state (errors are reported

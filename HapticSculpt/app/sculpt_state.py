@@ -3,7 +3,8 @@
 This is what a FreeCAD document stores (float lists are saved as binary doubles, JSON floats are
 written with ``repr``), so ``restore(capture(s))`` reproduces ``s`` bit for bit: poles, velocities,
 knots, weights, sampling, rest lengths, the bending reference, material maps, constraints (with their ids), held and
-linked poles, walls, mirror symmetry, laws, plasticity, tool and integrator settings. No FreeCAD import here.
+linked poles, walls, mirror symmetry, laws, plasticity, the pull toward a scan (on, strength; its target is the
+``Target`` link, see :mod:`scan_target`), tool and integrator settings. No FreeCAD import here.
 """
 from __future__ import annotations
 
@@ -19,19 +20,19 @@ from .. import core
 FORMAT_VERSION = 1
 #: The float arrays of a state, by the name of the document property that holds each.
 ARRAY_NAMES = ("Poles", "Velocities", "KnotsU", "KnotsV", "Weights", "RestLengths",
-               "MassMap", "DampingMap", "StiffnessMap", "BendingMap", "BendingReference")
+               "MassMap", "DampingMap", "StiffnessMap", "BendingMap", "BendingReference", "PullMap")
 _MAPS = {"MassMap": "mass_map", "DampingMap": "damping_map", "StiffnessMap": "stiffness_map",
-         "BendingMap": "bending_map"}
-#: Arrays documents from before the bending energy do not have (empty there: the core's default).
-_OPTIONAL = ("BendingMap", "BendingReference")
+         "BendingMap": "bending_map", "PullMap": "pull_map"}
+#: Arrays documents from before the bending energy or the pull do not have (empty there: the core's default).
+_OPTIONAL = ("BendingMap", "BendingReference", "PullMap")
 
 
 def map_property(name: str) -> str:
-    """The document property of material map ``name`` ("mass", "damping", "stiffness" or "bending")."""
+    """The document property of material map ``name`` ("mass", "damping", "stiffness", "bending" or "pull")."""
     for prop, attr in _MAPS.items():
         if attr == name + "_map":
             return prop
-    raise ValueError(f"map: one of mass, damping, stiffness, bending, not {name!r}")
+    raise ValueError(f"map: one of mass, damping, stiffness, bending, pull, not {name!r}")
 
 
 @dataclass
@@ -116,6 +117,7 @@ def capture(surface: core.DynamicSurface) -> SculptState:
         "plasticity": list(surface.plasticity),
         "constraint_stiffness_factor": surface.constraint_stiffness_factor,
         "max_point_force": surface.max_point_force,
+        "pull": [surface.pull["enabled"], surface.pull["strength"]],
         "tool": tool_settings(surface),
         "constraints": constraints,
         "held_poles": list(surface.held_poles),
@@ -274,6 +276,11 @@ def _apply_settings(surface: core.DynamicSurface, s: dict[str, Any]) -> None:
             surface.set_damping_law(*s["damping_law"])
         if "plasticity" in s:
             surface.set_plasticity(*s["plasticity"])
+        if "pull" in s:
+            enabled, strength = s["pull"]
+            if not isinstance(enabled, bool):
+                raise TypeError(f"pull: expected [on, strength], got {s['pull']!r}")
+            surface.set_pull(enabled, strength)
         if "tool" in s:
             apply_tool(surface, s["tool"])
     except (TypeError, ValueError) as exc:

@@ -22,10 +22,11 @@ GROUPS = {
                                [*(f"HapticSculpt_Tool{core.TOOL_INFO[t]['title']}" for t in core.TOOLS),
                                 "HapticSculpt_Falloff"], 0),
     "HapticSculpt_MaterialGroup": ("Material", "The material: elastic or clay, keep the shape, fair it, airbrush "
-                                   "the mass, damping, stiffness or bending map, the slider panel",
+                                   "the mass, damping, stiffness, bending or pull map, the slider panel",
                                    ["HapticSculpt_Material", "HapticSculpt_KeepShape", "HapticSculpt_Fair",
                                     "HapticSculpt_PaintMass", "HapticSculpt_PaintDamping",
-                                    "HapticSculpt_PaintStiffness", "HapticSculpt_PaintBending", "HapticSculpt_Panel"],
+                                    "HapticSculpt_PaintStiffness", "HapticSculpt_PaintBending", "HapticSculpt_PaintPull",
+                                    "HapticSculpt_Panel"],
                                    0),
     "HapticSculpt_ConstraintGroup": ("Constraints and edges", "Hold the edges (free / G0 to G3), follow a curve "
                                      "(G0 / G1), or toggle a point, normal or curvature constraint at the cursor",
@@ -38,7 +39,7 @@ GROUPS = {
                                    "HapticSculpt_CombDensity", "HapticSculpt_CombScale", "HapticSculpt_Zebra",
                                    "HapticSculpt_ZebraMode", "HapticSculpt_ZebraStripes",
                                    "HapticSculpt_ZebraDirection", "HapticSculpt_SetTarget",
-                                   "HapticSculpt_ShowDeviation", "HapticSculpt_FitToTarget"], 0),
+                                   "HapticSculpt_ShowDeviation", "HapticSculpt_FitToTarget", "HapticSculpt_PullToTarget"], 0),
 }
 #: The toolbars: few buttons, so that all show at 1280 px beside FreeCAD's own. Output is a toolbar
 #: of its own: a toolbar squeezed by a narrow window keeps its first button, so Export STEP never
@@ -521,6 +522,25 @@ class FitToTarget(_SculptCommand):
                                          f"{report['tolerance_mm']:g} mm (p95 {report['p95_mm']:.3g} mm)\n")
 
 
+class PullToTarget(_SculptCommand):
+    icon_name, menu = "PullToTarget", "Pull toward scan (on/off)"
+    tip = ("Switch the pull toward the scan target on or off: while sculpting (a session or HapticSculpt.run) the "
+           "surface is drawn onto the scan where it is near, bridging holes; the Paint pull airbrush takes it away "
+           "where it sprays; one undo step")
+
+    def IsActive(self) -> bool:
+        return _with_target() is not None
+
+    def Activated(self) -> None:
+        from .echo import ref, run_echoed
+        sculpt = _with_target()
+        if sculpt is None:
+            return
+        on = not sculpt.Proxy.live.snapshot().pull["enabled"]
+        run_echoed(f"HapticSculpt.set_pull({ref(sculpt)}, {on!r})")
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: the pull toward {sculpt.Target.Label} is {'on' if on else 'off'}\n")
+
+
 class _Tool(_SculptCommand):
     tool = "rope"
 
@@ -614,9 +634,15 @@ class PaintBending(_Paint):
            "hold the left button (or the device's button during a session) and move over the surface")
 
 
+class PaintPull(_Paint):
+    which, icon_name, menu = "pull", "PaintPull", "Paint pull (erase)"
+    tip = ("Airbrush on the pull map: takes the pull toward the target away where it sprays (the panel's pull "
+           "slider puts it back everywhere); hold the left button (or the device's button during a session)")
+
+
 class ShowMap(_SculptCommand):
     icon_name, menu = "ShowMap", "Show map (M)"
-    tip = "Cycle the material map display in pseudo-colour: mass, damping, stiffness, bending, off (key M toggles)"
+    tip = "Cycle the material map display in pseudo-colour: mass, damping, stiffness, bending, pull, off (key M toggles)"
 
     def Activated(self) -> None:
         from .workbench import MAP_CYCLE
@@ -770,8 +796,10 @@ COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_NewClampedPatch": N
             "HapticSculpt_NormalConstraint": NormalConstraint, "HapticSculpt_CurvatureConstraint": CurvatureConstraint,
             "HapticSculpt_PaintMass": PaintMass, "HapticSculpt_PaintDamping": PaintDamping,
             "HapticSculpt_PaintStiffness": PaintStiffness, "HapticSculpt_PaintBending": PaintBending,
+            "HapticSculpt_PaintPull": PaintPull,
             "HapticSculpt_ShowMap": ShowMap, "HapticSculpt_SetTarget": SetTarget,
             "HapticSculpt_ShowDeviation": ShowDeviation, "HapticSculpt_FitToTarget": FitToTarget,
+            "HapticSculpt_PullToTarget": PullToTarget,
             "HapticSculpt_ShowCurvature": ShowCurvature, "HapticSculpt_Combs": Combs, "HapticSculpt_ContinuityCheck": ContinuityCheck, "HapticSculpt_Zebra": Zebra,
             "HapticSculpt_ZebraMode": ZebraMode, "HapticSculpt_ZebraStripes": ZebraStripes,
             "HapticSculpt_ZebraDirection": ZebraDirection,

@@ -28,7 +28,7 @@ from . import stripes as stripe_shading
 from .hud import Hud
 from .panel import SliderPanel, sliders
 
-MAPS = ("mass", "damping", "stiffness", "bending")
+MAPS = ("mass", "damping", "stiffness", "bending", "pull")
 DISPLAYS = ("shading", *MAPS, "curvature", "mean", "gauss", "zebra", "deviation")
 #: Scan points the deviation display colours (evenly taken), and how often they are measured again
 #: while the surface moves (a session): the surface's own colours follow every frame.

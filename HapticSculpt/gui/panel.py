@@ -19,11 +19,11 @@ from .. import core
 
 # name, label, low, high (log scale)
 SLIDERS = (("mass", "mass", 1e-2, 1e2), ("damping", "damping", 1e-2, 1e3), ("stiffness", "stiffness", 1e0, 1e5),
-           ("bending", "bending (plate/springs)", 1e-1, 1e3),
+           ("bending", "bending (plate/springs)", 1e-1, 1e3), ("pull", "pull toward the target", 1e-2, 1e2),
            ("curvature_u", "curvature u (1/mm)", 1e-4, 1e-1), ("curvature_v", "curvature v (1/mm)", 1e-4, 1e-1))
-MAPS = ("mass", "damping", "stiffness", "bending")
-#: Sliders whose left end is 0, not their low value: no plate at all is springs alone.
-ZERO_AT_LEFT = ("bending",)
+MAPS = ("mass", "damping", "stiffness", "bending", "pull")
+#: Sliders whose left end is 0, not their low value: no plate at all is springs alone, no pull none.
+ZERO_AT_LEFT = ("bending", "pull")
 
 #: A tool setting's slider spans this factor either side of its declared default (log scale).
 TOOL_RANGE = 10.0

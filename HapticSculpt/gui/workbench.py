@@ -33,10 +33,18 @@ from .coin_events import FrontCallbacks
 from .echo import ref, run_echoed
 from .overlay import Overlay
 
-MAP_CYCLE = ("mass", "damping", "stiffness", "bending")
+MAP_CYCLE = ("mass", "damping", "stiffness", "bending", "pull")
 CURVATURE_CYCLE = ("curvature", "mean", "gauss")
 KEYS = {"p": "point", "n": "normal", "c": "curvature"}
 AIRBRUSH_FACTOR = 3.0  # a stroke moves the map toward this times its mean when the stroke began
+#: The pull's airbrush takes the pull away where it sprays (a region the scan should not shape:
+#: the slider puts it back everywhere).
+AIRBRUSH_FACTORS = {"pull": 1e-6}
+
+
+def airbrush_factor(map: str) -> float:
+    """What the airbrush on ``map`` moves it toward, as a factor of its mean when the stroke began."""
+    return AIRBRUSH_FACTORS.get(map, AIRBRUSH_FACTOR)
 AIRBRUSH_RADIUS = 0.08  # map coordinates (the unit square)
 AIRBRUSH_STRENGTH = 0.25  # per dab, at its centre
 ECHO_MAX = 200  # an echoed call longer than this goes into the StrokeLog (a person reads the console)
@@ -328,7 +336,7 @@ class Controller:
             raise ValueError(f"which: one of {', '.join(MAP_CYCLE)}")
         self.painting = None if which is None or which == self.painting else which
         if self.session is not None and self.session.running:
-            self.session.set_airbrush(self.painting, factor=AIRBRUSH_FACTOR)
+            self.session.set_airbrush(self.painting, factor=airbrush_factor(self.painting))
         for ov in self.overlays.values():
             ov.mode = f"airbrush: {self.painting}" if self.painting else ""
         if self.painting is not None:
@@ -345,7 +353,7 @@ class Controller:
         self._paint_stroke = obj
         surface = obj.Proxy.live.surface
         # One target for the whole stroke (as the session's airbrush), so dabs saturate at it.
-        self._paint_target = AIRBRUSH_FACTOR * float(np.mean(getattr(surface, self.painting + "_map").values))
+        self._paint_target = airbrush_factor(self.painting) * float(np.mean(getattr(surface, self.painting + "_map").values))
         self._paint_path = []
         self._dab_to(obj, self.mouse_point)
 
@@ -356,7 +364,7 @@ class Controller:
         if obj is not None and _alive(obj) and self._paint_path:
             obj.Proxy.live.revert_map(self.painting)  # (the call below lays the same dabs again)
             call = (f"HapticSculpt.paint({ref(obj)}, {self.painting!r}, {self._paint_path!r}, radius={AIRBRUSH_RADIUS!r}, "
-                    f"factor={AIRBRUSH_FACTOR!r}, strength={AIRBRUSH_STRENGTH!r})")
+                    f"factor={airbrush_factor(self.painting)!r}, strength={AIRBRUSH_STRENGTH!r})")
             if len(call) <= ECHO_MAX:
                 run_echoed(call)
             else:  # a long path: kept in the sculpt's StrokeLog, echoed as one short line
@@ -469,7 +477,7 @@ class Controller:
             device.attach_all([i.view for i in self.inputs] or [self.view()])
         self.mouse = device if isinstance(device, MouseDevice) else None
         session = Session()
-        session.set_airbrush(self.painting, factor=AIRBRUSH_FACTOR)  # before the first tick can grab
+        session.set_airbrush(self.painting, factor=airbrush_factor(self.painting))  # before the first tick can grab
         self.session = session.start(obj, device, tool=obj.Proxy.live.snapshot().tool.name, haptic_rate=rate)
         self._follow(self.view())
         return self.session
@@ -581,5 +589,5 @@ def paint_long_stroke(obj: Any, map: str, path: list[tuple[float, float]]) -> No
     from .echo import echo_stroke
     title = f"Paint {map}"
     before = read_state(obj)
-    change = api.paint_change(map, path, radius=AIRBRUSH_RADIUS, factor=AIRBRUSH_FACTOR, strength=AIRBRUSH_STRENGTH)
+    change = api.paint_change(map, path, radius=AIRBRUSH_RADIUS, factor=airbrush_factor(map), strength=AIRBRUSH_STRENGTH)
     obj.Proxy.live.edit(change, title, inside=lambda: echo_stroke(obj, before, title, 0))

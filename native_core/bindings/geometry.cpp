@@ -152,7 +152,7 @@ void bindGeometry(py::module_& m) {
         .def("curvature", [](const BSplineSurface& s, double u, double v) { return curvatureDict(s.curvature(u, v)); },
              py::arg("u"), py::arg("v"), "Normal curvature along u and v, principal (min, max), mean and Gaussian.");
 
-    py::class_<PointTree>(m, "PointTree", "Nearest-point queries over a fixed cloud of 3D points (a k-d tree).")
+    py::class_<PointTree, std::shared_ptr<PointTree>>(m, "PointTree", "Nearest-point queries over a fixed cloud of 3D points (a k-d tree).")
         .def(py::init([](DoubleArray points) { return PointTree(cloudFrom(points, "points")); }), py::arg("points"),
              "points: (n, 3), n >= 1, finite.")
         .def_property_readonly("size", &PointTree::size)

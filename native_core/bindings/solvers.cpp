@@ -88,7 +88,7 @@ void bindSolvers(py::module_& m) {
             auto& s = self.cast<DynamicSurface&>();
             return view(s.meshVelocities().data(), {s.g(), s.h(), 3}, self);
         }, "(g, h, 3) view of A p' (recomputed by this call)")
-        .def_property_readonly("external_forces", [](py::object self) {
+        .def_property_readonly("external_forces", [](py::object self) {  // (the point forces and the pull)
             auto& s = self.cast<DynamicSurface&>();
             return view(s.externalForces().data(), {s.g(), s.h(), 3}, self);
         })
@@ -175,6 +175,28 @@ void bindSolvers(py::module_& m) {
         .def_property_readonly("stiffness_map", py::overload_cast<>(&DynamicSurface::stiffnessMap), py::return_value_policy::reference_internal)
         .def_property_readonly("bending_map", py::overload_cast<>(&DynamicSurface::bendingMap), py::return_value_policy::reference_internal,
                                "Bending (thin-plate) weight beta per mesh cell, in the springs' units; 0 switches it off")
+        .def_property_readonly("pull_map", py::overload_cast<>(&DynamicSurface::pullMap), py::return_value_policy::reference_internal,
+                               "Where the pull toward the target acts, as a factor of its strength (0: not there)")
+        .def("set_pull_target", [](DynamicSurface& s, std::shared_ptr<PointTree> tree, double reach) {
+            s.setPullTarget(std::move(tree), reach);
+        }, py::arg("tree"), py::arg("reach") = 1.0,
+           "The scan the data springs pull toward (a PointTree, shared; None: none) and the reach (mm) beyond which "
+           "a scan point does not pull; every anchor is sought afresh.")
+        .def("set_pull", &DynamicSurface::setPull, py::arg("enabled"), py::arg("strength") = 1.0,
+             "Switch the pull toward the target on or off, at strength (0..1e6; 1: a mesh point alone would reach "
+             "the scan in about 1/8 s).")
+        .def_property_readonly("pull", [](const DynamicSurface& s) {
+            const DataSprings& p = s.pull();
+            py::dict d;
+            d["enabled"] = p.enabled();
+            d["strength"] = p.strength();
+            d["target"] = static_cast<bool>(p.target());
+            d["reach"] = p.reach();
+            d["active"] = p.active();
+            d["anchored"] = p.anchored();
+            return d;
+        }, "The pull toward the target: enabled, strength, target (whether one is set), reach, active, anchored "
+           "(mesh points that have a scan point to pull toward)")
         .def_property_readonly("bending_reference", [](py::object self) {
             auto& s = self.cast<DynamicSurface&>();
             return view(s.bending().reference().data(), {s.g(), s.h(), 3}, self).attr("copy")();

@@ -102,7 +102,8 @@ const char* mapName(AirbrushSettings::Map map) { return nameOf(kMapNames, map); 
 MaterialMap& HapticRuntime::mapOf(AirbrushSettings::Map map) {
     return map == AirbrushSettings::Map::Mass ? surface_->massMap()
          : map == AirbrushSettings::Map::Damping ? surface_->dampingMap()
-         : map == AirbrushSettings::Map::Bending ? surface_->bendingMap() : surface_->stiffnessMap();
+         : map == AirbrushSettings::Map::Bending ? surface_->bendingMap()
+         : map == AirbrushSettings::Map::Pull ? surface_->pullMap() : surface_->stiffnessMap();
 }
 
 bool HapticRuntime::takePaintedMap(PaintedMap& out) {
@@ -185,7 +186,7 @@ void HapticRuntime::airbrush(bool spraying, double simTime) {
     if (sprayMap_ == Map::Off) {
         sprayMap_ = want;
         // One target for the whole spray, so dabs saturate at it instead of compounding.
-        sprayTarget_ = std::clamp(airbrush_.factor * m.mean(), want == Map::Damping || want == Map::Bending ? 0.0 : kMinMaterial, kMaxMaterial);
+        sprayTarget_ = std::clamp(airbrush_.factor * m.mean(), want == Map::Damping || want == Map::Bending || want == Map::Pull ? 0.0 : kMinMaterial, kMaxMaterial);
         nextDab_ = simTime;
     }
     if (simTime < nextDab_) return;

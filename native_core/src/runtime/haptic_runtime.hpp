@@ -85,7 +85,7 @@ struct HapticTick {
 /// instead of grabbing (the tool lets go and renders no force): a dab every 1/rate seconds at the
 /// mass point nearest the cursor moves the map toward `factor` times its mean at the spray's start.
 struct AirbrushSettings {
-    enum class Map { Off, Mass, Damping, Stiffness, Bending };
+    enum class Map { Off, Mass, Damping, Stiffness, Bending, Pull };
     Map map = Map::Off;
     double radius = 0.08;    ///< in map coordinates (the unit square)
     double factor = 3.0;     ///< target = factor * the map's mean when the spray started
@@ -95,13 +95,15 @@ struct AirbrushSettings {
     void validate() const;
 };
 
-inline constexpr std::array<Named<AirbrushSettings::Map>, 4> kMapNames{{
+inline constexpr std::array<Named<AirbrushSettings::Map>, 5> kMapNames{{
     {"mass", AirbrushSettings::Map::Mass}, {"damping", AirbrushSettings::Map::Damping},
-    {"stiffness", AirbrushSettings::Map::Stiffness}, {"bending", AirbrushSettings::Map::Bending}}};
-const char* mapName(AirbrushSettings::Map map);  ///< "mass", "damping", "stiffness", "bending" ("" when off)
-/// The four maps, in the order of StrokeSnapshot::maps.
-constexpr std::array<AirbrushSettings::Map, 4> kMaps = {AirbrushSettings::Map::Mass, AirbrushSettings::Map::Damping,
-                                                        AirbrushSettings::Map::Stiffness, AirbrushSettings::Map::Bending};
+    {"stiffness", AirbrushSettings::Map::Stiffness}, {"bending", AirbrushSettings::Map::Bending},
+    {"pull", AirbrushSettings::Map::Pull}}};
+const char* mapName(AirbrushSettings::Map map);  ///< "mass", "damping", "stiffness", "bending", "pull" ("" when off)
+/// The five maps, in the order of StrokeSnapshot::maps.
+constexpr std::array<AirbrushSettings::Map, 5> kMaps = {AirbrushSettings::Map::Mass, AirbrushSettings::Map::Damping,
+                                                        AirbrushSettings::Map::Stiffness, AirbrushSettings::Map::Bending,
+                                                        AirbrushSettings::Map::Pull};
 
 /// A material map's values as a snapshot carries them.
 struct MapSnapshot {
@@ -135,7 +137,7 @@ struct StrokeSnapshot {
     Points bendingReference;  ///< the bending energy's reference (clay's follows plastic flow)
     AirbrushSettings::Map painted = AirbrushSettings::Map::Off;
     std::uint64_t edit = 0;
-    std::array<MapSnapshot, 4> maps;  ///< in kMaps order (those carried)
+    std::array<MapSnapshot, 5> maps;  ///< in kMaps order (those carried)
 };
 
 /// The map a spray is painting, as the GUI shows it while the spray goes on.

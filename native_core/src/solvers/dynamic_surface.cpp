@@ -82,7 +82,8 @@ void DynamicSurface::continueFrom(DynamicSurface& live, bool keepMaps) {
     if (keepMaps) {
         Material &mine = material_, &theirs = live.material_;
         for (auto [to, from] : {std::pair{&mine.massMap, &theirs.massMap}, {&mine.dampingMap, &theirs.dampingMap},
-                                {&mine.stiffnessMap, &theirs.stiffnessMap}, {&mine.bendingMap, &theirs.bendingMap}})
+                                {&mine.stiffnessMap, &theirs.stiffnessMap}, {&mine.bendingMap, &theirs.bendingMap},
+                                {&pullMap(), &live.pullMap()}})
             if (to->rows() != from->rows() || to->cols() != from->cols() || to->values() != from->values())
                 to->setValues(from->rows(), from->cols(), from->values());
     }
@@ -90,12 +91,25 @@ void DynamicSurface::continueFrom(DynamicSurface& live, bool keepMaps) {
         live.tool().copySettings(tool());
         forces_.swapTool(live.forces_);
     }
+    forces_.pull().takeAnchors(live.forces_.pull());
     forces_.cursor = live.forces_.cursor;
     localGlobal_.continueFrom(live.localGlobal_);  // (so the step after an edit stays second order)
     time_ = live.time_;
     work_ = live.work_;
     steps_ = live.steps_;
     touch();
+}
+
+void DynamicSurface::setPullTarget(std::shared_ptr<const PointTree> tree, double reach) {
+    forces_.pull().setTarget(std::move(tree), reach);
+    wake();
+}
+
+void DynamicSurface::setPull(bool enabled, double strength) {
+    DataSprings& pull = forces_.pull();
+    pull.setStrength(strength);
+    pull.setEnabled(enabled);
+    wake();
 }
 
 void DynamicSurface::holdPoles(const std::vector<int>& indices, const std::vector<PoleLink>& links) {
@@ -225,9 +239,10 @@ void DynamicSurface::setCursor(const Cursor& c) {
 StepReport DynamicSurface::step(double dt) {
     if (!(dt >= kMinDt) || !std::isfinite(dt)) throw std::invalid_argument("dt: must be finite and >= 1e-9 s");
     refreshMaterials();
-    const std::uint64_t key[5] = {material_.massMap.version(), material_.dampingMap.version(),
-                                  material_.stiffnessMap.version(), constraints().version(), material_.bendingMap.version()};
-    for (int i = 0; i < 5; ++i)
+    const std::uint64_t key[6] = {material_.massMap.version(), material_.dampingMap.version(),
+                                  material_.stiffnessMap.version(), constraints().version(), material_.bendingMap.version(),
+                                  pullMap().version()};
+    for (int i = 0; i < 6; ++i)
         if (key[i] != wakeKey_[i]) { wake(); wakeKey_[i] = key[i]; }
     // A held tool keeps the surface awake; its forces are refreshed by the integrator each step.
     const bool grabbed = tool().grabbed();
@@ -237,6 +252,12 @@ StepReport DynamicSurface::step(double dt) {
         r.slept = true;
         return r;
     }
+    // The pull is taken where the step starts, as the point forces are held over it.
+    if (forces_.pull().active() && !state_.avValid) {  // (its damper reads the mesh's velocity)
+        state_.A.apply(state_.v, state_.av);
+        state_.avValid = true;
+    }
+    forces_.applyPull(state_.d, state_.av, state_.spacingU, state_.spacingV, material_.masses(), dt);
     StepModel m = model();
     const bool localGlobal = solver_.kind == IntegratorKind::LocalGlobal;
     const bool verlet = localGlobal && verlet_.stable(m, dt);

@@ -112,6 +112,7 @@ public:
     /// Persistent external force on a mesh point (clamped to maxPointForce()).
     void setPointForce(int index, const Vec3& force);
     void clearForces();
+    /// The point forces plus the pull toward the target, as the last step applied them.
     const Points& externalForces() const { return forces_.external(); }
     double maxPointForce() const { return forces_.maxPointForce; }
     void setMaxPointForce(double f);  ///< > 0 (std::invalid_argument naming max_point_force)
@@ -124,6 +125,15 @@ public:
     const Cursor& cursor() const { return forces_.cursor; }
     /// The active tool's local model for the haptic loop (see haptic_estimate.hpp).
     void describeTool(const Reaction& last, HapticEstimate& e) const { forces_.tool().describe(meshView(), last, e); }
+
+    /// The pull toward a scan (data_springs.hpp): data springs from the mesh to the nearest points
+    /// of `tree` within `reach` (a null tree: none), on or off, at `strength` (0..1e6), painted by
+    /// pullMap(). Each change wakes the surface; a new target seeks every anchor afresh.
+    void setPullTarget(std::shared_ptr<const PointTree> tree, double reach);
+    void setPull(bool enabled, double strength);
+    const DataSprings& pull() const { return forces_.pull(); }
+    MaterialMap& pullMap() { return forces_.pull().map; }
+    const MaterialMap& pullMap() const { return forces_.pull().map; }
 
     ConstraintSet& constraints() { return forces_.constraints(); }
     const ConstraintSet& constraints() const { return forces_.constraints(); }
@@ -248,7 +258,7 @@ private:
     EnergyGuard guard_;
     SleepMonitor sleep_;
     RegionChooser region_;
-    std::uint64_t wakeKey_[5] = {0, 0, 0, 0, 0};  // the maps' and constraints' versions the last step saw
+    std::uint64_t wakeKey_[6] = {0, 0, 0, 0, 0, 0};  // the maps' and constraints' versions the last step saw
     double time_ = 0, work_ = 0;  // the clock, and the work of the applied forces
     std::uint64_t steps_ = 0;
 };

@@ -35,14 +35,20 @@ double VerletIntegrator::toolTerm(const StepModel& m) const {
     if (m.material.springs.law.kind != LawKind::Linear || m.material.dampingLaw.kind != LawKind::Linear ||
         m.forces.constraints().anyNonConvex())
         return kInf;
-    // The tool adds at most slope on each point it holds: omega^2 grows by at most slope / m_min.
-    return m.forces.tool().grabbed() ? m.toolSlope() / m.material.minMass() : 0.0;
+    // The tool adds at most slope on each point it holds: omega^2 grows by at most slope / m_min;
+    // the pull toward a scan by its own omega^2 (its stiffness goes with the mass).
+    return (m.forces.tool().grabbed() ? m.toolSlope() / m.material.minMass() : 0.0) + m.forces.pull().maxOmegaSq();
+}
+
+double VerletIntegrator::dampingRate(const StepModel& m) {
+    // The material's, and the pull's critical damper (2 omega).
+    return m.material.maxDampingRate() + 2.0 * std::sqrt(m.forces.pull().maxOmegaSq());
 }
 
 bool VerletIntegrator::stable(StepModel& m, double dt) {
     // Damping is explicit too (rate gamma / m, A^T D A <= rate A^T M A): stable up to rate dt = 0.1
     // together with omega dt = 1.8 (the scalar recurrence's spectral radius is then 0.84).
-    if (dt * m.material.maxDampingRate() > 0.1) return false;
+    if (dt * dampingRate(m) > 0.1) return false;
     const double tool = toolTerm(m);
     if (!std::isfinite(tool)) return false;
     const double limit = kVerletStability * kVerletStability / (dt * dt);
@@ -54,7 +60,7 @@ double VerletIntegrator::stepLimit(StepModel& m) {
     if (!std::isfinite(tool)) return 0.0;
     bound_.below(m, kInf, true);
     double dt = kVerletStability / std::sqrt(bound_.upper() + tool);
-    if (m.material.maxDampingRate() > 0) dt = std::min(dt, 0.1 / m.material.maxDampingRate());
+    if (dampingRate(m) > 0) dt = std::min(dt, 0.1 / dampingRate(m));
     return dt;
 }
 

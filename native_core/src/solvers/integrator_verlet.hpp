@@ -23,8 +23,10 @@ public:
     void clearStepPotential() { stepPotential_ = -1; }
 
 private:
-    /// The tool's share of the omega^2 bound; infinite where Verlet is never taken.
+    /// The tool's and the pull's share of the omega^2 bound; infinite where Verlet is never taken.
     double toolTerm(const StepModel& m) const;
+    /// Largest damping rate (explicit here too): the material's and the pull's.
+    static double dampingRate(const StepModel& m);
     /// scratch.poleStep = (A^T M A)^-1 A^T (external + tool forces), over the poles they reach only.
     void solveApplied(StepModel& m);
 

@@ -4,9 +4,9 @@
 
 namespace hs {
 
-SurfaceForces::SurfaceForces(int g, int h) : constraints_(g, h) {
+SurfaceForces::SurfaceForces(int g, int h) : pull_(g, h), constraints_(g, h) {
     const Eigen::Index S = static_cast<Eigen::Index>(g) * h;
-    for (Points* m : {&external_, &fromTool_, &total_}) m->setZero(S, 3);
+    for (Points* m : {&pointForces_, &external_, &fromTool_, &total_}) m->setZero(S, 3);
     dampingFactor_.setZero(S);
     terms_.reserve(64);
     setTool("rope");
@@ -17,21 +17,36 @@ void SurfaceForces::setPointForce(int index, const Vec3& force, const MirrorSymm
     if (!force.allFinite()) throw std::invalid_argument("force: must be finite");
     const double n = force.norm();
     const Vec3 f = n > maxPointForce ? Vec3(force * (maxPointForce / n)) : force;
-    if (mirror.empty()) external_.row(index) = f.transpose();
-    else mirror.pointForce(external_, index, f);
-    hasExternal_ = true;
+    for (Points* to : {&pointForces_, &external_}) {  // (the pull adds its part at the next step)
+        if (mirror.empty()) to->row(index) = f.transpose();
+        else mirror.pointForce(*to, index, f);
+    }
+    hasPointForces_ = true;
 }
 
 void SurfaceForces::clearExternal() {
+    pointForces_.setZero();
     external_.setZero();
-    hasExternal_ = false;
+    hasPointForces_ = false;
+}
+
+void SurfaceForces::applyPull(const Points& d, const Points& dd, double su, double sv, const Eigen::VectorXd& m, double dt) {
+    if (!pull_.active()) {
+        if (pullOn_) external_ = pointForces_;
+        pullOn_ = false;
+        return;
+    }
+    pull_.refresh(d, su, sv);
+    pull_.forces(d, dd, m, dt, external_);
+    if (hasPointForces_) external_ += pointForces_;
+    pullOn_ = true;
 }
 
 double SurfaceForces::appliedWork(const Points& d, const Points& before, const GridRect& window) const {
     // (whole runs of rows, so the loop vectorises)
     double work = 0;
     window.forSpans([&](const auto& r) {
-        if (hasExternal_) work += r(external_).cwiseProduct(r(d) - r(before)).sum();
+        if (hasExternal()) work += r(external_).cwiseProduct(r(d) - r(before)).sum();
         if (toolActive_) work += r(fromTool_).cwiseProduct(r(d) - r(before)).sum();
     });
     return work;
@@ -70,7 +85,7 @@ double SurfaceForces::all(Material& material, const Points& d, const Points& dd)
     if (nonlinearDamping)
         for (Eigen::Index i = 0; i < d.rows(); ++i) dampingFactor_[i] = law.dampingFactor(total_.row(i).norm());
     const double bend = material.bending.addForces(d, total_);  // (after the damping law: it reads spring forces)
-    if (hasExternal_) total_ += external_;
+    if (hasExternal()) total_ += external_;
     if (toolActive_) total_ += fromTool_;
     double penalty = 0;
     if (!constraints_.empty()) penalty = constraints_.addForces(d, total_, terms_);

@@ -1,5 +1,5 @@
-// The forces on the mesh: the applied ones (persistent point forces, the tool's pull toward the
-// cursor) and the internal ones (springs, bending, penalty constraints, damping), summed into one
+// The forces on the mesh: the applied ones (persistent point forces, the pull toward a scan, the
+// tool's pull toward the cursor) and the internal ones (springs, bending, penalty constraints, damping), summed into one
 // buffer the integrators read.
 #pragma once
 #include <memory>
@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "common/types.hpp"
+#include "dynamics/data_springs.hpp"
 #include "dynamics/material.hpp"
 #include "dynamics/mirror_symmetry.hpp"
 #include "tools_and_constraints/constraints.hpp"
@@ -23,13 +24,23 @@ public:
     /// Persistent external force on a mesh point, clamped to maxPointForce (and mirrored).
     void setPointForce(int index, const Vec3& force, const MirrorSymmetry& mirror);
     void clearExternal();
+    /// The persistent applied forces: the point forces plus the pull toward the target, taken
+    /// explicitly (held over a step, as the integrators hold the point forces).
     const Points& external() const { return external_; }
-    bool hasExternal() const { return hasExternal_; }
+    bool hasExternal() const { return hasPointForces_ || pullOn_; }
+
+    // --- the pull toward a scan (data_springs.hpp) ---------------------------------------------
+    DataSprings& pull() { return pull_; }
+    const DataSprings& pull() const { return pull_; }
+    /// At a step's start: re-seeks some anchors on mesh d (mean spacings su, sv) and puts the pull
+    /// at d moving at dd, for point masses m and step dt, into external(); once it stops,
+    /// external() is the point forces alone again.
+    void applyPull(const Points& d, const Points& dd, double su, double sv, const Eigen::VectorXd& m, double dt);
     /// The tool's force on the mesh as last applied (plus, after an implicit step, its linear part).
     const Points& fromTool() const { return fromTool_; }
     Points& fromTool() { return fromTool_; }
     bool toolActive() const { return toolActive_; }
-    bool anyApplied() const { return hasExternal_ || toolActive_; }
+    bool anyApplied() const { return hasExternal() || toolActive_; }
     /// The work of the applied forces, held constant, over the mesh's motion from `before` to `d`.
     double appliedWork(const Points& d, const Points& before, const GridRect& window) const;
 
@@ -72,9 +83,10 @@ public:
     double constraintStiffnessFactor = 1e3;
 
 private:
-    Points external_, fromTool_, total_;
+    Points pointForces_, external_, fromTool_, total_;  // external_: pointForces_ plus the pull
     Eigen::VectorXd dampingFactor_;  // the non-linear damping law's factor per mesh point
-    bool hasExternal_ = false, toolActive_ = false;
+    DataSprings pull_;
+    bool hasPointForces_ = false, pullOn_ = false, toolActive_ = false;
     std::unique_ptr<Tool> tool_;
     ConstraintSet constraints_;
     std::vector<ConstraintTerm> terms_;
