@@ -40,6 +40,9 @@ def _sculpts(doc):
                     "selected": o in Gui.Selection.getSelection(), "screen": _on_screen(o), "digest": digest(o),
                     "drawn_poles": _drawn_poles(o), "curves": _curves(o),
                     "target": o.Target.Name if getattr(o, "Target", None) is not None else None,
+                    "pull": settings.get("pull", [True, 1.0]),
+                    "pull_map": [min(o.PullMap), max(o.PullMap), len(o.PullMap)]
+                    if getattr(o, "PullMap", None) else [],
                     "deviation": json.loads(o.Deviation) if getattr(o, "Deviation", "") else {}})
     return out
 
