@@ -258,6 +258,8 @@ bench: build wheel
 	$(PY) bench/discretisation.py
 	$(PY) bench/builds.py
 	$(PY) bench/solids.py
+	$(PY) bench/scan_fit.py
+	$(PY) bench/scan_pull.py
 
 # Peers run in their own virtual environment (optional benchmark dependencies, not test ones).
 BENCH_VENV := $(BUILD)/bench-venv

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace hs {
 
@@ -20,6 +21,7 @@ DataSprings::DataSprings(int g, int h) : map(1.0, "pull"), g_(g), h_(h) {
     anchor_.setZero(S, 3);
     normal_.setZero(S, 3);
     held_.assign(static_cast<size_t>(S), 0);
+    misses_.assign(static_cast<size_t>(S), 0);
     weight_.setOnes(S);
 }
 
@@ -36,7 +38,9 @@ void DataSprings::setStrength(double strength) { strength_ = requireInRange(stre
 
 void DataSprings::forget() {
     std::fill(held_.begin(), held_.end(), 0);
+    std::fill(misses_.begin(), misses_.end(), 0);
     next_ = 0;
+    sweeps_ = 0;
 }
 
 Eigen::Index DataSprings::anchored() const {
@@ -56,24 +60,42 @@ Vec3 DataSprings::normalAt(const Points& d, int a, int b) const {
 void DataSprings::refresh(const Points& d, double su, double sv) {
     if (!tree_) return;
     const Eigen::Index S = d.rows();
-    const Eigen::Index count = std::min(S, std::clamp(S / 32, kMinRefresh, kMaxRefresh));
+    const Eigen::Index count = std::min(S, std::clamp(S / 128, kMinRefresh, kMaxRefresh));
     const double side = kSideSpacings * std::max(su, sv), reachSq = reach_ * reach_;
-    for (Eigen::Index k = 0; k < count; ++k) {
+    for (Eigen::Index visited = 0, sought = 0; sought < count && visited < S; ++visited) {
         const Eigen::Index i = next_;
-        next_ = next_ + 1 < S ? next_ + 1 : 0;
+        if (++next_ == S) {
+            next_ = 0;
+            ++sweeps_;
+        }
+        // A point that found no scan point twice running (over a hole, past the scan's edge) is
+        // sought one sweep in kMissedEvery: its search is the dearest (far from every point).
+        std::uint8_t& missed = misses_[static_cast<size_t>(i)];
+        if (missed >= 2 && (sweeps_ + static_cast<std::uint64_t>(i)) % kMissedEvery != 0) continue;
+        ++sought;
         const Vec3 x = d.row(i).transpose();
         const Vec3 n = normalAt(d, static_cast<int>(i / h_), static_cast<int>(i % h_));
+        // Sought within the distance of the last anchor (it moved a little since): the search
+        // prunes most of the tree at once, and keeps that anchor where nothing is nearer; a point
+        // without one within the reach.
+        const bool had = held_[static_cast<size_t>(i)] != 0;
         double distSq = 0;
-        const Vec3 a = tree_->point(tree_->nearest(x, distSq));
-        const Vec3 off = a - x;
-        const double along = off.dot(n), sideways = (off - along * n).norm();
-        const bool pulls = distSq <= reachSq && n.squaredNorm() > 0 &&
-                           sideways <= std::max(side, kSideSlope * std::abs(along));
-        held_[static_cast<size_t>(i)] = pulls ? 1 : 0;
-        if (pulls) {
-            anchor_.row(i) = a.transpose();
-            normal_.row(i) = n.transpose();
+        const double bound = had ? (anchor_.row(i).transpose() - x).squaredNorm() * (1 + 1e-12) + 1e-300 : reachSq;
+        const Eigen::Index found = tree_->nearest(x, distSq, bound);
+        bool pulls = false;
+        if (found >= 0 || had) {
+            const Vec3 a = found >= 0 ? tree_->point(found) : Vec3(anchor_.row(i).transpose());
+            const Vec3 off = a - x;
+            const double along = off.dot(n), sideways = (off - along * n).norm();
+            pulls = off.squaredNorm() <= reachSq && n.squaredNorm() > 0 &&
+                    sideways <= std::max(side, kSideSlope * std::abs(along));
+            if (pulls) {
+                anchor_.row(i) = a.transpose();
+                normal_.row(i) = n.transpose();
+            }
         }
+        held_[static_cast<size_t>(i)] = pulls ? 1 : 0;
+        missed = pulls ? 0 : static_cast<std::uint8_t>(std::min(missed + 1, 255));
     }
 }
 
@@ -95,7 +117,9 @@ void DataSprings::takeAnchors(const DataSprings& other) {
     anchor_ = other.anchor_;
     normal_ = other.normal_;
     held_ = other.held_;
+    misses_ = other.misses_;
     next_ = other.next_;
+    sweeps_ = other.sweeps_;
 }
 
 double DataSprings::forces(const Points& d, const Points& dd, const Eigen::VectorXd& m, double dt, Points& out) {

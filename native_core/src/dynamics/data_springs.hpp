@@ -26,8 +26,13 @@ public:
     /// settles on the scan in about 1/40 s, and the pull outweighs the sheet's stiffness over a
     /// feature a few mesh cells wide.
     static constexpr double kOmega = 200.0;
-    /// Anchors re-sought per step (rolling over the mesh), at least a 32nd of it.
-    static constexpr Eigen::Index kMinRefresh = 128, kMaxRefresh = 512;
+    /// Anchors re-sought per step (rolling over the mesh), a 128th of it within these bounds: a
+    /// 64 x 64 mesh is sought again every 128 ms at 1 kHz, a 256 x 256 one every 256 ms. (A query
+    /// on a million-point scan costs about 4 us, its tree being far larger than the caches; the
+    /// plane a spring pulls toward stays good while its point slides along the scan.)
+    static constexpr Eigen::Index kMinRefresh = 32, kMaxRefresh = 256;
+    /// A point that found no scan point twice running is sought again one sweep in this many.
+    static constexpr std::uint64_t kMissedEvery = 8;
 
     /// For a g x h mesh.
     DataSprings(int g, int h);
@@ -72,10 +77,12 @@ private:
     double reach_ = 0, strength_ = 1.0;
     bool enabled_ = true;
     Points anchor_, normal_;      // per mesh point: its scan point, and the normal it pulls along
-    std::vector<std::uint8_t> held_;  // whether it has an anchor
+    std::vector<std::uint8_t> held_;    // whether it has an anchor
+    std::vector<std::uint8_t> misses_;  // sweeps in a row it found none
     Eigen::VectorXd weight_;      // the map at each mesh point
     std::uint64_t mapVersion_ = ~0ull;
-    Eigen::Index next_ = 0;
+    Eigen::Index next_ = 0;      // the next point to seek
+    std::uint64_t sweeps_ = 0;   // sweeps over the mesh so far
 };
 
 }  // namespace hs

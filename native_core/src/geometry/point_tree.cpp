@@ -73,12 +73,12 @@ double PointTree::outsideSq(const Cell& c, const Vec3& x) const {
     return d;
 }
 
-Eigen::Index PointTree::nearest(const Vec3& x, double& distanceSq) const {
+Eigen::Index PointTree::nearest(const Vec3& x, double& distanceSq, double bound) const {
     std::int32_t stack[kMaxPending];
     int top = 0;
     stack[top++] = 0;
-    double best = std::numeric_limits<double>::infinity();
-    Eigen::Index bestAt = 0;
+    double best = bound;
+    Eigen::Index bestAt = -1;
     const auto visit = [&](Eigen::Index k) {
         const double d = (sorted_.row(k).transpose() - x).squaredNorm();
         if (d < best) best = d, bestAt = k;
@@ -97,7 +97,7 @@ Eigen::Index PointTree::nearest(const Vec3& x, double& distanceSq) const {
         for (Eigen::Index k = c->lo; k < c->hi; ++k) visit(k);
     }
     distanceSq = best;
-    return order_[bestAt];
+    return bestAt >= 0 ? order_[bestAt] : -1;
 }
 
 }  // namespace hs

@@ -2,6 +2,7 @@
 // balanced at the median, queried without allocation, so the haptic loop can ask it.
 #pragma once
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "common/types.hpp"
@@ -21,8 +22,12 @@ public:
     Vec3 point(Eigen::Index i) const { return sorted_.row(rank_[i]).transpose(); }
 
     /// The index (as given) of the point nearest x, and its squared distance in `distanceSq`.
-    /// Allocates nothing; ties go to the point met first (deterministic for one cloud).
-    Eigen::Index nearest(const Vec3& x, double& distanceSq) const;
+    /// Allocates nothing; ties go to the point met first (deterministic for one cloud). With a
+    /// `bound` (a squared distance some point is known to be within: the last answer, for a
+    /// point that moved a little) only points nearer than it are sought, and -1 is returned
+    /// where there is none.
+    Eigen::Index nearest(const Vec3& x, double& distanceSq,
+                         double bound = std::numeric_limits<double>::infinity()) const;
 
 private:
     static constexpr int kLeaf = 8;
