@@ -1,5 +1,5 @@
-"""The pull toward a scan (issue 30): data springs draw the surface onto its target in hs.run (and
-sessions: the same core surface); the switch and the strength are one undo step each and saved; the
+"""The pull toward a scan (issue 30): data springs draw the surface onto its target in hs.run and
+in a threaded session (kept at its stop as one undo step, with no stroke made); the switch and the strength are one undo step each and saved; the
 pull map, painted or set to 0, takes the pull away there; a changed target link is followed;
 outliers and a hole do not pull or tear it; bad calls are refused by name."""
 from __future__ import annotations
@@ -50,6 +50,25 @@ class TestPull(DocumentTestCase):
         self.doc.undo()  # the run
         self.doc.undo()  # the switch
         self.assertFalse(hs.pull_of(self.sculpt)["enabled"])
+
+    def test_a_session_without_a_stroke_keeps_what_the_pull_did_as_one_undo_step(self):
+        hs.set_target(self.sculpt, plane_scan(3.0), tolerance=0.1)
+        undo = self.doc.UndoCount
+        t = np.linspace(0.0, 1.0, 41)  # (the device hovers away from the patch, its button up)
+        hover = hs.ReplayDevice(t, np.tile([80.0, 80.0, 30.0], (41, 1)), buttons=np.zeros(41, dtype=int))
+        session = hs.Session().start(self.sculpt, hover, stop_when_finished=True)
+        self.assertTrue(session.wait(timeout=30))
+        self.assertEqual(session.status()["error"], "")
+        self.assertEqual(self.doc.UndoNames[: self.doc.UndoCount - undo], ["Pulled toward target"])
+        self.assertGreater(hs.deviation_of(self.sculpt)["within_pct"], 99.0)  # (the document's state)
+        self.doc.undo()
+        self.assertEqual(float(np.abs(np.asarray(self.sculpt.Poles)).reshape(-1, 3)[:, 2].max()), 0.0)
+        # Switched off, a session moves nothing and adds no step.
+        hs.set_pull(self.sculpt, False)
+        undo = self.doc.UndoCount
+        session = hs.Session().start(self.sculpt, hover, stop_when_finished=True)
+        self.assertTrue(session.wait(timeout=30))
+        self.assertEqual(self.doc.UndoCount, undo)
 
     def test_a_zero_pull_map_and_a_cleared_target_pull_nothing(self):
         hs.set_target(self.sculpt, plane_scan(3.0))

@@ -423,6 +423,7 @@ class Session:
         live = obj.Proxy.live
         last = self._last_commit
         if not self._committed or last is None:
+            self._commit_pull(obj)
             live.document_changed()
             return
         current = sculpt_state.capture(live.surface)
@@ -448,6 +449,24 @@ class Session:
             _tell_commit(obj, before, title, strokes, echo=not told)  # (told: its line names it already)
             obj.purgeTouched()
         live.document_changed()
+
+    def _commit_pull(self, obj: Any) -> None:
+        """A session with no stroke, spray or edit in which the scan's pull moved the surface: that
+        motion is what the designer watched happen, so it is kept, as one undo step."""
+        live = obj.Proxy.live
+        surface = live.surface
+        if not surface.pull["active"]:
+            return
+        current = sculpt_state.capture(surface)
+        before = live.stored()
+        if float(np.max(np.abs(current.arrays["Poles"] - before.arrays["Poles"]), initial=0.0)) <= 1e-9:
+            return
+        live.reset_shape()
+        title = "Pulled toward target"
+        with transaction(obj.Document, title):
+            live.write(current)
+            _tell_commit(obj, before, title, 0)
+            obj.purgeTouched()
 
     # --- GUI: shape at graphics rate, strokes as they end ----------------------------------------
     def _start_timer(self) -> None:
