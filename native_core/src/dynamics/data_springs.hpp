@@ -2,13 +2,13 @@
 // 1994). Each mesh point hangs on a zero-rest spring to the plane through the nearest point of the
 // target cloud, across the mesh's normal there as it was when the point was sought (fixed until it
 // is sought again, so the spring is conservative in between; a normal taken afresh each step is a
-// follower force, and it fluttered), with a damper that makes it critically damped. Pulling along
-// the normal only, the mesh does not slide along the scan: pulled toward the nearest point itself,
-// a plate half over a scan crawled sideways onto it. The stiffness goes with the point's mass (the
-// pull is a frequency, the same on any mesh). A spring is dropped where its scan point is beyond
-// reach (an outlier, another part of the scan) or lies off to the side, past the scan's edge or
-// across a hole: there the surface's own stiffness bridges. Springs re-seek their scan point a few
-// hundred at a time, so the cost per step does not grow with the mesh.
+// follower force, and it fluttered), with a damper that makes it critically damped.
+// Acting along the normal only, it lets the mesh slide along the scan: pulled toward the nearest
+// point itself, a plate half over a scan crawled sideways onto it. The stiffness goes with the
+// point's mass (the pull is a frequency, the same on any mesh). A spring is dropped where its scan
+// point is beyond reach (an outlier, another part of the scan) or lies off to the side, past the
+// scan's edge or across a hole: there the surface's own stiffness bridges. Springs re-seek their
+// scan point a fraction of the mesh at a time, so the cost per step stays small.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -58,9 +58,8 @@ public:
     /// Forgets every anchor (a new target or mesh): the next refreshes seek them afresh.
     void forget();
     /// The pull at mesh d moving at dd into `out` (overwritten) for point masses m and a step of
-    /// dt, its frequency held to omega dt <= 0.5 (explicit: stable, the damper too); returns its
-    /// elastic energy.
-    double forces(const Points& d, const Points& dd, const Eigen::VectorXd& m, double dt, Points& out);
+    /// dt, its frequency held to omega dt <= 0.5 (explicit: stable, the damper too).
+    void forces(const Points& d, const Points& dd, const Eigen::VectorXd& m, double dt, Points& out);
     /// Largest omega^2 the pull adds to a mesh point (for the explicit bound; 0 when inactive).
     double maxOmegaSq() const;
     /// Takes `other`'s anchors where it has the same target (an edit continuing a live surface).
