@@ -73,6 +73,7 @@ class Overlay:
         self.per_pixel = True  # zebra per pixel where the driver runs GLSL (False: per mesh vertex)
         self._sampled: tuple[bytes, np.ndarray, tuple[bytes, bytes], int] | None = None  # poles, points, texture, size
         self._scan: tuple[bytes, float, Any] | None = None  # poles, when, the scan's coloured points
+        self._live_deviation: str | None = None  # the HUD's line as the scan's points last measured it
         self._trims: dict[tuple[int, int], list[int] | None] = {}  # grid size -> cells on the trimmed face
         self._curve_rows: tuple[str, list[tuple[str, Any]]] = ("", [])  # CurveConstraints text -> (kind, rows)
         self.hud: Hud | None = None  # the screen-space layer, made when the overlay first draws
@@ -371,7 +372,9 @@ class Overlay:
                     else "to ({:.2g}, {:.2g}, {:.2g})".format(*self.stripe_direction))
             parts.append(f"zebra: {self.stripe_mode}, {self.stripes:g} stripes, {turn}")
         if self.display == "deviation":
-            parts.append(self._deviation_text())
+            # (in a session the surface moves between commits: the line the points shown give)
+            parts.append(self._live_deviation if session is not None and self._live_deviation else
+                         self._deviation_text())
         if self.combs:
             parts.append(f"combs: every {self.comb_every}, x{self.comb_gain:g}")
         if self.continuity:
@@ -429,9 +432,14 @@ class Overlay:
         target = self._target()
         points = thinned(target.points, SCAN_POINTS_SHOWN)
         distances, over = signed_distances(s.surface, points, float(int(getattr(self.obj, "TargetSide", 0)) or 1))
-        colours, _ = analysis.deviation_colours(np.where(over, distances, np.nan), self.tolerance(), rng)
+        tol = self.tolerance()
+        colours, _ = analysis.deviation_colours(np.where(over, distances, np.nan), tol, rng)
         node = shapes.coloured_points(points, colours, 3.0)
         self._scan = (key, now, node)
+        d = np.abs(distances[over])
+        self._live_deviation = (f"deviation: {100.0 * float(np.mean(d <= tol)):.1f} % within +-{tol:g} mm, p95 "
+                                f"{float(np.percentile(d, 95)):.3g} mm, max {float(d.max()):.3g} mm (live, "
+                                f"{d.size} points)") if d.size else None
         return node
 
     def _colours(self, s: core.DynamicSurface, mesh: np.ndarray) -> tuple[np.ndarray, tuple[float, float]]:
