@@ -66,16 +66,16 @@ def test_flatten_presses_the_bump_flatter_in_one_undo_step(tmp_path):
         before = d.shot("flatten_before")
         s = d.press_button("ToolFlatten", lambda s: undo(s) and undo(s)[0] == "Tool: flatten",
                            "Flatten from the Tools drop-down")
-        # its settings on the panel after the material's six: radius (7) and stiffness (8)
-        s = d.press_button("Panel", lambda s: "track8" in overlay(s)["hud"] and "track9" not in overlay(s)["hud"],
+        # its settings on the panel after the material's seven: radius (8) and stiffness (9)
+        s = d.press_button("Panel", lambda s: "track9" in overlay(s)["hud"] and "track10" not in overlay(s)["hud"],
                            "the slider panel with the flatten tool's two settings")
         calibrate(d)
-        label, radius, _, f = overlay(s)["sliders"][6]
-        assert label == "flatten radius (mm)" and radius == 10.0, overlay(s)["sliders"][6]
-        x0, y0, x1, y1 = overlay(s)["hud"]["track7"]
+        label, radius, _, f = overlay(s)["sliders"][7]
+        assert label == "flatten radius (mm)" and radius == 10.0, overlay(s)["sliders"][7]
+        x0, y0, x1, y1 = overlay(s)["hud"]["track8"]
         d.drag([d.to_screen([x0 + (f + (0.65 - f) * t) * (x1 - x0), (y0 + y1) / 2]) for t in np.linspace(0, 1, 8)],
                seconds=0.5)
-        s = d.wait(lambda s: undo(s)[:2] == ["Tool: flatten", "Tool: flatten"] and 15 < overlay(s)["sliders"][6][1] < 25,
+        s = d.wait(lambda s: undo(s)[:2] == ["Tool: flatten", "Tool: flatten"] and 15 < overlay(s)["sliders"][7][1] < 25,
                    "the radius set to about 20 mm as one undo step")
         d.shot("flatten_panel")
         d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
@@ -103,7 +103,7 @@ def test_flatten_presses_the_bump_flatter_in_one_undo_step(tmp_path):
         d.press_button("ToolRope", lambda s: undo(s)[0] == "Tool: rope", "Rope from the drop-down")
         s = d.press_button("ToolFlatten", lambda s: undo(s)[:2] == ["Tool: flatten", "Tool: rope"],
                            "Flatten again from the drop-down")
-        d.wait(lambda s: overlay(s)["sliders"][6][0] == "flatten radius (mm)" and 15 < overlay(s)["sliders"][6][1] < 25,
+        d.wait(lambda s: overlay(s)["sliders"][7][0] == "flatten radius (mm)" and 15 < overlay(s)["sliders"][7][1] < 25,
                "the flatten radius kept across the change of tools")
     finally:
         d.close()
