@@ -13,6 +13,17 @@ from test_gui_real_input import NEEDS, STYLES, USER_CFG, Desktop, sculpt, undo
 #: 0.20 shows it by default, 1.0 does not).
 CONSOLE_SHOWN = ('<FCParamGroup Name="BaseApp"><FCParamGroup Name="MainWindow"><FCParamGroup Name="DockWindows">'
                  '<FCBool Name="Std_PythonView" Value="1"/></FCParamGroup></FCParamGroup>')
+#: The combo view (its model tree) shown, as a designer's FreeCAD has it.
+TREE_SHOWN = ('<FCParamGroup Name="BaseApp"><FCParamGroup Name="MainWindow"><FCParamGroup Name="DockWindows">'
+              '<FCBool Name="Std_ComboView" Value="1"/></FCParamGroup></FCParamGroup>')
+
+
+def tree_shown_desktop(tmp: str) -> Desktop:
+    """FreeCAD under Xvfb with the model tree shown."""
+    home = make_addon_home(os.path.join(tmp, "home"))
+    with open(os.path.join(home, "user.cfg"), "w") as f:
+        f.write(USER_CFG.format(style=STYLES["CAD"]).replace('<FCParamGroup Name="BaseApp">', TREE_SHOWN))
+    return Desktop(tmp, "CAD")
 
 
 @pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD's GUI")
@@ -53,5 +64,41 @@ def test_keys_and_undo_reach_the_view_under_the_pointer_after_the_console_had_th
         s = d.wait(lambda s: undo(s) == names[1:], "ctrl+z: the last constraint undone")
         assert len(sculpt(s)["constraints"]) == 1
         d.shot("focus_keys_undone")
+    finally:
+        d.close()
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD's GUI")
+def test_a_name_typed_in_the_tree_keeps_its_letters_while_the_pointer_crosses_the_view(tmp_path):
+    """A designer renames the sculpt (F2 in the tree) and the pointer drifts over the view while they
+    type: P, N, C and M are letters of the name, not constraints and the map display. Once the name
+    is in, the pointer over the view gives it the keys again."""
+    d = tree_shown_desktop(str(tmp_path))
+    try:
+        s = d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        d.calibrate()
+        centre, east, _, _, _ = [d.to_screen(p) for p in sculpt(s)["screen"]]
+        item = d.wait(lambda s: sculpt(s)["label"] in s["tree"], "the sculpt in the tree")["tree"][sculpt(s)["label"]]
+        d.xdo("mousemove", str(item[0]), str(item[1]), "click", "1")
+        d.wait(lambda s: sculpt(s)["selected"], "the sculpt selected in the tree")
+        d.xdo("key", "F2")
+        d.wait(lambda s: s["focus_field"], "the tree's name editor to have the keyboard")
+        displays = [ov["display"] for ov in d.state()["overlays"]]
+        d.xdo("type", "--delay", "30", "Pan")
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.wait(lambda s: s["mouse_point"] is not None, "the pointer over the patch")
+        d.xdo("mousemove", str(east[0]), str(east[1]))
+        d.xdo("type", "--delay", "30", "el cm")
+        d.xdo("key", "Return")
+        s = d.wait(lambda s: sculpt(s)["label"] == "Panel cm", "the name typed in full")
+        assert sculpt(s)["constraints"] == []
+        assert [ov["display"] for ov in s["overlays"]] == displays
+        d.shot("focus_keys_renamed")
+        # the name is in: the pointer over the view gives it the keys again
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.wait(lambda s: not s["focus_field"] and s["focus"] != "Gui::TreeWidget", "the view to take the keyboard")
+        d.xdo("key", "p")
+        s = d.wait(lambda s: len(sculpt(s)["constraints"]) == 1, "P: a point constraint")
+        assert sculpt(s)["constraints"][0][0] == "point"
     finally:
         d.close()

@@ -3,11 +3,16 @@
 Coin sees keys only while the view's widget has the keyboard focus, and FreeCAD leaves it wherever
 it was last given: after the Python console was used, P typed a "p" there and ctrl+z undid the
 console's text. While the workbench is active, a mouse move over a 3D view gives that view the
-keyboard, as a click in it would, unless a task dialog is open (its fields keep what is typed) or
-another window is active (a dialog). The widgets are FreeCAD's own, reached through its main window
-object: no Qt module is imported.
+keyboard, as a click in it would, unless a task dialog is open (its fields keep what is typed),
+another window is active (a dialog) or a field is being typed in (a name in the tree, a value in
+the property editor: its letters P, N, C and M went to the view as constraints). The widgets are
+FreeCAD's own, reached through its main window object: no Qt module is imported.
 """
 from __future__ import annotations
+
+#: Widgets a person types a value into; they keep the keyboard. The Python console (a text edit
+#: too, but a pane that stays open) gives it up: the view's keys were meant for the view.
+FIELDS = ("QLineEdit", "QAbstractSpinBox")
 
 
 def give_keyboard_to_view(view) -> None:
@@ -18,6 +23,9 @@ def give_keyboard_to_view(view) -> None:
     import FreeCADGui as Gui
     main = Gui.getMainWindow()
     if main is None or not main.isActiveWindow() or Gui.Control.activeDialog():
+        return
+    focus = main.focusWidget()
+    if focus is not None and any(focus.inherits(kind) for kind in FIELDS):
         return
     widget = view.graphicsView()
     if widget is not None and not widget.hasFocus():
