@@ -114,9 +114,17 @@ class Overlay:
     def start(self, rate: float = 60.0) -> None:
         from pivy import coin
         if self._timer is None:
-            self._timer = coin.SoTimerSensor(lambda *_: self.frame(), None)
+            self._timer = coin.SoTimerSensor(lambda *_: self._tick(), None)
             self._timer.setInterval(coin.SbTime(1.0 / rate))
             self._timer.schedule()
+
+    def _tick(self) -> None:
+        """A frame, unless the object was deleted (or its creation undone) or the view closed since
+        the last one: then the overlay takes itself away (the controller forgets it on its next look)."""
+        if self.alive():
+            self.frame()
+        else:
+            self.remove()
 
     def stop(self) -> None:
         self._camera_sensor.detach()

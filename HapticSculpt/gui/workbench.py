@@ -153,7 +153,13 @@ class Controller:
         FreeCAD.Console.PrintMessage(HELLO)
 
     def sync_views(self) -> None:
-        """Attaches to views that opened and forgets closed ones."""
+        """Attaches to views that opened and forgets closed ones; stops a session whose sculpt was
+        deleted (or its creation undone)."""
+        if self.session is not None and (self.session.obj is None or not _alive(self.session.obj)):
+            import FreeCAD  # (the session stopped itself: the left button is the view's again)
+            self.stop_session()
+            FreeCAD.Console.PrintMessage("HapticSculpt: the sculpting session stopped: its sculpt was deleted or "
+                                         "its document closed\n")
         for closed in [i for i in self.inputs if not i.alive()]:
             closed.remove()
             self.inputs.remove(closed)

@@ -24,7 +24,7 @@ def _sculpts(doc):
             continue
         settings = json.loads(o.SculptSettings)
         face = o.Shape.Faces[0].Surface if o.Shape.Faces else None
-        out.append({"name": o.Name, "poles": list(o.Poles), "strokes": o.Strokes,
+        out.append({"name": o.Name, "label": o.Label, "poles": list(o.Poles), "strokes": o.Strokes,
                     "shape_poles": [[p.x, p.y, p.z] for row in face.getPoles() for p in row] if face else [],
                     "constraints": [[c["kind"], c["index"]] for c in settings.get("constraints", [])],
                     "plasticity": settings.get("plasticity"), "tool": settings.get("tool", {}).get("name"),
@@ -360,13 +360,19 @@ def _focus():
     return w.metaObject().className() if w is not None else None
 
 
+def _focus_is_field():
+    """True if the keyboard is in a field a value is typed into (a name being edited in the tree)."""
+    w = Gui.getMainWindow().focusWidget()
+    return w is not None and bool(w.inherits("QLineEdit") or w.inherits("QAbstractSpinBox"))
+
+
 def write(*_):
     state = {"version": [int(x) for x in FreeCAD.Version()[:2]],
              "workbench": Gui.activeWorkbench().name() if Gui.activeWorkbench() else "",
              "active": FreeCAD.ActiveDocument.Name if FreeCAD.ActiveDocument else None, "docs": {}, "views": _views(),
              "task_dialog": bool(Gui.Control.activeDialog()), "tree": _tree_items(),
              "task_buttons": _task_buttons(), "toolbars": _toolbars(), "console": _widget_rect("Gui::PythonConsole"),
-             "focus": _focus(), "selection": [[o.ObjectName, list(o.SubElementNames)]
+             "focus": _focus(), "focus_field": _focus_is_field(), "selection": [[o.ObjectName, list(o.SubElementNames)]
                                               for o in Gui.Selection.getSelectionEx()],
              "preselection": _preselection()}
     state["overlay_panels"], state["message_buttons"] = _panels_and_questions()
@@ -382,6 +388,7 @@ def write(*_):
         import HapticSculpt.gui.workbench as hg
         ctl = hg.controller()
         state["painting"] = ctl.painting
+        state["session"] = ctl.session is not None
         state["inputs"] = len(ctl.inputs)
         state["mouse_point"] = None if ctl.mouse_point is None else [float(x) for x in ctl.mouse_point]
         state["overlays"] = [{"display": ov.display, "frames": ov.frames, "view_size": list(ov.view.getSize()),

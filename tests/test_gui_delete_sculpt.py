@@ -1,0 +1,58 @@
+"""A sculpt deleted while the workbench draws it, and while a mouse session sculpts it (real X
+events through xdotool): no traceback, the session stops and gives the left button back, and
+Undo brings the sculpt back drawn and sculptable."""
+from __future__ import annotations
+
+import os
+
+import pytest
+from test_gui_focus_keys import tree_shown_desktop
+from test_gui_real_input import NEEDS, Desktop, sculpt, undo
+
+
+def tracebacks(d: Desktop) -> list[str]:
+    with open(os.path.join(d.tmp, "freecad.log"), errors="replace") as f:
+        text = f.read()
+    return [part[:600] for part in text.split("Traceback (most recent call last)")[1:]]
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD's GUI")
+def test_deleting_the_sculpt_mid_session_stops_it_cleanly_and_undo_brings_it_back(tmp_path):
+    d = tree_shown_desktop(str(tmp_path))
+    try:
+        s = d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        d.calibrate()
+        centre, east, west, _, _ = [d.to_screen(p) for p in sculpt(s)["screen"]]
+        label = sculpt(s)["label"]
+        # the material map shown (a display redrawn each frame), then a mouse session
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.wait(lambda s: s["mouse_point"] is not None, "the pointer over the patch")
+        d.xdo("key", "m")
+        d.wait(lambda s: any(ov["display"] == "mass" for ov in s["overlays"]), "M: the mass map")
+        d.press_button("Session", lambda s: s["session"] and sculpt(s)["session"], "a mouse session")
+        d.drag([east, (east[0], east[1] - 40), (east[0], east[1] - 80)])
+        d.wait(lambda s: sculpt(s)["strokes"] == 1, "a stroke")
+        # the sculpt picked in the tree and deleted there with the Delete key
+        item = d.wait(lambda s: label in s["tree"], "the sculpt in the tree")["tree"][label]
+        d.xdo("mousemove", str(item[0]), str(item[1]), "click", "1")
+        d.wait(lambda s: sculpt(s)["selected"], "the sculpt selected in the tree")
+        d.xdo("key", "Delete")
+        s = d.wait(lambda s: not s["docs"][s["active"]]["sculpts"] and not s["session"],
+                   "the sculpt deleted and its session stopped")
+        d.shot("delete_sculpt_deleted")
+        # the left button is the view's again: a drag over where the patch was is no stroke and raises nothing
+        d.drag([west, (west[0] + 60, west[1] + 30)])
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.wait(lambda s: s["focus"] not in ("Gui::TreeWidget",) and not s["focus_field"], "the view to take the keyboard")
+        d.xdo("key", "ctrl+z")
+        s = d.wait(lambda s: s["docs"][s["active"]]["sculpts"] and "Delete" not in undo(s)[:1],
+                   "ctrl+z: the sculpt back")
+        assert sculpt(s)["strokes"] == 1
+        d.shot("delete_sculpt_undone")
+        # and it sculpts again
+        d.press_button("Session", lambda s: s["session"] and sculpt(s)["session"], "a mouse session again")
+        d.drag([east, (east[0], east[1] - 40), (east[0], east[1] - 80)])
+        d.wait(lambda s: sculpt(s)["strokes"] == 2, "a second stroke")
+        assert tracebacks(d) == []
+    finally:
+        d.close()
