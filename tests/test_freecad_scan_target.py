@@ -76,7 +76,7 @@ class TestScanTarget(DocumentTestCase):
         self.doc = FreeCAD.openDocument(path)
         sculpt = self.doc.getObject(sculpt_name)
         self.assertEqual(sculpt.Target.Name, name)
-        self.assertEqual(sculpt.TargetTolerance, 0.5)
+        self.assertEqual(float(sculpt.TargetTolerance), 0.5)
         pull = hs.pull_of(sculpt)  # (the weight is the pull's strength, in the sculpt state)
         self.assertEqual((pull["enabled"], pull["strength"], pull["target"]), (True, 2.0, True))
         self.assertEqual(sculpt.Deviation, stored)
@@ -206,6 +206,24 @@ class TestScanTarget(DocumentTestCase):
         self.assertAlmostEqual(after["max_mm"], hs.deviation_of(self.sculpt)["max_mm"], places=9)
         self.assertEqual(self.sculpt.getEditorMode("Deviation"), ["ReadOnly"])
 
+    def test_the_tolerance_is_a_length_and_editing_it_measures_again(self):
+        """TargetTolerance shows and takes its unit in the property editor; an edit there (a
+        transaction of its own) is one undo step with the report measured at the new tolerance."""
+        rng = np.random.default_rng(4)
+        hs.set_target(self.sculpt, np.c_[rng.uniform(-40, 40, (2000, 2)), rng.uniform(-0.2, 0.2, 2000)],
+                      weight=0.0, tolerance=0.1)
+        self.assertEqual(self.sculpt.getTypeIdOfProperty("TargetTolerance"), "App::PropertyLength")
+        self.assertAlmostEqual(self.deviation_property()["within_pct"], 50.0, delta=4.0)
+        undo = self.doc.UndoCount
+        self.doc.openTransaction("Edit tolerance")
+        self.sculpt.TargetTolerance = "0.15 mm"
+        self.doc.commitTransaction()
+        self.assertEqual(self.doc.UndoCount, undo + 1)
+        self.assertEqual(self.deviation_property()["tolerance_mm"], 0.15)
+        self.assertAlmostEqual(self.deviation_property()["within_pct"], 75.0, delta=4.0)
+        self.doc.undo()
+        self.assertEqual(self.deviation_property()["tolerance_mm"], 0.1)
+
     def test_the_sign_is_outside_a_sculpted_solid(self):
         box = self.doc.addObject("Part::Box", "Box")
         box.Length, box.Width, box.Height = 40, 40, 20
@@ -217,3 +235,34 @@ class TestScanTarget(DocumentTestCase):
         report = hs.deviation_of(solid)
         self.assertTrue(report["signed"])
         self.assertAlmostEqual(report["min_signed_mm"], 0.7, places=5)
+
+
+class TestNoScanThere(DocumentTestCase):
+    def test_past_the_scans_edge_and_in_its_hole_the_display_shows_no_scan(self):
+        """The colour map's NaN (grey): a surface point past the scan's edge by more than a spacing
+        and a half, or inside a hole; over the scan, the distance along the normal, also where the
+        surface is tilted to the scan and off it."""
+        from HapticSculpt import core
+        from HapticSculpt.app.scan_deviation import mesh_deviation
+        from HapticSculpt.app.scan_target import point_spacing
+        x, y = np.meshgrid(np.arange(0.0, 50.0001, 0.5), np.arange(0.0, 50.0001, 0.5), indexing="ij")
+        scan = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+        scan = scan[np.hypot(scan[:, 0] - 25.0, scan[:, 1] - 25.0) > 5.0]  # a hole of radius 5 mm
+        spacing = point_spacing(scan)
+        self.assertAlmostEqual(spacing, 0.5, delta=0.03)
+        tree, tol = core.PointTree(scan), 0.1
+        u, v = np.meshgrid(np.linspace(-20.0, 70.0, 91), np.linspace(-20.0, 70.0, 91), indexing="ij")
+        flat = np.stack([u, v, np.full(u.shape, 0.05)], axis=-1)
+        normals = np.broadcast_to(np.array([0.0, 0.0, 1.0]), flat.shape)
+        signed = mesh_deviation(flat, normals, tree, scan, 0, 1.5 * spacing + tol)
+        past = (u < -1.0) | (u > 51.0) | (v < -1.0) | (v > 51.0) | (np.hypot(u - 25.0, v - 25.0) < 4.0)
+        over = (u >= 0) & (u <= 50) & (v >= 0) & (v <= 50) & (np.hypot(u - 25.0, v - 25.0) > 6.0)
+        self.assertTrue(np.isnan(signed[past]).all())
+        np.testing.assert_allclose(signed[over], -0.05, atol=1e-12)
+        # tilted 20 degrees and 5 mm off over the scan's middle: measured, not "no scan"
+        t = np.radians(20.0)
+        tilted = np.stack([u * 0.2 + 10.0, v * 0.2 + 10.0, 5.0 + (u * 0.2) * np.tan(t)], axis=-1)
+        n = np.array([-np.sin(t), 0.0, np.cos(t)])
+        signed = mesh_deviation(tilted, np.broadcast_to(n, tilted.shape), tree, scan, 0, 1.5 * spacing + tol)
+        self.assertFalse(np.isnan(signed).any())
+        self.assertTrue((signed < -3.0).all())

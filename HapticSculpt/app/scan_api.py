@@ -42,8 +42,8 @@ def _ensure_properties(sculpt: Any) -> None:
     if "Target" not in props:
         sculpt.addProperty("App::PropertyLink", "Target", GROUP, "The scan the surface is measured against "
                            "(a mesh or point cloud in the document)")
-    if "TargetTolerance" not in props:
-        sculpt.addProperty("App::PropertyFloat", "TargetTolerance", GROUP, "Deviation (mm) a point may have "
+    if "TargetTolerance" not in props:  # (a length: the property editor shows and takes its unit)
+        sculpt.addProperty("App::PropertyLength", "TargetTolerance", GROUP, "Deviation a point may have "
                            "and count as within")
     if "TargetSide" not in props:
         sculpt.addProperty("App::PropertyInteger", "TargetSide", GROUP, "+1 or -1: the sign that makes a "
@@ -107,9 +107,13 @@ def set_target(obj: Any, target: Any, weight: float = 1.0, tolerance: float = 0.
 
     def link() -> None:
         linked = scan_target.add_target_object(doc, made, f"{sculpt.Name}Target") if made is not None else target
-        sculpt.Target = linked
-        sculpt.TargetTolerance = tolerance
-        sculpt.TargetSide = _outward_side(sculpt)
+        sculpt.Proxy.setting_target = True  # (the report is measured once, below, not at each property)
+        try:
+            sculpt.Target = linked
+            sculpt.TargetTolerance = tolerance
+            sculpt.TargetSide = _outward_side(sculpt)
+        finally:
+            sculpt.Proxy.setting_target = False
         scan_deviation.refresh_property(sculpt)
         chosen.append(linked)
 

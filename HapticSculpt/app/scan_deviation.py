@@ -22,6 +22,9 @@ from . import sculpt_state
 PROPERTY_POINTS = 50_000
 #: The property the report is kept in (JSON, read-only).
 PROPERTY = "Deviation"
+#: A nearest scan point this many times farther to the side than along the normal (tan 60 degrees)
+#: is not over this mesh point (as the pull's springs judge it).
+SIDEWAYS = 3.0 ** 0.5
 
 
 def core_surface(state: sculpt_state.SculptState) -> core.BSplineSurface:
@@ -97,8 +100,10 @@ def mesh_deviation(mesh: np.ndarray, normals: np.ndarray, tree: Any, points: np.
                    reach: float) -> np.ndarray:
     """The scan's signed distance at each point of a surface's mesh ((g, h, 3), its unit normals
     alike): how far the nearest scan point lies along the normal (its offset along the surface is a
-    scan's sampling, not a deviation), times ``side`` as in :func:`measure`; NaN where the nearest
-    scan point lies more than ``reach`` along the surface (a hole in the scan, or past its edge)."""
+    scan's sampling, not a deviation), times ``side`` as in :func:`measure`. NaN where the nearest
+    scan point lies to the side by more than ``reach`` (about the scan's spacing) and by more than
+    SIDEWAYS times its distance along the normal: a hole in the scan, or past its edge (a surface
+    tilted to the scan and off it finds its nearest points to the side: they still count)."""
     flat = mesh.reshape(-1, 3)
     index, distance = tree.nearest(flat)
     offset = points[index] - flat
@@ -106,5 +111,5 @@ def mesh_deviation(mesh: np.ndarray, normals: np.ndarray, tree: Any, points: np.
     along = np.einsum("ij,ij->i", offset, n)
     across = np.sqrt(np.maximum(distance ** 2 - along ** 2, 0.0))
     signed = along * float(side or 1)
-    signed[across > reach] = np.nan
+    signed[across > np.maximum(reach, SIDEWAYS * np.abs(along))] = np.nan
     return signed.reshape(mesh.shape[:2])

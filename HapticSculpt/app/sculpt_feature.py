@@ -64,7 +64,8 @@ class SculptFeature:
 
     def onChanged(self, obj: Any, prop: str) -> None:
         """A state property changed from outside (Undo, Redo, a script): the live surface follows;
-        so does its pull when the ``Target`` link changed."""
+        so does its pull when the ``Target`` link changed, and the deviation report when the
+        tolerance was edited (in the property editor, or by a script)."""
         live = getattr(self, "live", None)
         if live is not None and prop in STATE_PROPERTIES:
             live.property_written()
@@ -72,6 +73,9 @@ class SculptFeature:
                 live.document_changed()
         elif live is not None and prop == "Target":
             live.target_changed()
+        elif prop == "TargetTolerance" and not getattr(self, "setting_target", False) and not obj.Document.Restoring:
+            from .scan_deviation import refresh_property
+            refresh_property(obj)
 
     def onDocumentRestored(self, obj: Any) -> None:
         """Opening a file: add properties older files lack, then load the state (errors are reported

@@ -422,10 +422,9 @@ class Overlay:
         tol = self.tolerance()
         if target is None:
             return analysis.deviation_colours(np.full(mesh.shape[:2], np.nan), tol, (-2 * tol, 2 * tol))
-        _, spacing_u, spacing_v = s.reference
-        reach = 2.0 * max(spacing_u, spacing_v) + 2.0 * tol
+        # a point past the scan's edge by a spacing and a half shows no scan (grey), not the edge's colour
         signed = mesh_deviation(mesh, analysis.vertex_normals(mesh), target.tree, target.points,
-                                int(getattr(self.obj, "TargetSide", 0)), reach)
+                                int(getattr(self.obj, "TargetSide", 0)), 1.5 * target.spacing + tol)
         return analysis.deviation_colours(signed, tol)
 
     def _scan_points(self, s: core.DynamicSurface, rng: tuple[float, float]) -> Any:
