@@ -235,6 +235,10 @@ class TestBadArguments(DocumentTestCase):
         self.assert_refused(ValueError, hs.make_sculpt, self.doc, size=(float("nan"), 1.0), name="size")
         self.assert_refused(TypeError, hs.make_sculpt, "doc", name="doc")
         self.assert_refused(TypeError, hs.make_sculpt, self.doc, source=42, name="source")
+        self.assert_refused(ValueError, hs.make_sculpt, self.doc, centre=(1.0, 2.0), name="centre")
+        self.assert_refused(ValueError, hs.make_sculpt, self.doc, centre=(float("inf"), 0, 0), name="centre")
+        self.assert_refused(TypeError, hs.make_sculpt, self.doc, centre="origin", name="centre")
+        self.assert_refused(TypeError, hs.make_sculpt, self.doc, centre=5, name="centre")
         other = FreeCAD.newDocument("HSOther")
         try:
             box = other.addObject("Part::Box", "Box")
@@ -242,6 +246,13 @@ class TestBadArguments(DocumentTestCase):
             self.assert_refused(ValueError, hs.make_sculpt, self.doc, source=(box, "Face1"), name="source")
         finally:
             FreeCAD.closeDocument(other.Name)
+
+    def test_a_flat_patch_lies_where_its_centre_says(self):
+        obj = hs.make_sculpt(self.doc, size=(60.0, 40.0), centre=(100.0, -20.0, 5.0))
+        box = obj.Shape.BoundBox
+        self.assertAlmostEqual(box.XMin, 70.0, places=9)
+        self.assertAlmostEqual(box.YMax, 0.0, places=9)
+        self.assertAlmostEqual(box.ZMax, 5.0, places=9)
 
     def test_run_and_constraints(self):
         obj = hs.make_sculpt(self.doc)

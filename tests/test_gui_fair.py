@@ -91,7 +91,9 @@ try:
             Gui.updateGui()
         new = [o for o in doc.Objects if o.Name not in before]
         made[command] = {{"objects": len(new), "undo": doc.UndoNames[:doc.UndoCount - undo],
-                          "edges": hs.held_boundary(new[0]), "bending": list(new[0].BendingMap)}}
+                          "edges": hs.held_boundary(new[0]), "bending": list(new[0].BendingMap),
+                          "box": [new[0].Shape.BoundBox.XMin, new[0].Shape.BoundBox.XMax,
+                                  new[0].Shape.BoundBox.YMin, new[0].Shape.BoundBox.YMax]}}
     out["made"] = made
 except Exception:
     out["error"] = traceback.format_exc()
@@ -103,7 +105,8 @@ os._exit(0)
 @pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
 def test_new_patch_offers_free_or_held_edges(tmp_path):
     """The create toolbar's New patch drop-down: New sculpt patch makes a free sheet, New clamped
-    patch one with every edge held G1; each one undo step, both bending by default."""
+    patch one with every edge held G1; each one undo step, both bending by default. The first lies
+    at the origin, the second beside it (not on it)."""
     from HapticSculpt.app.api import FAIR_BENDING
     out = run_freecad_gui(NEW_PATCH_SCRIPT.format(answer="{answer}"), str(tmp_path))
     assert "error" not in out, out["error"]
@@ -113,3 +116,5 @@ def test_new_patch_offers_free_or_held_edges(tmp_path):
     assert set(free["edges"].values()) == {"free"}
     assert held["edges"] == {"u0": "G1", "u1": "G1", "v0": "G1", "v1": "G1"}
     assert free["bending"] == held["bending"] == [FAIR_BENDING]
+    assert free["box"] == pytest.approx([-50, 50, -50, 50], abs=1e-6)
+    assert held["box"] == pytest.approx([70, 170, -50, 50], abs=1e-6)

@@ -71,10 +71,10 @@ def _sculpt(obj: Any, name: str = "obj", solids: bool = False) -> Any:
 def make_sculpt(doc: Any = None, source: Any = None, controls: tuple[int, int] = (8, 8),
                 degree: tuple[int, int] = (3, 3), mesh: tuple[int, int] = (40, 40),
                 size: tuple[float, float] = (100.0, 100.0), name: str = "Sculpt", material: str = "elastic",
-                edges: Any = "free") -> Any:
+                edges: Any = "free", centre: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> Any:
     """A new Sculpt object in ``doc`` (the active or a new document when None).
 
-    ``source``: None (a flat ``size`` patch in XY, centred at the origin), a ``Part.Face``, a
+    ``source``: None (a flat ``size`` patch in XY, centred at ``centre``), a ``Part.Face``, a
     ``Part.BSplineSurface`` or ``(document_object, "FaceN")``. Faces with an exact B-spline form are
     converted exactly and refined exactly to at least ``controls`` poles of at least ``degree``;
     others are fitted at ``controls``/``degree``. The conversion error (mm) is stored in
@@ -97,10 +97,18 @@ def make_sculpt(doc: Any = None, source: Any = None, controls: tuple[int, int] =
     except (TypeError, ValueError):
         raise TypeError(f"size: expected (width, height), got {size!r}") from None
     size = (_finite(sx, "size", positive=True), _finite(sy, "size", positive=True))
+    try:
+        centre = tuple(_finite(c, "centre") for c in centre)
+    except TypeError as exc:
+        raise TypeError(f"centre: expected (x, y, z) in mm ({exc})") from None
+    if len(centre) != 3:
+        raise ValueError(f"centre: expected (x, y, z) in mm, got {len(centre)} numbers")
+    if source is not None and any(centre):
+        raise ValueError("centre: only for a flat patch (source None): a face stays where it is")
     if not isinstance(name, str) or not name:
         raise TypeError("name: expected a non-empty string")
     _material(material)
-    made = source_surface(source, controls, degree, size, doc)
+    made = source_surface(source, controls, degree, size, doc, centre=centre)
     state = _sculpt_state(made, mesh, material, held=boundary_poles(tuple(made.surface.controls), edges))
     if doc.UndoMode == 0:
         doc.UndoMode = 1

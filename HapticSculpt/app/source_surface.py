@@ -171,12 +171,17 @@ def _fit(geom: Any, controls: tuple[int, int], degree: tuple[int, int]) -> core.
 
 
 def source_surface(source: Any, controls: tuple[int, int], degree: tuple[int, int],
-                   size: tuple[float, float], doc: Any = None, extra_knots: tuple[Any, Any] = ((), ())) -> SourceSurface:
-    """The core surface for ``source`` (None: a flat ``size`` patch) at the requested resolution;
-    ``extra_knots`` (u values, v values) refine an exactly converted source further where asked."""
+                   size: tuple[float, float], doc: Any = None, extra_knots: tuple[Any, Any] = ((), ()),
+                   centre: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> SourceSurface:
+    """The core surface for ``source`` (None: a flat ``size`` patch in XY centred at ``centre``) at
+    the requested resolution; ``extra_knots`` (u values, v values) refine an exactly converted
+    source further where asked."""
     if source is None:
-        return SourceSurface(core.BSplineSurface.plane(controls, degree, size), "plane", 0.0,
-                             f"plane {size[0]:g} x {size[1]:g}")
+        plane = core.BSplineSurface.plane(controls, degree, size)
+        if any(centre):
+            plane = core.BSplineSurface(np.asarray(plane.poles, float) + np.asarray(centre, float), plane.degree,
+                                        plane.knots_u, plane.knots_v, plane.weights)
+        return SourceSurface(plane, "plane", 0.0, f"plane {size[0]:g} x {size[1]:g}")
     geom, description = resolve_face(source, doc)
     bs = _exact_bspline(geom)
     if bs is not None and max(bs.UDegree, bs.VDegree) <= core.MAX_DEGREE:

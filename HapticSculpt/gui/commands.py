@@ -63,9 +63,28 @@ def _selected_sculpts() -> list[Any]:
     return [o for o in Gui.Selection.getSelection() if is_sculpt(o)]
 
 
+#: The gap (mm) between a new patch and what the document holds already.
+NEW_PATCH_GAP = 20.0
+
+
+def free_spot(doc: Any, size: float = 100.0) -> tuple[float, float, float]:
+    """Where a new flat ``size`` patch is centred in ``doc``: the origin in an empty document, else
+    beside (+X) everything shown there, so that a second patch does not lie on the first (two
+    coincident sheets look like one, and a stroke catches either)."""
+    boxes = [o.Shape.BoundBox for o in doc.Objects
+             if getattr(o, "Visibility", True) and not getattr(getattr(o, "Shape", None), "isNull", lambda: True)()]
+    boxes = [b for b in boxes if b.isValid()]
+    if not boxes:
+        return (0.0, 0.0, 0.0)
+    x_max = max(b.XMax for b in boxes)
+    y_mid = 0.5 * (min(b.YMin for b in boxes) + max(b.YMax for b in boxes))
+    z_min = min(b.ZMin for b in boxes)
+    return (round(x_max + NEW_PATCH_GAP + 0.5 * size, 3), round(y_mid, 3), round(z_min, 3))
+
+
 class NewPatch:
     """A flat 8x8 sculpt patch (100 x 100 mm) with free edges in the active document, or in a new one
-    when none is open (as Part's primitives do)."""
+    when none is open (as Part's primitives do), beside what the document shows already."""
 
     #: make_sculpt's ``edges``.
     EDGES = "free"
@@ -83,9 +102,11 @@ class NewPatch:
         if FreeCAD.ActiveDocument is None:
             run_echoed("App.newDocument()", modules=())
         edges = "" if self.EDGES == "free" else f", edges={self.EDGES!r}"
+        spot = free_spot(FreeCAD.ActiveDocument)
+        at = f", centre={spot!r}" if any(spot) else ""
         # clay: designers expect what they pull to stay
         run_echoed(f"HapticSculpt.make_sculpt(App.getDocument({FreeCAD.ActiveDocument.Name!r}), material='clay'"
-                   f"{edges})")
+                   f"{edges}{at})")
         FreeCAD.ActiveDocument.recompute()
         Gui.SendMsgToActiveView("ViewFit")
 
@@ -229,14 +250,22 @@ def _has_sculpt() -> bool:
     return _ctl().active_sculpt() is not None
 
 
+#: What a greyed-out command waits for, said at the end of its tool tip (shown on the greyed button too).
+NEEDS_SCULPT = "Needs a sculpt: select one (or have only one in the document), or make one with New patch or Sculpt face."
+NEEDS_TARGET = "Needs a sculpt with a scan target: select a mesh or point cloud and the sculpt, then Set scan target."
+NEEDS_CURSOR = "Needs a sculpt and the mouse over it (or a session's cursor)."
+
+
 class _SculptCommand:
     """A command on the active sculpt (selected, else the document's last): active only with one."""
 
     icon_name = "HapticSculpt"
     menu = tip = ""
+    needs = NEEDS_SCULPT
 
     def GetResources(self) -> dict[str, str]:
-        return {"Pixmap": icon(self.icon_name), "MenuText": self.menu, "ToolTip": self.tip}
+        return {"Pixmap": icon(self.icon_name), "MenuText": self.menu, "ToolTip": f"{self.tip}. {self.needs}"
+                if not self.tip.endswith(".") else f"{self.tip} {self.needs}"}
 
     def IsActive(self) -> bool:
         return _has_sculpt()
@@ -301,6 +330,7 @@ class HoldEdges(_SculptCommand):
     tip = ("Hold the sculpt's edges exactly (hard constraints): G0 keeps them where they are, G1 their "
            "tangent planes too, G2 the curvature across them too, G3 its rate; each press goes free, G0, G1, "
            "G2, G3, free, skipping what the net cannot hold (a face sculpted in its solid: G0 to G3)")
+    needs = NEEDS_SCULPT[:-1] + "; a face sculpted in its solid: with no session running."
 
     def IsActive(self) -> bool:
         # (a solid's edges change with a rebuilt net, which waits for the session to stop: greyed
@@ -485,7 +515,7 @@ class SetTarget:
 
 
 class ShowDeviation(_SculptCommand):
-    icon_name, menu = "ShowDeviation", "Show deviation"
+    icon_name, menu, needs = "ShowDeviation", "Show deviation", NEEDS_TARGET
     tip = ("Toggle the deviation display: the scan's signed distance from the surface in colour, green within "
            "the tolerance, yellow to red on the normal's side (outside a solid), cyan to blue on the other, grey "
            "where there is no scan; on the scan's points too")
@@ -501,6 +531,7 @@ class ShowDeviation(_SculptCommand):
 
 class FitToTarget(_SculptCommand):
     icon_name, menu = "FitToTarget", "Fit to scan"
+    needs = NEEDS_TARGET[:-1] + ", with no session running."
     tip = ("Fit the surface to its scan target within its tolerance (TargetTolerance): outliers and holes are "
            "ignored and bridged, held edges, seams, symmetry and curves kept, the net refined where it must be; "
            "one undo step")
@@ -523,7 +554,7 @@ class FitToTarget(_SculptCommand):
 
 
 class PullToTarget(_SculptCommand):
-    icon_name, menu = "PullToTarget", "Pull toward scan (on/off)"
+    icon_name, menu, needs = "PullToTarget", "Pull toward scan (on/off)", NEEDS_TARGET
     tip = ("Switch the pull toward the scan target on or off: while sculpting (a session or HapticSculpt.run) the "
            "surface is drawn onto the scan where it is near, bridging holes; the Paint pull airbrush takes it away "
            "where it sprays; one undo step")
@@ -578,7 +609,7 @@ class Falloff(_SculptCommand):
 
 
 class _Constraint(_SculptCommand):
-    kind = "point"
+    kind, needs = "point", NEEDS_CURSOR
 
     def IsActive(self) -> bool:
         return _has_sculpt() and _ctl().cursor() is not None
