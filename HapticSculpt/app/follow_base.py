@@ -23,16 +23,22 @@ from .curve_constraint import PROPERTY, records_of
 from .face_net import face_held, face_source, mirror_of, seam_links
 from .face_walls import face_walls
 from .sculpt_properties import face_of, read_state, write_state
+from .source_surface import SourceSurface, refined
 
 #: Grid (per direction) on which the displacement is sampled and fitted.
 FIT_SAMPLES = 48
 
 
 def source_of(obj: Any, chain: FaceChain, edges: list[face_in_solid.FaceEdge]) -> Any:
-    """The base faces' exact B-spline surface at the SculptedSolid's resolution (a SourceSurface)."""
+    """The base faces' exact B-spline surface at the SculptedSolid's resolution (a SourceSurface),
+    refined where a fit refined the sculpt's net (its ``fit_knots``)."""
     res = json.loads(obj.Resolution)
-    return face_source(obj.Base, chain, edges, tuple(res["controls"]), tuple(res["degree"]),
+    made = face_source(obj.Base, chain, edges, tuple(res["controls"]), tuple(res["degree"]),
                        int(res["trim_spans"]), mirror_of(obj))
+    fit = res.get("fit_knots")
+    if fit and (fit[0] or fit[1]):
+        made = SourceSurface(refined(made.surface, tuple(fit)), made.method, made.error, made.description)
+    return made
 
 
 def _basis_matrix(surface: core.BSplineSurface, n: int) -> np.ndarray:

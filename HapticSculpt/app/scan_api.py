@@ -18,7 +18,7 @@ import numpy as np
 from . import scan_deviation, scan_target
 from .api import _sculpt as api_sculpt
 from .sculpt_properties import read_state
-from .sculpted_solid import solid_of
+from .sculpted_solid import chain_of_solid, solid_of
 from .undo import transaction
 
 GROUP = "Scan"
@@ -242,37 +242,85 @@ def _refine_knots(surface: Any, r: dict[str, Any], tolerance: float, room: tuple
 
 def _refined(sculpt: Any, work: Any, extra: tuple[list[float], list[float]]) -> Any:
     """A new working surface on ``work``'s net with knots ``extra`` inserted (exactly: the shape is
-    kept), its edges held as before and its curves held again; None where the sculpt's holds are
-    not its edges' (they could not be carried to the finer net)."""
+    kept), held as before: a sheet's edges, or a sculpted solid's edges, trims and seams (held poles,
+    seam links and walls found again on the finer net); its curves held again. None where the
+    holds could not be carried to the finer net: a sheet's held poles that are not its edges', a
+    symmetric sculpt, a mesh with no room for more poles."""
     from . import api, curve_api, sculpt_state
-    from .part_surface import part_bspline
-    from .source_surface import insert_knots, to_core
+    from .solid_api import refined_net
+    from .source_surface import refined
     controls = tuple(work.surface.controls)
-    kinds = api.held_boundary(sculpt)
-    if sorted(work.held_poles) != sorted(set(api.boundary_poles(controls, kinds))) or work.symmetry is not None:
+    solid = solid_of(sculpt)
+    if work.symmetry is not None:
         return None
-    bs = work.surface
-    poles = np.asarray(work.poles, float).reshape(controls[0], controls[1], 3)
-    weights = None if bs.weights is None else np.asarray(bs.weights, float)
-    part = part_bspline(poles, np.asarray(bs.knots_u), np.asarray(bs.knots_v), tuple(bs.degree), weights)
-    insert_knots(part, extra)
-    finer = to_core(part)
+    if solid is None:
+        kinds = api.held_boundary(sculpt)
+        if sorted(work.held_poles) != sorted(set(api.boundary_poles(controls, kinds))):
+            return None
+        finer, links, walls = refined(work.surface, extra), [], []
+        held = api.boundary_poles(tuple(finer.controls), kinds)
+    else:
+        finer, held, links, walls = refined_net(solid, work.surface, extra)
     state = sculpt_state.capture(work)
     new_controls = tuple(finer.controls)
     mesh = tuple(state.settings["mesh"])
     if mesh[0] < new_controls[0] or mesh[1] < new_controls[1]:
         return None
-    state.settings.update(controls=list(new_controls), held_poles=[], linked_poles=[])
+    state.settings.update(controls=list(new_controls), held_poles=[], linked_poles=[], walls=[])
     state.arrays.update(Poles=np.asarray(finer.poles, float).ravel(), Velocities=np.zeros(finer.poles.size),
                         KnotsU=np.asarray(finer.knots_u, float), KnotsV=np.asarray(finer.knots_v, float),
                         Weights=np.zeros(0) if finer.weights is None else np.asarray(finer.weights, float).ravel())
     made = sculpt_state.restore(state)
-    held = api.boundary_poles(new_controls, kinds)
     poles_now = np.asarray(made.poles, float).reshape(-1, 3)
-    moved, links, _ = curve_api.rehold(sculpt, made, held, [], poles_now)
+    moved, links, _ = curve_api.rehold(sculpt, made, held, links, poles_now)
     made.set_poles(moved.reshape(new_controls[0], new_controls[1], 3))
     made.hold_poles(held, links)
+    if walls:
+        made.set_walls(walls)
     return made
+
+
+#: A face of a solid's faces sculpted as one surface that holds less than this share of the scan's
+#: points over the surface is one the scan does not reach: it keeps its shape through the fit.
+UNCOVERED_SHARE = 0.002
+
+
+def _uncovered_poles(sculpt: Any, surface: Any, u_over: np.ndarray) -> list[int]:
+    """The poles of a sculpted solid's faces (sculpted as one surface, joined along u) whose whole
+    support lies on a face the scan does not reach (``u_over``: the joined u of the points over the
+    surface). Held while fitting: no point shapes them, and a net too coarse for the scan rings
+    (least squares overshoot a bump it cannot follow): the smoothing alone let that ring on through
+    a G2 seam into a round, 2 mm out of its part on the net as made, 20 mm once refined."""
+    solid = solid_of(sculpt)
+    if solid is None or u_over.size == 0:
+        return []
+    chain = chain_of_solid(solid)
+    if len(chain.placements) < 2:
+        return []
+    knots, p = np.asarray(surface.knots_u, float), surface.degree[0]
+    nu, nv = surface.controls
+    rows: set[int] = set()
+    for placement in chain.placements:
+        lo, hi = sorted(placement.span)
+        if np.count_nonzero((u_over >= lo) & (u_over <= hi)) >= UNCOVERED_SHARE * u_over.size:
+            continue
+        rows |= {i for i in range(nu) if knots[i] >= lo - 1e-9 * (hi - lo) and knots[i + p + 1] <= hi + 1e-9 * (hi - lo)}
+    return [i * nv + j for i in sorted(rows) for j in range(nv)]
+
+
+def _fit_holding(work: Any, points: np.ndarray, tolerance: float, frozen: list[int]) -> tuple[Any, dict[str, Any]]:
+    """``fit_net_unfolded`` with the ``frozen`` poles held too (the surface's own holds back afterwards)."""
+    from .scan_fit import fit_net_unfolded
+    links = [tuple(link) for link in work.linked_poles]
+    extra = sorted(set(frozen) - set(work.held_poles) - {link[0] for link in links})
+    if not extra:
+        return fit_net_unfolded(work, points, tolerance)
+    held = list(work.held_poles)
+    work.hold_poles(sorted(held + extra), links)
+    try:
+        return fit_net_unfolded(work, points, tolerance)
+    finally:
+        work.hold_poles(held, links)
 
 
 def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[str, Any]:
@@ -287,15 +335,21 @@ def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[
     curve constraints hold exactly. Where the fit stays out of the tolerance, knots are inserted in
     the spans whose points are off by more than the scan's noise (exactly: the shape is kept) and it
     fits again, up to ``max_controls`` poles per direction (a number or a pair; default 48, never
-    fewer than the net has), half the mesh's points and one pole per 12 points. A sculpt whose held poles are not its edges', a symmetric one, and a sculpted solid's
-    face are fitted on their net as it is (the report says so).
+    fewer than the net has), half the mesh's points and one pole per 12 points. On a sculpted solid's
+    face the finer net is held as the face was (its edges, trims and seams: held poles, seam links and
+    walls found again), and the solid keeps the knots, so the net it makes again when its base
+    changes is the same; of faces sculpted as one, one the scan does not reach keeps its shape. A
+    sheet whose held poles are not its edges' and a symmetric sculpt are fitted on their net as it
+    is (the report says so). A net that folds in its own plane (its poles slid there, where little
+    holds them) is fitted again holding them more firmly; if it still folds, the coarser net's fit
+    is kept (the report says so), or on the first net nothing changes (ValueError).
 
     One undo step; the fitted shape is the rest shape. Not during a session (RuntimeError).
     Returns the report: ``met``, ``within_pct``, ``tolerance_mm``, ``controls``, ``points``,
     ``outliers``, ``beyond_edge``, ``message`` (where and why it fell short) and ``rounds`` (one
     per net: its controls, within_pct, max_mm, p95_mm, outliers, worst_uv)."""
     from . import sculpt_state
-    from .scan_fit import POINTS_PER_POLE, WITHIN_GOAL, FitReport, fit_net
+    from .scan_fit import POINTS_PER_POLE, WITHIN_GOAL, FitReport
     sculpt = _sculpt(obj)
     tolerance = _number(tolerance, "tolerance", 1e-6, 1e6)
     live = sculpt.Proxy.live
@@ -311,10 +365,24 @@ def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[
         _, point, normal = work.symmetry
         n = np.asarray(normal, float) / np.linalg.norm(normal)
         points = np.vstack([points, points - 2.0 * ((points - np.asarray(point, float)) @ n)[:, None] * n])
-    solid = solid_of(sculpt) is not None
+    solid = solid_of(sculpt)
+    start = work.surface
+    first = start.project(points)
+    u_over = first["uv"][~first["beyond_edge"], 0]
     report = FitReport(tolerance, 0.0, False, tuple(work.surface.controls))
+    coarser: Any = None  # (the last net's fit, kept while a finer one is tried)
     while True:
-        summary, r = fit_net(work, points, tolerance)
+        try:
+            summary, r = _fit_holding(work, points, tolerance, _uncovered_poles(sculpt, work.surface, u_over))
+        except ValueError as exc:  # (a net that folds: never written)
+            if coarser is None:
+                raise ValueError(f"{sculpt.Label}: not fitted, {exc} (nothing changed)") from None
+            work, summary, r = coarser
+            report.within_pct, report.controls = summary.within_pct, summary.controls
+            where = (f"worst near (u, v) = ({summary.worst_uv[0]:.3f}, {summary.worst_uv[1]:.3f}), "
+                     f"{summary.max_mm:.3g} mm off")
+            report.message = f"kept the {summary.controls} net's fit: {exc} ({where})"
+            break
         report.rounds.append(summary)
         report.within_pct, report.controls = summary.within_pct, summary.controls
         if summary.within_pct >= WITHIN_GOAL:
@@ -323,9 +391,6 @@ def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[
         controls = tuple(work.surface.controls)
         room = (limit[0] - controls[0], limit[1] - controls[1])
         where = f"worst near (u, v) = ({summary.worst_uv[0]:.3f}, {summary.worst_uv[1]:.3f}), {summary.max_mm:.3g} mm off"
-        if solid:
-            report.message = f"a sculpted solid's face is fitted on its net as it is: {where}"
-            break
         if room[0] <= 0 and room[1] <= 0:
             report.message = f"stopped at max_controls {limit}: {where}"
             break
@@ -353,7 +418,7 @@ def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[
         if tuple(finer.surface.controls) == controls:
             report.message = f"no span left to refine: {where}"
             break
-        work = finer
+        coarser, work = (work, summary, r), finer
     over = ~r["beyond_edge"]
     report.points = int(np.count_nonzero(over[: len(target.points)]))
     report.beyond_edge = int(len(target.points) - report.points)
@@ -361,6 +426,9 @@ def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[
     work.relax()
     state = sculpt_state.capture(work)
     with transaction(sculpt.Document, "Fit to target"):
+        if solid is not None and tuple(work.surface.controls) != tuple(start.controls):
+            from .solid_api import record_refinement
+            record_refinement(solid, start, work.surface)
         live.write(state)
         live.document_changed()  # (the cached surface is not the fitted one: read it again)
         scan_deviation.refresh_property(sculpt)

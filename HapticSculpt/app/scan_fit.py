@@ -28,6 +28,11 @@ SETTLED = 0.005
 #: How much a point's slide along the surface weighs against its distance across it (1 would be
 #: plain least squares, whose feet creep: 3 % a round on a bump where this takes 2 or 3 rounds).
 TANGENTIAL = 0.02
+#: ... and on a net that folded at that, fitted again with the slide weighing these in turn (slower
+#: to settle, so not always). Its poles slid in the surface's own plane, where little holds them:
+#: a refined solid's top crossed itself beside a bump (0.1 still did, 0.3 not), a sheet with held
+#: edges and a held line crossed itself in 57 cells of 1600 beside the line (0.3: 4, 1: none).
+TANGENTIAL_FIRM = (0.3, 1.0)
 #: Robust standard deviations beyond which a point is an outlier.
 OUTLIER_SPREAD = 4.0
 #: Points far off in a span cell are outliers only while they are fewer than this share of its
@@ -106,8 +111,35 @@ def span_cells(surface: core.BSplineSurface, uv: np.ndarray) -> np.ndarray:
     return iu * (len(bv) - 1) + iv
 
 
-def fit_net(surface: core.DynamicSurface, points: np.ndarray, tolerance: float,
-            smoothing: float = SMOOTHING, rounds: int = ROUNDS) -> tuple[FitRound, dict[str, Any]]:
+def folded(normals: np.ndarray, surface: core.BSplineSurface) -> bool:
+    """True if ``surface`` crosses itself in its own plane somewhere: a cell of its parameter grid
+    (the grid ``normals`` were taken on, (n, m, 3), from the surface before it moved) is mapped
+    turned over (its corners' orientation against the normal there)."""
+    n, m = normals.shape[:2]
+    pts = np.asarray(surface.grid(n, m)[0])
+    du, dv = pts[1:, :-1] - pts[:-1, :-1], pts[:-1, 1:] - pts[:-1, :-1]
+    cross = np.cross(du, dv)
+    turn = np.einsum("ijk,ijk->ij", cross, normals[:-1, :-1])
+    return bool(np.any(turn < -1e-9 * np.linalg.norm(cross, axis=-1)))
+
+
+def fit_net_unfolded(surface: core.DynamicSurface, points: np.ndarray, tolerance: float) -> tuple[FitRound, dict[str, Any]]:
+    """:func:`fit_net`, and again from the same poles with the slide weighing each of
+    TANGENTIAL_FIRM in turn while the net folds; ValueError (the poles put back) if it folds even so."""
+    nu, nv = surface.surface.controls
+    start = np.asarray(surface.poles, float).copy()
+    normals = np.asarray(surface.surface.grid(4 * nu + 1, 4 * nv + 1)[1])
+    for tangential in (TANGENTIAL, *TANGENTIAL_FIRM):
+        surface.set_poles(start.reshape(nu, nv, 3))
+        summary, r = fit_net(surface, points, tolerance, tangential=tangential)
+        if not folded(normals, surface.surface):
+            return summary, r
+    surface.set_poles(start.reshape(nu, nv, 3))
+    raise ValueError(f"the {nu} x {nv} net folds in its own plane fitting these points")
+
+
+def fit_net(surface: core.DynamicSurface, points: np.ndarray, tolerance: float, smoothing: float = SMOOTHING,
+            rounds: int = ROUNDS, tangential: float = TANGENTIAL) -> tuple[FitRound, dict[str, Any]]:
     """Fits ``surface``'s poles to ``points`` on its net as it is (the surface is moved there).
     Returns the net's summary and the last projection (with the weights)."""
     nu, nv = surface.surface.controls
@@ -115,7 +147,7 @@ def fit_net(surface: core.DynamicSurface, points: np.ndarray, tolerance: float,
     w = robust_weights(r["distance"], ~r["beyond_edge"], tolerance, span_cells(surface.surface, r["uv"]))
     mean = math.inf
     for _ in range(rounds):
-        fitted = surface.fit_poles(points, r["uv"], r["normal"], w, TANGENTIAL, smoothing)
+        fitted = surface.fit_poles(points, r["uv"], r["normal"], w, tangential, smoothing)
         surface.set_poles(fitted.reshape(nu, nv, 3))
         r = surface.surface.project(points, start=r["uv"])
         w = robust_weights(r["distance"], ~r["beyond_edge"], tolerance, span_cells(surface.surface, r["uv"]))

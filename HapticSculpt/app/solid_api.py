@@ -240,6 +240,44 @@ def _boundary_plan(obj: Any, boundary: Any) -> tuple[dict[str, str], Any, list[i
     return kinds, made, held, links, walls
 
 
+def refined_net(obj: Any, surface: core.BSplineSurface, extra: tuple[Any, Any]) -> tuple[Any, list[int], list[Any], list[Any]]:
+    """The SculptedSolid's net ``surface`` with knots ``extra`` inserted (exactly: the shape is
+    kept) and what holds it there as its Boundary says: (the finer net, its held poles, its seams'
+    linked poles, its walls). ValueError where the holds would take every pole."""
+    from .source_surface import refined
+    shape = base_solid(obj.Base)
+    faces = list(obj.SculptFaces)
+    chain = chain_of_solid(obj, shape)
+    edges = chain.edges(shape)
+    kinds = boundary_of(obj)
+    made = SourceSurface(refined(surface, extra), "exact", 0.0, "")
+    made, held, links = _holds(made, chain, edges, kinds, mirror_of(obj), ", ".join(faces))
+    walls = face_walls(shape, faces, edges, kinds, made.surface.poles, held + [link[0] for link in links])
+    return made.surface, held, links, walls
+
+
+def record_refinement(obj: Any, before: core.BSplineSurface, after: core.BSplineSurface) -> None:
+    """The SculptedSolid's net went from ``before`` to the finer ``after`` (knots inserted): its
+    Resolution keeps the knots (so the net made again from the base, when the base changes, is
+    this one) and its SourcePoles the face refined alike (so the sculpt still reads as a
+    displacement from it). The caller holds the transaction."""
+    from collections import Counter
+
+    from .source_surface import refined
+    added = tuple(sorted((Counter(np.asarray(b, float).tolist()) - Counter(np.asarray(a, float).tolist())).elements())
+                  for a, b in ((before.knots_u, after.knots_u), (before.knots_v, after.knots_v)))
+    if not added[0] and not added[1]:
+        return
+    res = json.loads(obj.Resolution)
+    kept = res.get("fit_knots", [[], []])
+    res["fit_knots"] = [sorted(kept[0] + list(added[0])), sorted(kept[1] + list(added[1]))]
+    nu, nv = before.controls
+    source = core.BSplineSurface(np.asarray(obj.SourcePoles, float).reshape(nu, nv, 3), tuple(before.degree),
+                                 list(before.knots_u), list(before.knots_v), before.weights)
+    obj.Resolution = json.dumps(res)
+    obj.SourcePoles = np.asarray(refined(source, added).poles, float).ravel().tolist()
+
+
 def can_hold(obj: Any, boundary: Any) -> bool:
     """Whether :func:`set_boundary` can hold ``boundary`` on the SculptedSolid (nothing changes)."""
     try:

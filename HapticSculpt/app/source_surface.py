@@ -112,6 +112,19 @@ def insert_knots(bs: Any, extra: tuple[Any, Any]) -> None:
                 bs.insertVKnot(x, 1, 0.0)
 
 
+def refined(surface: core.BSplineSurface, extra: tuple[Any, Any]) -> core.BSplineSurface:
+    """``surface`` with knots ``extra`` inserted as :func:`insert_knots` does (exactly: the same
+    shape on a finer net; two surfaces on the same knots refined with the same ``extra`` end on
+    the same knots)."""
+    from .part_surface import part_bspline
+    nu, nv = surface.controls
+    weights = None if surface.weights is None else np.asarray(surface.weights, float).reshape(nu, nv)
+    bs = part_bspline(np.asarray(surface.poles, float).reshape(nu, nv, 3), np.asarray(surface.knots_u),
+                      np.asarray(surface.knots_v), tuple(surface.degree), weights)
+    insert_knots(bs, extra)
+    return to_core(bs)
+
+
 def to_core(bs: Any) -> core.BSplineSurface:
     nu, nv = bs.NbUPoles, bs.NbVPoles
     poles = np.array([[tuple(p) for p in row] for row in bs.getPoles()], dtype=float).reshape(nu, nv, 3)
