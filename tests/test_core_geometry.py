@@ -115,3 +115,25 @@ def test_views_share_memory_and_are_read_only():
     assert mesh[..., 2].max() > 0
     with pytest.raises(ValueError):
         poles[0, 0, 0] = 1.0
+
+
+def test_fit_poles_in_plane_weighs_moves_not_places():
+    """Points the surface passes through already: the fit leaves the poles where they are, and the
+    in-plane weight (which weighs a pole's move, not its place) changes nothing; a bad weight is
+    refused by name."""
+    rng = np.random.default_rng(3)
+    flat = core.BSplineSurface.plane((8, 7), (3, 3), (80.0, 60.0))
+    poles = flat.poles.copy()
+    poles[..., 2] = 5 * np.sin(poles[..., 0] / 20) * np.cos(poles[..., 1] / 25)
+    s = core.DynamicSurface(core.BSplineSurface(poles), (24, 24))
+    (u0, u1), (v0, v1) = s.surface.domain
+    uv = rng.uniform(0.02, 0.98, (4000, 2))
+    uv = np.c_[u0 + uv[:, 0] * (u1 - u0), v0 + uv[:, 1] * (v1 - v0)]
+    pts = np.array([s.surface.evaluate(u, v)["point"] for u, v in uv])
+    normals = np.array([s.surface.normal(u, v) for u, v in uv])
+    plain = s.fit_poles(pts, uv, normals, np.ones(len(pts)), 0.02, 0.0, 0.0)  # (smoothing weighs the shape)
+    held = s.fit_poles(pts, uv, normals, np.ones(len(pts)), 0.02, 0.0, 1.0)
+    np.testing.assert_allclose(plain.reshape(poles.shape), poles, atol=1e-3)
+    np.testing.assert_allclose(held.reshape(poles.shape), poles, atol=1e-3)  # (on places it pulled them mm)
+    with pytest.raises(ValueError, match="in_plane"):
+        s.fit_poles(pts, uv, normals, np.ones(len(pts)), 0.02, 0.0, -1.0)

@@ -219,6 +219,29 @@ class TestFitToTarget(DocumentTestCase):
         self.assertGreater(float(z.max()), 27.0)
         self.assertTrue(solid.Shape.isValid())
 
+    def test_a_net_that_folds_is_fitted_again_held_firmer_in_its_plane(self):
+        """Held flat edges and a held line against a bump: without the in-plane weight the poles
+        slide beside the line and cells of the net turn over; the fit tries again holding the slide
+        firmer and writes a net that does not fold."""
+        from HapticSculpt.app import scan_fit, sculpt_state
+        from HapticSculpt.app.scan_target import target_of
+        points, _ = scan_of(truth_surface(), seed=1)
+        sculpt = hs.make_sculpt(self.doc, controls=(10, 10), mesh=(64, 64), size=(SIZE, SIZE), edges="G1")
+        hs.add_curve_constraint(sculpt, [(-60.0 + 10 * k, -50.0, 0.0) for k in range(13)], "G0")
+        hs.set_target(sculpt, points)
+        work = sculpt_state.restore(sculpt.Proxy.live.stored())
+        normals = np.asarray(work.surface.grid(41, 41)[1])
+        scan_fit.fit_net(work, target_of(sculpt).points, 0.25, in_plane=0.0)
+        self.assertTrue(scan_fit.folded(normals, work.surface))
+        work = sculpt_state.restore(sculpt.Proxy.live.stored())
+        saved = scan_fit.IN_PLANE
+        scan_fit.IN_PLANE = 0.0
+        try:
+            scan_fit.fit_net_unfolded(work, target_of(sculpt).points, 0.25)
+        finally:
+            scan_fit.IN_PLANE = saved
+        self.assertFalse(scan_fit.folded(normals, work.surface))
+
     def test_bad_calls_are_refused_by_name(self):
         sculpt = hs.make_sculpt(self.doc, controls=(6, 6))
         with self.assertRaisesRegex(ValueError, "has no target"):
@@ -250,14 +273,12 @@ class TestFitAcrossSeams(SolidChecks):
         before = tuple(sculpt.Proxy.live.surface.surface.controls)
         rng = np.random.default_rng(5)
         xy = rng.uniform((1, 13), (99, 79), (40000, 2))
-        bump = 3 * np.exp(-((xy[:, 0] - 50) ** 2 + (xy[:, 1] - 40) ** 2) / 10)
+        bump = 3 * np.exp(-((xy[:, 0] - 50) ** 2 + (xy[:, 1] - 40) ** 2) / 25)
         hs.set_target(solid, np.c_[xy, 30 + bump + rng.normal(0, 0.004, len(xy))])
         report = hs.fit_to_target(solid, 0.02)
         controls = tuple(sculpt.Proxy.live.surface.surface.controls)
         self.assertGreater(controls[0] * controls[1], before[0] * before[1], report)
-        # (the net that would meet it folds beside the bump: the fit keeps the last one that does not)
-        self.assertTrue(report["met"] or "folds in its own plane" in report["message"], report)
-        self.assertGreater(report["within_pct"], 85.0)
+        self.assertTrue(report["met"], report)
         self.assertEqual(hs.boundary_of(solid)[seam], "G2")
         surface = sculpted_surface(sculpt)
         jumps, vs = seam_jumps(surface, seam_knot(surface))

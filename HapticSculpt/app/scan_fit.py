@@ -28,10 +28,8 @@ SETTLED = 0.005
 #: How much a point's slide along the surface weighs against its distance across it (1 would be
 #: plain least squares, whose feet creep: 3 % a round on a bump where this takes 2 or 3 rounds).
 TANGENTIAL = 0.02
-#: ... and on a net that folded at that, fitted again with the slide weighing these in turn (slower
-#: to settle, so not always). Its poles slid in the surface's own plane, where little holds them:
-#: a refined solid's top crossed itself beside a bump (0.1 still did, 0.3 not), a sheet with held
-#: edges and a held line crossed itself in 57 cells of 1600 beside the line (0.3: 4, 1: none).
+#: ... and on a net that folds even with IN_PLANE, fitted again with the slide weighing these in turn
+#: (slower to settle, so not always).
 TANGENTIAL_FIRM = (0.3, 1.0)
 #: Robust standard deviations beyond which a point is an outlier.
 OUTLIER_SPREAD = 4.0
@@ -47,6 +45,12 @@ POINTS_PER_POLE = 12
 WITHIN_GOAL = 95.0
 #: The curvature variation's weight, relative to the points'.
 SMOOTHING = 1e-5
+#: A pole's move in the surface's own plane (at its Greville point), weighed against a pole's
+#: share of the points' weight (see fit_poles). The points hold a pole mostly across the surface;
+#: without this its poles slid in the plane and nets folded: a sheet with held edges and a held
+#: line turned 56 of 1600 cells over beside the line (0.1: 36, 1: none), a solid's refined top
+#: crossed itself beside a bump. A free sheet fits as before (98.9 % within 0.25 mm either way).
+IN_PLANE = 1.0
 
 
 @dataclass
@@ -139,7 +143,7 @@ def fit_net_unfolded(surface: core.DynamicSurface, points: np.ndarray, tolerance
 
 
 def fit_net(surface: core.DynamicSurface, points: np.ndarray, tolerance: float, smoothing: float = SMOOTHING,
-            rounds: int = ROUNDS, tangential: float = TANGENTIAL) -> tuple[FitRound, dict[str, Any]]:
+            rounds: int = ROUNDS, tangential: float = TANGENTIAL, in_plane: float | None = None) -> tuple[FitRound, dict[str, Any]]:
     """Fits ``surface``'s poles to ``points`` on its net as it is (the surface is moved there).
     Returns the net's summary and the last projection (with the weights)."""
     nu, nv = surface.surface.controls
@@ -147,7 +151,8 @@ def fit_net(surface: core.DynamicSurface, points: np.ndarray, tolerance: float, 
     w = robust_weights(r["distance"], ~r["beyond_edge"], tolerance, span_cells(surface.surface, r["uv"]))
     mean = math.inf
     for _ in range(rounds):
-        fitted = surface.fit_poles(points, r["uv"], r["normal"], w, tangential, smoothing)
+        fitted = surface.fit_poles(points, r["uv"], r["normal"], w, tangential, smoothing,
+                                   IN_PLANE if in_plane is None else in_plane)
         surface.set_poles(fitted.reshape(nu, nv, 3))
         r = surface.surface.project(points, start=r["uv"])
         w = robust_weights(r["distance"], ~r["beyond_edge"], tolerance, span_cells(surface.surface, r["uv"]))

@@ -188,10 +188,11 @@ public:
     /// with the surface's `normals` there), weighted by `weights` (>= 0), the slide along the
     /// surface by `tangential` (1e-6..1; 1 is plain least squares), with the mesh's curvature
     /// variation at `smoothing` (0..1e6, relative to the points' weight) bridging where there are
-    /// no points; held and linked poles and the mirror symmetry hold exactly. Returns them; the
-    /// surface is unchanged. Allocates.
+    /// no points, each pole's move in the surface's own plane weighed by `inPlane` (0..1e6,
+    /// relative to a pole's share of the points' weight); held and linked poles and the mirror
+    /// symmetry hold exactly. Returns them; the surface is unchanged. Allocates.
     Points fitPoles(const Points& targets, const Eigen::MatrixX2d& uv, const Points& normals,
-                    const Eigen::VectorXd& weights, double tangential, double smoothing);
+                    const Eigen::VectorXd& weights, double tangential, double smoothing, double inPlane = 0.0);
 
     // --- measures -----------------------------------------------------------------------------
     double kineticEnergy();

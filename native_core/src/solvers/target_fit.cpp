@@ -7,7 +7,10 @@
 // along the surface by a (tangential < 1): the feet then follow the points in a few rounds where
 // plain least squares (a = 1) creeps (Wang, Pottmann and Liu's squared distance minimisation,
 // without its curvature term). tau = smoothing x trace(data) / (3 trace(A^T C^T C A)), A the
-// sampling of a grid at least 3 points per span.
+// sampling of a grid at least 3 points per span. With inPlane > 0, each pole's move within the
+// tangent plane at its Greville point is weighed too, by inPlane x trace(data) / (3 poles): the
+// points hold a pole mostly across the surface, and on a slope a move along it serves them as well
+// as one across, so poles slid far in the plane and a refined net folded (a cell turned over).
 // Solved for the increment in the free poles (P = T z, held_poles.hpp), T applied to each
 // coordinate: held poles stay, linked ones follow, the mirror symmetry is put back exactly. The
 // normal matrix is summed into a band of 3 x 3 blocks, (2p+1)(2q+1) per pole, so millions of
@@ -48,7 +51,7 @@ Eigen::SparseMatrix<double> coordinatewise(const HeldPoles& held, int poles) {
 }  // namespace
 
 Points DynamicSurface::fitPoles(const Points& targets, const Eigen::MatrixX2d& uv, const Points& normals,
-                                const Eigen::VectorXd& weights, double tangential, double smoothing) {
+                                const Eigen::VectorXd& weights, double tangential, double smoothing, double inPlane) {
     const Eigen::Index count = targets.rows();
     if (uv.rows() != count || normals.rows() != count || weights.size() != count)
         throw std::invalid_argument("targets: uv, normals and weights need one row per target point");
@@ -59,6 +62,7 @@ Points DynamicSurface::fitPoles(const Points& targets, const Eigen::MatrixX2d& u
         throw std::invalid_argument("weights: must be finite and >= 0");
     requireInRange(tangential, "tangential", 1e-6, 1.0);
     requireInRange(smoothing, "smoothing", 0.0, 1e6);
+    requireInRange(inPlane, "in_plane", 0.0, 1e6);
     const BSplineSurface& S = surface();
     const int nv = S.nv(), poles = S.nu() * nv, p = S.knotsU().degree(), q = S.knotsV().degree();
     const int bw = 2 * p + 1, bh = 2 * q + 1;
@@ -118,12 +122,31 @@ Points DynamicSurface::fitPoles(const Points& targets, const Eigen::MatrixX2d& u
         for (Eigen::SparseMatrix<double>::InnerIterator it(F, k); it; ++it)
             for (int c = 0; c < 3; ++c) entries.emplace_back(3 * it.row() + c, 3 * it.col() + c, tau * it.value());
     for (int i = 0; i < 3 * poles; ++i) entries.emplace_back(i, i, 1e-8 * trace / (3 * poles));
+    const Points& P = state_.poles();
+    Points inPlaneBack = Points::Zero(poles, 3);  // (the in-plane term weighs the move, not the place)
+    if (inPlane > 0) {
+        const double k = inPlane * trace / (3 * poles);
+        const std::vector<double>& tu = S.knotsU().knots();
+        const std::vector<double>& tv = S.knotsV().knots();
+        for (int i = 0; i < poles; ++i) {
+            const int a = i / nv, b = i % nv;
+            double greU = 0, greV = 0;
+            for (int j = 1; j <= p; ++j) greU += tu[a + j] / p;
+            for (int j = 1; j <= q; ++j) greV += tv[b + j] / q;
+            const Vec3 n = S.normal(greU, greV);
+            if (!n.allFinite() || n.squaredNorm() < 0.5) continue;  // (a degenerate corner: no plane)
+            const Block K = k * (Block::Identity() - n * n.transpose());
+            for (int r = 0; r < 3; ++r)
+                for (int c = 0; c < 3; ++c) entries.emplace_back(3 * i + r, 3 * i + c, K(r, c));
+            inPlaneBack.row(i) = (K * P.row(i).transpose()).transpose();
+        }
+    }
     Eigen::SparseMatrix<double> sys(3 * poles, 3 * poles);
     sys.setFromTriplets(entries.begin(), entries.end());
 
-    const Points& P = state_.poles();
     const Eigen::Map<const Eigen::VectorXd> flat(P.data(), 3 * poles);  // (x, y, z) per pole, row-major
     rhs -= sys * flat;  // for the increment
+    rhs += Eigen::Map<const Eigen::VectorXd>(inPlaneBack.data(), 3 * poles);
     const Eigen::SparseMatrix<double> T = coordinatewise(held_, poles);
     Points fitted = P;
     if (T.cols() > 0) {
