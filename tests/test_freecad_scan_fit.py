@@ -220,9 +220,9 @@ class TestFitToTarget(DocumentTestCase):
         self.assertTrue(solid.Shape.isValid())
 
     def test_a_net_that_folds_is_fitted_again_held_firmer_in_its_plane(self):
-        """Held flat edges and a held line against a bump: without the in-plane weight the poles
-        slide beside the line and cells of the net turn over; the fit tries again holding the slide
-        firmer and writes a net that does not fold."""
+        """Held flat edges and a held line against a bump: the poles slide in the plane beside the
+        line and cells of the net turn over; the fit tries again weighing each pole's move in the
+        plane, and what it writes does not fold."""
         from HapticSculpt.app import scan_fit, sculpt_state
         from HapticSculpt.app.scan_target import target_of
         points, _ = scan_of(truth_surface(), seed=1)
@@ -231,16 +231,15 @@ class TestFitToTarget(DocumentTestCase):
         hs.set_target(sculpt, points)
         work = sculpt_state.restore(sculpt.Proxy.live.stored())
         normals = np.asarray(work.surface.grid(41, 41)[1])
-        scan_fit.fit_net(work, target_of(sculpt).points, 0.25, in_plane=0.0)
+        scan_fit.fit_net(work, target_of(sculpt).points, 0.25)
         self.assertTrue(scan_fit.folded(normals, work.surface))
         work = sculpt_state.restore(sculpt.Proxy.live.stored())
-        saved = scan_fit.IN_PLANE
-        scan_fit.IN_PLANE = 0.0
-        try:
-            scan_fit.fit_net_unfolded(work, target_of(sculpt).points, 0.25)
-        finally:
-            scan_fit.IN_PLANE = saved
+        scan_fit.fit_net_unfolded(work, target_of(sculpt).points, 0.25)
         self.assertFalse(scan_fit.folded(normals, work.surface))
+        report = hs.fit_to_target(sculpt, 0.25, max_controls=16)
+        nu, nv = report["controls"]
+        written = sculpt.Proxy.live.surface.surface  # (the patch was flat: the normal was +z everywhere)
+        self.assertFalse(scan_fit.folded(np.broadcast_to([0.0, 0.0, 1.0], (4 * nu + 1, 4 * nv + 1, 3)), written))
 
     def test_bad_calls_are_refused_by_name(self):
         sculpt = hs.make_sculpt(self.doc, controls=(6, 6))
