@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 
 import pytest
+from freecad_support import GUI_AVAILABLE, run_freecad_gui
 from test_gui_focus_keys import tree_shown_desktop
 from test_gui_real_input import NEEDS, Desktop, sculpt, undo
 
@@ -56,3 +57,56 @@ def test_deleting_the_sculpt_mid_session_stops_it_cleanly_and_undo_brings_it_bac
         assert tracebacks(d) == []
     finally:
         d.close()
+
+
+DELETE_SOLID_SCRIPT = """
+import json, os, time, traceback
+import FreeCAD, FreeCADGui as Gui
+out = {}
+def pump(seconds):
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        Gui.updateGui()
+        time.sleep(0.02)
+try:
+    Gui.activateWorkbench("HapticSculptWorkbench")
+    import HapticSculpt as hs
+    from HapticSculpt.gui.workbench import controller
+    doc = FreeCAD.newDocument("DeleteSolid")
+    box = doc.addObject("Part::Box", "Box")
+    doc.recompute()
+    top = next(i for i, f in enumerate(box.Shape.Faces) if abs(f.CenterOfMass.z - 10) < 1e-9)
+    solid = hs.sculpt_solid(doc, box, ["Face%d" % (top + 1)])
+    doc.recompute()
+    Gui.Selection.addSelection(solid)
+    Gui.runCommand("HapticSculpt_Session")
+    pump(1.0)
+    out["session"] = controller().session is not None
+    out["before"] = sorted(o.Name for o in doc.Objects)
+    Gui.Selection.clearSelection()
+    Gui.Selection.addSelection(solid)
+    Gui.runCommand("Std_Delete")
+    pump(1.0)
+    out["after"] = sorted(o.Name for o in doc.Objects)
+    out["session_after"] = controller().session is not None
+    out["box_shown"] = bool(box.ViewObject.Visibility)
+    doc.undo()
+    pump(0.5)
+    out["undone"] = sorted(o.Name for o in doc.Objects)
+    out["undone_valid"] = doc.getObject(solid.Name).Shape.isValid()
+except Exception:
+    out["error"] = traceback.format_exc()
+json.dump(out, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+def test_deleting_a_sculpted_solid_mid_session_deletes_its_face_sculpt_and_stops_the_session(tmp_path):
+    """The hidden sculpt of a deleted SculptedSolid went on being sculpted (the HUD said so, drags
+    echoed strokes on it): it goes with the solid, in the same undo step."""
+    out = run_freecad_gui(DELETE_SOLID_SCRIPT, str(tmp_path))
+    assert out["session"]
+    assert out["before"] == ["Box", "SculptedSolid", "SculptedSolidFace"]
+    assert out["after"] == ["Box"] and out["box_shown"] and not out["session_after"]
+    assert out["undone"] == out["before"] and out["undone_valid"]

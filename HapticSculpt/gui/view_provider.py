@@ -85,9 +85,16 @@ class SolidViewProvider(_Stateless):
         return [o for o in [getattr(obj, "Base", None), *getattr(obj, "Sculpts", [])] if o is not None]
 
     def onDelete(self, vobj: Any, subelements: Any) -> bool:
-        base = getattr(vobj.Object, "Base", None)
+        """Deleting it shows its base again and deletes its sculpts with it (in the same undo step):
+        a face of a solid that is gone is nothing to sculpt, and a session on it went on, hidden."""
+        obj = vobj.Object
+        base = getattr(obj, "Base", None)
         if base is not None and base.ViewObject is not None:
             base.ViewObject.Visibility = True
+        for sculpt in list(getattr(obj, "Sculpts", [])):
+            if sculpt is not None and obj.Document.getObject(sculpt.Name) is sculpt and \
+                    not [o for o in sculpt.InList if o is not obj]:
+                obj.Document.removeObject(sculpt.Name)
         return True
 
 
