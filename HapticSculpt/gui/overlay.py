@@ -429,10 +429,10 @@ class Overlay:
 
     def _scan_points(self, s: core.DynamicSurface, rng: tuple[float, float]) -> Any:
         """The scan's points (up to SCAN_POINTS_SHOWN) coloured by their signed deviation from the
-        surface on the surface's scale; measured again when the poles moved, at most every
-        SCAN_REMEASURE_S during a session."""
+        surface on the surface's scale; measured again when the poles moved or the tolerance changed,
+        at most every SCAN_REMEASURE_S during a session."""
         from ..app.scan_deviation import signed_distances, thinned
-        key = np.asarray(s.poles).tobytes()
+        key = (np.asarray(s.poles).tobytes(), self.tolerance())  # (a new tolerance colours them anew)
         now = time.monotonic()
         if self._scan is not None and (self._scan[0] == key or now - self._scan[1] < SCAN_REMEASURE_S):
             return self._scan[2]
