@@ -10,6 +10,12 @@ import FreeCADGui as Gui
 from .. import core
 from .view_provider import icon
 
+#: What a greyed-out command waits for, said at the end of its tool tip (shown on the greyed button too).
+NEEDS_SCULPT = "Needs a sculpt: select one (or have only one in the document), or make one with New patch or Sculpt face."
+NEEDS_TARGET = "Needs a sculpt with a scan target: select a mesh or point cloud and the sculpt, then Set scan target."
+NEEDS_CURSOR = "Needs a sculpt and the mouse over it (or a session's cursor)."
+
+
 #: The drop-down command groups (FreeCAD group commands, as Draft's and PartDesign's): name ->
 #: (menu text, tool tip, the commands, the one the button runs until another entry is picked).
 GROUPS = {
@@ -18,18 +24,19 @@ GROUPS = {
     "HapticSculpt_OutputGroup": ("Output", "Export STEP, or thicken the selected sculpt into a solid",
                                  ["HapticSculpt_ExportStep", "HapticSculpt_Thicken"], 0),
     "HapticSculpt_ToolGroup": ("Tools", f"Choose the sculpting tool: {', '.join(core.TOOLS)}; and the falloff of "
-                               "those that have one",
+                               f"those that have one. {NEEDS_SCULPT}",
                                [*(f"HapticSculpt_Tool{core.TOOL_INFO[t]['title']}" for t in core.TOOLS),
                                 "HapticSculpt_Falloff"], 0),
     "HapticSculpt_MaterialGroup": ("Material", "The material: elastic or clay, keep the shape, fair it, airbrush "
-                                   "the mass, damping, stiffness, bending or pull map, the slider panel",
+                                   f"the mass, damping, stiffness, bending or pull map, the slider panel. {NEEDS_SCULPT}",
                                    ["HapticSculpt_Material", "HapticSculpt_KeepShape", "HapticSculpt_Fair",
                                     "HapticSculpt_PaintMass", "HapticSculpt_PaintDamping",
                                     "HapticSculpt_PaintStiffness", "HapticSculpt_PaintBending", "HapticSculpt_PaintPull",
                                     "HapticSculpt_Panel"],
                                    0),
     "HapticSculpt_ConstraintGroup": ("Constraints and edges", "Hold the edges (free / G0 to G3), follow a curve "
-                                     "(G0 / G1), or toggle a point, normal or curvature constraint at the cursor",
+                                     "(G0 / G1), or toggle a point, normal or curvature constraint at the cursor. "
+                                     f"{NEEDS_SCULPT}",
                                      ["HapticSculpt_HoldEdges", "HapticSculpt_FollowCurve", "HapticSculpt_PointConstraint",
                                       "HapticSculpt_NormalConstraint", "HapticSculpt_CurvatureConstraint"], 0),
     "HapticSculpt_DisplayGroup": ("Displays", "Analysis displays: material map, curvature, combs, zebra stripes "
@@ -248,12 +255,6 @@ def _ctl() -> Any:
 
 def _has_sculpt() -> bool:
     return _ctl().active_sculpt() is not None
-
-
-#: What a greyed-out command waits for, said at the end of its tool tip (shown on the greyed button too).
-NEEDS_SCULPT = "Needs a sculpt: select one (or have only one in the document), or make one with New patch or Sculpt face."
-NEEDS_TARGET = "Needs a sculpt with a scan target: select a mesh or point cloud and the sculpt, then Set scan target."
-NEEDS_CURSOR = "Needs a sculpt and the mouse over it (or a session's cursor)."
 
 
 class _SculptCommand:
