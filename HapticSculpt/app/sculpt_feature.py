@@ -73,7 +73,8 @@ class SculptFeature:
                 live.document_changed()
         elif live is not None and prop == "Target":
             live.target_changed()
-        elif prop == "TargetTolerance" and not getattr(self, "setting_target", False) and not obj.Document.Restoring:
+        elif prop == "TargetTolerance" and not getattr(self, "setting_target", False) and not obj.Document.Restoring \
+                and not getattr(obj.Document, "Transacting", False):  # (Undo and Redo restore the report themselves)
             from .scan_deviation import refresh_property
             refresh_property(obj)
 
