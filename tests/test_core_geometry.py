@@ -137,3 +137,29 @@ def test_fit_poles_in_plane_weighs_moves_not_places():
     np.testing.assert_allclose(held.reshape(poles.shape), poles, atol=1e-3)  # (on places it pulled them mm)
     with pytest.raises(ValueError, match="in_plane"):
         s.fit_poles(pts, uv, normals, np.ones(len(pts)), 0.02, 0.0, -1.0)
+
+
+def _fit_beyond(points: np.ndarray, beyond: float) -> np.ndarray:
+    """Poles of a flat 100 mm 8 x 8 sheet fitted to ``points`` in one solve, with ``beyond``."""
+    s = core.DynamicSurface(core.BSplineSurface.plane((8, 8), (3, 3), (100.0, 100.0)), (32, 32))
+    r = s.surface.project(points)
+    return s.fit_poles(points, r["uv"], r["normal"], np.ones(len(points)), 0.02, 1e-5, 0.0, beyond).reshape(8, 8, 3)
+
+
+def test_fit_poles_beyond_levels_the_change_past_the_scan_and_nowhere_else():
+    """A scan of a 2.3 mm bump over the central 60 mm of a 100 mm sheet: the curvature variation alone
+    carries the bump's curvature out to the corners; weighed beyond the points, the change levels off
+    there. A scan over the whole sheet with a hole inside gets the same fit with it as without."""
+    rng = np.random.default_rng(5)
+    xy = rng.uniform(-30, 30, (20000, 2))
+    bump = np.c_[xy, 2 * np.exp(-(xy ** 2).sum(1) / 300) + 0.3]
+    loose, level = _fit_beyond(bump, 0.0), _fit_beyond(bump, 1e-2)
+    corners = [(0, 0), (0, 7), (7, 0), (7, 7)]
+    assert max(loose[c][2] for c in corners) > 2.0
+    assert max(abs(level[c][2]) for c in corners) < 0.8
+    xy = rng.uniform(-50, 50, (20000, 2))
+    xy = xy[np.hypot(xy[:, 0] - 10, xy[:, 1] + 5) > 15]
+    holed = np.c_[xy, 2 * np.exp(-(xy ** 2).sum(1) / 300)]
+    np.testing.assert_array_equal(_fit_beyond(holed, 0.0), _fit_beyond(holed, 1e-2))
+    with pytest.raises(ValueError, match="beyond"):
+        _fit_beyond(bump, -1.0)

@@ -120,6 +120,21 @@ class TestFitToTarget(DocumentTestCase):
         self.assertIn("max_controls", report["message"])
         self.assertIn("worst near (u, v)", report["message"])
 
+    def test_a_patch_wider_than_its_scan_keeps_its_shape_past_the_scan(self):
+        rng = np.random.default_rng(1)
+        xy = rng.uniform(-30, 30, (20000, 2))
+        points = np.c_[xy, 2 * np.exp(-(xy ** 2).sum(1) / 300) + 0.3 + rng.normal(0, 0.05, len(xy))]
+        sculpt = hs.make_sculpt(self.doc, controls=(8, 8), size=(100, 100))
+        hs.set_target(sculpt, points)
+        report = hs.fit_to_target(sculpt, 0.1)
+        self.assertTrue(report["met"], report)
+        face = sculpt.Shape.Faces[0].Surface
+        edges = np.array([tuple(face.value(a, b)) for t in np.linspace(0, 1, 41) for a, b in
+                          ((t, 0.0), (t, 1.0), (0.0, t), (1.0, t))])
+        side = np.max(np.abs(edges[:, :2]), axis=1)  # (each edge point's distance out along x or y)
+        np.testing.assert_allclose(side, 50.0, atol=0.6)  # (the curvature alone moved it 4 mm)
+        self.assertLess(np.abs(edges[:, 2]).max(), 1.5)  # (and lifted the corners 6 to 10 mm; the scan tops 2.3)
+
     def test_a_sculpted_solid_stays_valid_and_a_symmetric_one_symmetric(self):
         box = self.doc.addObject("Part::Box", "Box")
         box.Length, box.Width, box.Height = 60, 40, 20

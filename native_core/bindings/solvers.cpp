@@ -205,7 +205,8 @@ void bindSolvers(py::module_& m) {
             s.setBendingReference(pointsFrom(r, static_cast<Eigen::Index>(s.g()) * s.h(), "reference"));
         }, py::arg("reference"), "Replace the bending energy's reference shape ((g, h, 3) or (g*h, 3)).")
         .def("fit_poles", [](DynamicSurface& s, DoubleArray targets, const Eigen::MatrixX2d& uv, DoubleArray normals,
-                             const Eigen::VectorXd& weights, double tangential, double smoothing, double inPlane) {
+                             const Eigen::VectorXd& weights, double tangential, double smoothing, double inPlane,
+                             double beyond) {
             if (targets.ndim() != 2 || targets.shape(1) != 3) throw std::invalid_argument("targets: expected an (n, 3) array");
             const auto n = static_cast<Eigen::Index>(targets.shape(0));
             const Points t = pointsFrom(targets, n, "targets");
@@ -216,17 +217,18 @@ void bindSolvers(py::module_& m) {
             Points fitted;
             {
                 py::gil_scoped_release release;
-                fitted = s.fitPoles(t, uv, nn, weights, tangential, smoothing, inPlane);
+                fitted = s.fitPoles(t, uv, nn, weights, tangential, smoothing, inPlane, beyond);
             }
             Eigen::MatrixXd out = fitted;
             return out;
         }, py::arg("targets"), py::arg("uv"), py::arg("normals"), py::arg("weights"), py::arg("tangential") = 0.1,
-           py::arg("smoothing") = 1e-5, py::arg("in_plane") = 0.0,
+           py::arg("smoothing") = 1e-5, py::arg("in_plane") = 0.0, py::arg("beyond") = 0.0,
            "The poles ((nu * nv, 3)) that bring the surface nearest targets ((n, 3)) at parameters uv ((n, 2)) with "
            "the surface's normals there ((n, 3)), weighted (n,), the slide along the surface weighed by tangential "
            "(1 = plain least squares), with the mesh's curvature variation at smoothing (relative) bridging where "
-           "there are no points and each pole's move in the surface's own plane weighed by in_plane (relative); held "
-           "and linked poles and the symmetry hold. The surface is not changed.")
+           "there are no points, each pole's move in the surface's own plane weighed by in_plane (relative) and the "
+           "change's slope by beyond (relative) past the points' reach; held and linked poles and the symmetry hold. "
+           "The surface is not changed.")
         .def("fair", [](DynamicSurface& s, const Eigen::VectorXd& weights, double strength) { s.fair(weights, strength); },
              py::arg("weights"), py::arg("strength") = 10.0,
              "Relax the curvature variation where weights (one per mesh point, row a*h + b, in [0, 1]) ask, "

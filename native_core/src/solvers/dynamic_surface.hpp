@@ -189,10 +189,12 @@ public:
     /// surface by `tangential` (1e-6..1; 1 is plain least squares), with the mesh's curvature
     /// variation at `smoothing` (0..1e6, relative to the points' weight) bridging where there are
     /// no points, each pole's move in the surface's own plane weighed by `inPlane` (0..1e6,
-    /// relative to a pole's share of the points' weight); held and linked poles and the mirror
-    /// symmetry hold exactly. Returns them; the surface is unchanged. Allocates.
+    /// relative to a pole's share of the points' weight), and the change's slope weighed by `beyond`
+    /// (0..1e6, relative to the points' weight) where the points do not reach; held and linked poles
+    /// and the mirror symmetry hold exactly. Returns them; the surface is unchanged. Allocates.
     Points fitPoles(const Points& targets, const Eigen::MatrixX2d& uv, const Points& normals,
-                    const Eigen::VectorXd& weights, double tangential, double smoothing, double inPlane = 0.0);
+                    const Eigen::VectorXd& weights, double tangential, double smoothing, double inPlane = 0.0,
+                    double beyond = 0.0);
 
     // --- measures -----------------------------------------------------------------------------
     double kineticEnergy();
