@@ -132,3 +132,57 @@ def test_a_scan_set_as_target_shows_its_deviation_and_a_stroke_reduces_it(tmp_pa
         d.shot_changed("scan_off", fitted_picture, "the display off")
     finally:
         d.close()
+
+
+TWO = """
+import json, os
+import numpy as np
+import FreeCAD, FreeCADGui, Mesh
+import HapticSculpt as hs
+doc = FreeCAD.newDocument("Two")
+shown = hs.make_sculpt(doc, material="clay", edges="held")
+hs.make_sculpt(doc, material="clay", edges="held", centre=(130.0, 0.0, 0.0))
+xs = np.linspace(-45, 45, 30)
+X, Y = np.meshgrid(xs, xs, indexing="ij")
+points = np.stack([X, Y, 6.0 * np.exp(-(X ** 2 + Y ** 2) / 250.0)], -1).reshape(-1, 3)
+hs.set_target(shown, points)
+doc.recompute()
+doc.saveAs(PATH)
+json.dump({}, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_a_session_beside_a_deviation_display_shows_one_hud(tmp_path):
+    """One patch shows its deviation (legend, status line); a session on the other takes the view's
+    HUD while it runs (both printed in one place), and gives it back when it stops."""
+    os.makedirs(SHOTS, exist_ok=True)
+    path = str(tmp_path / "two.FCStd")
+    run_freecad_gui(f"PATH = {path!r}\n" + TWO, str(tmp_path))
+    d = Desktop(str(tmp_path), "CAD", open_file=path)
+    try:
+        s = view_part(d, "Sculpt")
+        of = lambda s, name: next(x for x in s["docs"][s["active"]]["sculpts"] if x["name"] == name)  # noqa: E731
+        hud = lambda s, name: next((o["hud"] for o in s["overlays"] if o["object"] == name), {})  # noqa: E731
+        c, east, _, north, _ = (np.array(p, float) for p in of(s, "Sculpt")["screen"])
+        shown = d.to_screen(list(c + (east - c) * -48 / 25 + (north - c) * -48 / 25))  # (past the scan's points)
+        other = d.to_screen(of(s, "Sculpt001")["screen"][0])
+        d.xdo("mousemove", str(shown[0]), str(shown[1]), "click", "1")
+        d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sculpt"], "the shown patch selected")
+        before = d.shot("two_huds_before")
+        s = d.press_button("ShowDeviation", lambda s: "legend_band" in hud(s, "Sculpt"), "the deviation and its legend")
+        d.shot_changed("two_huds_deviation", before, "the deviation shown")
+        d.xdo("mousemove", str(other[0]), str(other[1]), "click", "1")
+        d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sculpt001"], "the other patch selected")
+        s = d.press_button("Session", lambda s: of(s, "Sculpt001")["session"] and "status" in hud(s, "Sculpt001")
+                           and not hud(s, "Sculpt"), "the session's HUD alone")
+        during = d.shot("two_huds_session")
+        d.click_button("Session")
+        s = d.wait(lambda s: not of(s, "Sculpt001")["session"] and "legend_band" in hud(s, "Sculpt")
+                   and not hud(s, "Sculpt001"), "the deviation's HUD back")
+        frames = next(o["frames"] for o in s["overlays"] if o["object"] == "Sculpt")
+        d.wait(lambda s: next(o["frames"] for o in s["overlays"] if o["object"] == "Sculpt") > frames + 10, "frames")
+        d.shot_changed("two_huds_after", during, "the deviation's legend drawn again")
+    finally:
+        d.close()

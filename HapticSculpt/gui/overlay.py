@@ -77,6 +77,7 @@ class Overlay:
         self._trims: dict[tuple[int, int], list[int] | None] = {}  # grid size -> cells on the trimmed face
         self._curve_rows: tuple[str, list[tuple[str, Any]]] = ("", [])  # CurveConstraints text -> (kind, rows)
         self.hud: Hud | None = None  # the screen-space layer, made when the overlay first draws
+        self.speaks: Any = lambda overlay: True  # whether its HUD is the view's one (set by the Controller)
         self._root = coin.SoSeparator()
         self._root.setName("HapticSculptOverlay")
         self._timer: Any = None
@@ -251,7 +252,7 @@ class Overlay:
         self._root.addChild(scene)
         if self.hud is None:
             self.hud = Hud(self.view)
-        if not self.needed:  # the jacks alone: nothing for the HUD to say
+        if not self.needed or not self.speaks(self):  # the jacks alone, or another sculpt's HUD is shown here
             self.hud.clear()
             self.frames += 1
             return

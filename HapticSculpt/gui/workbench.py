@@ -218,7 +218,24 @@ class Controller:
         if key not in self.overlays:
             self.overlays[key] = Overlay(view, obj)
             self.overlays[key].mode = f"airbrush: {self.painting}" if self.painting else ""
+            self.overlays[key].speaks = self.speaks
         return self.overlays[key]
+
+    def speaks(self, overlay: Overlay) -> bool:
+        """Whether ``overlay``'s HUD is the one its view shows: of the overlays drawing there, the
+        session's, else the active sculpt's, else the first. (Each drew its status line and legend in
+        the same place: a deviation display beside a session on a solid printed over each other.)"""
+        drawing = [ov for (v, _), ov in self.overlays.items() if v == id(overlay.view) and ov.alive() and ov.needed]
+        if len(drawing) < 2:
+            return True
+        for ov in drawing:
+            if ov.obj.Proxy.live.session is not None and ov.live:
+                return ov is overlay
+        active = self.active_sculpt()
+        for ov in drawing:
+            if active is not None and ov.obj == active:
+                return ov is overlay
+        return drawing[0] is overlay
 
     def overlays_of(self, obj: Any) -> list[Overlay]:
         name = obj.Document.Name + "/" + obj.Name
