@@ -3,7 +3,7 @@ and a scanned bump imported as a mesh (FreeCAD's Mesh importer, as File > Import
 and the patch picked (click, ctrl+click), "Set scan target" from the Scan drop-down: the deviation
 shows in colour on the patch and on the scan's points (the grey mesh hidden), with its legend;
 a mouse stroke in a session (the scan's pull on) pulls the patch toward the scan and the deviation
-report falls; "Pull toward scan" switches the pull off and on, one undo step each; "Fit to scan" brings 95 % of the scan within the tolerance; the display off again shows the mesh. Screenshots build/screenshots/real_scan_*.png."""
+report falls; "Pull toward scan" switches the pull off and on, one undo step each, the HUD saying which; "Fit to scan" brings 95 % of the scan within the tolerance; the display off again shows the mesh. Screenshots build/screenshots/real_scan_*.png."""
 from __future__ import annotations
 
 import os
@@ -117,10 +117,13 @@ def test_a_scan_set_as_target_shows_its_deviation_and_a_stroke_reduces_it(tmp_pa
         # (the legend spans the deviation there is, so the colours are not comparable one for one)
         assert np.mean(np.any(np.abs(pulled - picture) > 0.1, axis=2)) > 0.02, "the colours did not follow the stroke"
         # the pull off and on again: one undo step each, from the Displays drop-down
+        assert "pull toward the scan: on" in overlay(s)["status_text"], overlay(s)["status_text"]
         s = d.press_button("PullToTarget", lambda s: sculpt(s)["pull"][0] is False, "the pull off")
         assert undo(s)[0] == "Stop pulling toward target", undo(s)
+        d.wait(lambda s: "pull toward the scan: off" in overlay(s)["status_text"], "the HUD saying the pull is off")
         s = d.press_button("PullToTarget", lambda s: sculpt(s)["pull"][0] is True, "the pull on")
         assert undo(s)[0] == "Pull toward target", undo(s)
+        d.wait(lambda s: "pull toward the scan: on" in overlay(s)["status_text"], "the HUD saying the pull is on")
         # Fit to scan: within the tolerance (0.1 mm) at 95 % of the scan's points at least
         s = d.press_button("FitToTarget", lambda s: undo(s)[0] == "Fit to target", "the fit")
         fitted = sculpt(s)["deviation"]

@@ -384,6 +384,10 @@ class Overlay:
             # (in a session the surface moves between commits: the line the points shown give)
             parts.append(self._live_deviation if session is not None and self._live_deviation else
                          self._deviation_text())
+        pull = s.pull
+        if pull["target"] and (session is not None or self.display == "deviation"):
+            # (on by default: a session drew a bump sculpted before toward the scan, unannounced)
+            parts.append(f"pull toward the scan: {'on' if pull['enabled'] else 'off'}")
         if self.combs:
             parts.append(f"combs: every {self.comb_every}, x{self.comb_gain:g}")
         if self.continuity:

@@ -503,6 +503,11 @@ class Controller:
         session.set_airbrush(self.painting, factor=airbrush_factor(self.painting))  # before the first tick can grab
         self.session = session.start(obj, device, tool=obj.Proxy.live.snapshot().tool.name, haptic_rate=rate)
         self._follow(self.view())
+        pull = obj.Proxy.live.snapshot().pull
+        if pull["target"] and pull["enabled"]:
+            import FreeCAD  # (it moves the surface from the first step, a stroke or none)
+            FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label} is pulled toward its scan while the session "
+                                         "runs (Displays > Pull toward scan switches it off)\n")
         return self.session
 
     @staticmethod
