@@ -110,3 +110,55 @@ def test_deleting_a_sculpted_solid_mid_session_deletes_its_face_sculpt_and_stops
     assert out["before"] == ["Box", "SculptedSolid", "SculptedSolidFace"]
     assert out["after"] == ["Box"] and out["box_shown"] and not out["session_after"]
     assert out["undone"] == out["before"] and out["undone_valid"]
+
+
+SCAN_SHOWN_SCRIPT = """
+import json, os, time, traceback
+import numpy as np
+import FreeCAD, FreeCADGui as Gui, Mesh
+out = {}
+def pump(seconds):
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        Gui.updateGui()
+        time.sleep(0.02)
+try:
+    Gui.activateWorkbench("HapticSculptWorkbench")
+    import HapticSculpt as hs
+    from HapticSculpt.gui.workbench import controller
+    doc = FreeCAD.newDocument("ScanShown")
+    sculpt = hs.make_sculpt(doc)
+    scan = doc.addObject("Mesh::Feature", "Scan")
+    scan.Mesh = Mesh.Mesh([[(-40, -40, 2), (40, -40, 2), (40, 40, 3)], [(-40, -40, 2), (40, 40, 3), (-40, 40, 2)]])
+    hs.set_target(sculpt, scan)
+    doc.recompute()
+    Gui.Selection.addSelection(sculpt)
+    controller().set_display("deviation")
+    pump(0.5)
+    out["hidden"] = not scan.ViewObject.Visibility
+    doc.undo()  # (Set target undone: the display has no target, the mesh shows)
+    pump(0.5)
+    out["undone_shown"] = bool(scan.ViewObject.Visibility)
+    doc.redo()
+    pump(0.5)
+    out["redone_hidden"] = not scan.ViewObject.Visibility
+    Gui.Selection.clearSelection()
+    Gui.Selection.addSelection(sculpt)
+    Gui.runCommand("Std_Delete")
+    pump(0.5)
+    out["deleted"] = doc.getObject("Sculpt") is None
+    out["deleted_shown"] = bool(scan.ViewObject.Visibility)
+except Exception:
+    out["error"] = traceback.format_exc()
+json.dump(out, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+def test_the_scan_the_deviation_display_hid_shows_again_when_its_sculpt_or_target_goes(tmp_path):
+    """The deviation display hides the target's mesh (it draws the points in colour); deleting the
+    sculpt, or undoing Set target, left the scan hidden with nothing drawn in its place."""
+    out = run_freecad_gui(SCAN_SHOWN_SCRIPT, str(tmp_path))
+    assert out["hidden"] and out["undone_shown"] and out["redone_hidden"], out
+    assert out["deleted"] and out["deleted_shown"], out

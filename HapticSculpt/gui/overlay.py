@@ -78,6 +78,7 @@ class Overlay:
         self._curve_rows: tuple[str, list[tuple[str, Any]]] = ("", [])  # CurveConstraints text -> (kind, rows)
         self.hud: Hud | None = None  # the screen-space layer, made when the overlay first draws
         self.speaks: Any = lambda overlay: True  # whether its HUD is the view's one (set by the Controller)
+        self.hidden_scan: Any = None  # the target's mesh the deviation display hid (it draws the points)
         self._root = coin.SoSeparator()
         self._root.setName("HapticSculptOverlay")
         self._timer: Any = None
@@ -142,11 +143,37 @@ class Overlay:
         """False once its view is closed or its object deleted."""
         try:
             self.view.getSize()
+        except Exception:  # noqa: BLE001 - a closed view raises on any access
+            return False
+        return self._object_alive()
+
+    def _object_alive(self) -> bool:
+        try:
             return self.obj.Document.getObject(self.obj.Name) is self.obj
-        except Exception:  # noqa: BLE001 - a closed view or a deleted object raises on any access
+        except Exception:  # noqa: BLE001 - a deleted object raises on any access
             return False
 
+    def hide_scan(self) -> None:
+        """Hides the sculpt's target (the deviation display draws its points in colour: the plain
+        mesh would hide them)."""
+        scan = getattr(self.obj, "Target", None)
+        vobj = getattr(scan, "ViewObject", None)
+        if vobj is not None:
+            vobj.Visibility = False
+            self.hidden_scan = scan
+
+    def show_scan(self) -> None:
+        """Shows again the mesh hide_scan hid, if it is still there."""
+        scan, self.hidden_scan = self.hidden_scan, None
+        try:
+            if scan is not None and scan.Document.getObject(scan.Name) == scan:
+                scan.ViewObject.Visibility = True
+        except Exception:  # noqa: BLE001 - deleted, or its document closed: nothing to show
+            pass
+
     def remove(self) -> None:
+        if self.hidden_scan is not None and not self._object_alive():
+            self.show_scan()  # (its sculpt deleted: the scan stayed hidden, no display to show it)
         self.stop()
         if self.hud is not None:
             self.hud.remove()
@@ -192,6 +219,10 @@ class Overlay:
         """Rebuilds the whole overlay from the current state."""
         from pivy import coin
         t0 = time.perf_counter()
+        if self.hidden_scan is not None and (self.display != "deviation" or getattr(self.obj, "Target", None) != self.hidden_scan):
+            self.show_scan()  # (the target cleared or changed, its Set target undone)
+        if self.display == "deviation" and self.hidden_scan is None and getattr(self.obj, "Target", None) is not None:
+            self.hide_scan()  # (a new target's mesh, or one set again by Redo)
         if not self.shown:
             self.stop()
             return

@@ -438,12 +438,10 @@ class Controller:
         ov = self.overlay()
         if ov is None:
             return
-        if (display == "deviation") != (ov.display == "deviation"):
-            # The deviation display draws the scan's points in colour: the plain scan would hide them.
-            scan = getattr(ov.obj, "Target", None)
-            vobj = getattr(scan, "ViewObject", None)
-            if vobj is not None:
-                vobj.Visibility = display != "deviation"
+        if display == "deviation" and ov.display != "deviation":
+            ov.hide_scan()
+        elif display != "deviation" and ov.display == "deviation":
+            ov.show_scan()
         ov.display = display
         if display in MAP_CYCLE:
             self.last_map = display
