@@ -210,7 +210,7 @@ class Hud:
             self._text(f"{rng[0]:.3g}{units}", x0 - 6, bottom, TEXT, "legend_lo", w, right=True)
         if display == "deviation" and rng[1] > rng[0]:  # the band within the tolerance, labelled at its middle
             middle = bottom + (top - bottom) * (0.0 - rng[0]) / (rng[1] - rng[0])
-            self._text(f"+-{tolerance:.3g}{units}", x0 - 6, middle - FONT_SIZE / 2, TEXT, "legend_band", w, right=True)
+            self._text(f"\u00b1{tolerance:.3g}{units}", x0 - 6, middle - FONT_SIZE / 2, TEXT, "legend_band", w, right=True)
         title = {"curvature": "curvature u / v", "mean": "mean curvature", "gauss": "Gaussian curvature",
                  "zebra": f"zebra: {int(zebra_bands)} stripes", "deviation": "deviation from the scan"}.get(display, display)
         self._text(title, x1, top + 6 + (titles - 1) * (FONT_SIZE + 4), TEXT, "legend_title", w, right=True)

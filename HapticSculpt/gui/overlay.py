@@ -436,7 +436,7 @@ class Overlay:
         report = json.loads(text)
         if "error" in report:
             return f"deviation: {report['error']}"
-        return (f"deviation: {report['within_pct']:.1f} % within +-{report['tolerance_mm']:g} mm, p95 "
+        return (f"deviation: {report['within_pct']:.1f} % within \u00b1{report['tolerance_mm']:g} mm, p95 "
                 f"{report['p95_mm']:.3g} mm, max {report['max_mm']:.3g} mm")
 
     def _target(self) -> Any:
@@ -480,7 +480,7 @@ class Overlay:
         node = shapes.coloured_points(points, colours, 3.0)
         self._scan = (key, now, node)
         d = np.abs(distances[over])
-        self._live_deviation = (f"deviation: {100.0 * float(np.mean(d <= tol)):.1f} % within +-{tol:g} mm, p95 "
+        self._live_deviation = (f"deviation: {100.0 * float(np.mean(d <= tol)):.1f} % within \u00b1{tol:g} mm, p95 "
                                 f"{float(np.percentile(d, 95)):.3g} mm, max {float(d.max()):.3g} mm (live, "
                                 f"{d.size} points)") if d.size else None
         return node
