@@ -111,7 +111,8 @@ class Overlay:
         return bool(svobj is not None and svobj.Visibility)
 
     def _session(self) -> Any:
-        return self.obj.Proxy.live.session
+        live = getattr(self.obj.Proxy, "live", None)  # (None while its document is being read)
+        return live.session if live is not None else None
 
     def start(self, rate: float = 60.0) -> None:
         from pivy import coin

@@ -38,15 +38,15 @@ class SculptViewProvider(_Stateless):
         self.Object = vobj.Object
 
     def onChanged(self, vobj: Any, prop: str) -> None:
-        if prop == "Visibility":  # the constraint jacks show and hide with the sculpt
+        if prop == "Visibility" and not vobj.Object.Document.Restoring:  # the jacks show and hide with the sculpt
             from .workbench import controller
             ctl = controller()
             for ov in ctl.overlays_of(vobj.Object) if ctl.inputs else []:
                 ov.refresh()
 
     def updateData(self, obj: Any, prop: str) -> None:
-        if prop == "CurveConstraints":  # the curves it follows show at once, however they were added
-            from .workbench import controller
+        if prop == "CurveConstraints" and not obj.Document.Restoring:  # the curves it follows show at once
+            from .workbench import controller  # (a document being read: its views draw it once it is)
             ctl = controller()
             if ctl.inputs:
                 ctl.refresh(obj)
@@ -73,7 +73,7 @@ class SolidViewProvider(_Stateless):
         return icon("HapticSculpt")
 
     def onChanged(self, vobj: Any, prop: str) -> None:
-        if prop == "Visibility":  # its sculpt's displays lie on its face: they show and hide with it
+        if prop == "Visibility" and not vobj.Object.Document.Restoring:  # its sculpt's displays lie on its face
             from .workbench import controller
             ctl = controller()
             for sculpt in getattr(vobj.Object, "Sculpts", []) if ctl.inputs else []:

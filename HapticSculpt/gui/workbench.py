@@ -215,6 +215,8 @@ class Controller:
         if obj is None or view is None or not _alive(obj):
             return None
         key = (id(view), obj.Document.Name + "/" + obj.Name)
+        if key in self.overlays and not (self.overlays[key].obj is obj and self.overlays[key].alive()):
+            self.overlays.pop(key).remove()  # (a closed document's, opened again: the names are the same)
         if key not in self.overlays:
             self.overlays[key] = Overlay(view, obj)
             self.overlays[key].mode = f"airbrush: {self.painting}" if self.painting else ""
@@ -238,8 +240,8 @@ class Controller:
         return drawing[0] is overlay
 
     def overlays_of(self, obj: Any) -> list[Overlay]:
-        name = obj.Document.Name + "/" + obj.Name
-        return [ov for (_, n), ov in self.overlays.items() if n == name]
+        name = obj.Document.Name + "/" + obj.Name  # (and the object itself: a closed document's
+        return [ov for (_, n), ov in self.overlays.items() if n == name and ov.obj is obj]  # opened again has its names)
 
     def cursor(self) -> np.ndarray | None:
         """Where the cursor is: the session's device while one runs, else the mouse."""
