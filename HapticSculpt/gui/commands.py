@@ -19,8 +19,10 @@ NEEDS_CURSOR = "Needs a sculpt and the mouse over it (or a session's cursor)."
 #: The drop-down command groups (FreeCAD group commands, as Draft's and PartDesign's): name ->
 #: (menu text, tool tip, the commands, the one the button runs until another entry is picked).
 GROUPS = {
-    "HapticSculpt_NewGroup": ("New patch", "A new flat sculpt patch: free edges (a free sheet) or held edges (a "
-                              "clamped sheet)", ["HapticSculpt_NewPatch", "HapticSculpt_NewClampedPatch"], 0),
+    # (clamped first: a free sheet pulled at its middle lifts whole, and a designer's first stroke
+    # on the button's patch made no bump)
+    "HapticSculpt_NewGroup": ("New patch", "A new flat sculpt patch: held edges (a clamped sheet: a pull makes a "
+                              "bump) or free edges (a free sheet)", ["HapticSculpt_NewPatch", "HapticSculpt_NewClampedPatch"], 1),
     "HapticSculpt_OutputGroup": ("Output", "Export STEP, or thicken the selected sculpt into a solid",
                                  ["HapticSculpt_ExportStep", "HapticSculpt_Thicken"], 0),
     "HapticSculpt_ToolGroup": ("Tools", f"Choose the sculpting tool: {', '.join(core.TOOLS)}; and the falloff of "
