@@ -226,3 +226,49 @@ def test_a_document_closed_and_opened_again_draws_without_a_traceback(tmp_path):
     out = run_freecad_gui(REOPEN_SCRIPT, str(tmp_path))
     assert out["raised"] == [], out["raised"]
     assert out["drawn"] == ["mass"], out
+
+
+OTHER_DOCUMENT_SCRIPT = """
+import json, os, time, traceback
+import FreeCAD, FreeCADGui as Gui
+out = {}
+def pump(seconds):
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        Gui.updateGui()
+        time.sleep(0.02)
+try:
+    Gui.activateWorkbench("HapticSculptWorkbench")
+    import HapticSculpt as hs
+    from HapticSculpt.gui.workbench import all_3d_views, controller
+    first = FreeCAD.newDocument("First")
+    hs.make_sculpt(first)
+    first.recompute()
+    pump(0.5)
+    ctl = controller()
+    ctl.sync_views()
+    ctl.mouse_view = next(v for d, v in all_3d_views() if d == first)  # (the mouse was last in its view)
+    second = FreeCAD.newDocument("Second")  # (ctrl+n: the new view is active, the mouse not in it yet)
+    sculpt = hs.make_sculpt(second)
+    second.recompute()
+    pump(0.5)
+    Gui.Selection.clearSelection()
+    Gui.Selection.addSelection(sculpt)
+    Gui.runCommand("HapticSculpt_ShowMap")
+    pump(0.5)
+    views = {d.Name: v for d, v in all_3d_views()}
+    out["drawn_in"] = [name for name, v in views.items() for ov in ctl.overlays.values()
+                       if ov.view is v and ov.display != "shading"]
+except Exception:
+    out["error"] = traceback.format_exc()
+json.dump(out, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+def test_a_display_set_in_a_new_document_is_drawn_in_its_view(tmp_path):
+    """A display turned on for a new document's sculpt was drawn in the other document's view, the
+    one the mouse was in last."""
+    out = run_freecad_gui(OTHER_DOCUMENT_SCRIPT, str(tmp_path))
+    assert out["drawn_in"] == ["Second"], out

@@ -211,8 +211,10 @@ class Controller:
 
     def overlay(self, obj: Any | None = None, view: Any = None) -> Overlay | None:
         obj = obj or self.active_sculpt()
-        view = view or self.view()
-        if obj is None or view is None or not _alive(obj):
+        if obj is None or not _alive(obj):
+            return None
+        view = view or self.view_of(obj)
+        if view is None:
             return None
         key = (id(view), obj.Document.Name + "/" + obj.Name)
         if key in self.overlays and not (self.overlays[key].obj is obj and self.overlays[key].alive()):
@@ -238,6 +240,19 @@ class Controller:
             if active is not None and ov.obj == active:
                 return ov is overlay
         return drawing[0] is overlay
+
+    def view_of(self, obj: Any) -> Any:
+        """A 3D view of ``obj``'s document: the one the mouse was last in, else the active one, else
+        its first. (The mouse's alone drew a display set from the toolbar in the other document's
+        view when the new document had not had the mouse yet.)"""
+        import FreeCADGui as Gui
+        mine = [v for doc, v in all_3d_views() if doc == obj.Document]
+        if self.mouse_view is not None and any(v is self.mouse_view for v in mine):
+            return self.mouse_view
+        active = self.active_view()
+        if active is not None and Gui.ActiveDocument is not None and Gui.ActiveDocument.Document == obj.Document:
+            return active
+        return mine[0] if mine else None
 
     def overlays_of(self, obj: Any) -> list[Overlay]:
         name = obj.Document.Name + "/" + obj.Name  # (and the object itself: a closed document's
