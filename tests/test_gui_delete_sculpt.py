@@ -37,7 +37,7 @@ def test_deleting_the_sculpt_mid_session_stops_it_cleanly_and_undo_brings_it_bac
         item = d.wait(lambda s: label in s["tree"], "the sculpt in the tree")["tree"][label]
         d.xdo("mousemove", str(item[0]), str(item[1]), "click", "1")
         d.wait(lambda s: sculpt(s)["selected"], "the sculpt selected in the tree")
-        d.xdo("key", "Delete")
+        d.shortcut("Delete", "Std_Delete")
         s = d.wait(lambda s: not s["docs"][s["active"]]["sculpts"] and not s["session"],
                    "the sculpt deleted and its session stopped")
         d.shot("delete_sculpt_deleted")
@@ -45,7 +45,7 @@ def test_deleting_the_sculpt_mid_session_stops_it_cleanly_and_undo_brings_it_bac
         d.drag([west, (west[0] + 60, west[1] + 30)])
         d.xdo("mousemove", str(centre[0]), str(centre[1]))
         d.wait(lambda s: s["focus"] not in ("Gui::TreeWidget",) and not s["focus_field"], "the view to take the keyboard")
-        d.xdo("key", "ctrl+z")
+        d.shortcut("ctrl+z", "Std_Undo")
         s = d.wait(lambda s: s["docs"][s["active"]]["sculpts"] and "Delete" not in undo(s)[:1],
                    "ctrl+z: the sculpt back")
         assert sculpt(s)["strokes"] == 1

@@ -60,7 +60,7 @@ def test_keys_and_undo_reach_the_view_under_the_pointer_after_the_console_had_th
         names = undo(d.state())
         d.xdo("mousemove", str(centre[0]), str(centre[1]))
         d.wait(lambda s: s["focus"] != "Gui::PythonConsole", "the view to take the keyboard")
-        d.xdo("key", "ctrl+z")
+        d.shortcut("ctrl+z", "Std_Undo")
         s = d.wait(lambda s: undo(s) == names[1:], "ctrl+z: the last constraint undone")
         assert len(sculpt(s)["constraints"]) == 1
         d.shot("focus_keys_undone")

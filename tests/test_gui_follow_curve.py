@@ -114,15 +114,15 @@ def test_follow_curve_pulls_the_patch_onto_a_sketch_keeps_it_through_a_stroke_g1
         assert kind == "G0" and distance <= tolerance, curves(s)
         d.shot_changed("follow_stroked", pulled, "the stroke")
         # Undo the stroke and the curve, Redo both
-        d.xdo("key", "ctrl+z")
+        d.shortcut("ctrl+z", "Std_Undo")
         s = d.wait(lambda s: undo(s)[0] == "Follow curve", "Undo of the stroke")
-        d.xdo("key", "ctrl+z")
+        d.shortcut("ctrl+z", "Std_Undo")
         s = d.wait(lambda s: not curves(s) and np.abs(np.array(sculpt(s)["poles"])[2::3]).max() < 1e-9,
                    "Undo of Follow curve: flat, following nothing")
         d.shot_changed("follow_undone", pulled, "Undo of Follow curve", level=0.02)
-        d.xdo("key", "ctrl+shift+z")
+        d.shortcut("ctrl+shift+z", "Std_Redo")
         d.wait(lambda s: curves(s) and undo(s)[0] == "Follow curve", "Redo of Follow curve")
-        d.xdo("key", "ctrl+shift+z")
+        d.shortcut("ctrl+shift+z", "Std_Redo")
         s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke" and curves(s)[0][1] <= tolerance, "Redo of the stroke")
         # the same two still selected: Follow curve again makes it G1, then frees it
         assert sorted(o for o, _ in s["selection"]) == ["Sculpt", "Sketch"], s["selection"]

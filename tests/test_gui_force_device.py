@@ -47,7 +47,7 @@ def test_the_session_takes_the_falcon_and_its_stroke_is_one_undo_step(tmp_path, 
         d.wait(lambda s: np.array(sculpt(s)["shape_poles"])[:, 2].max() > 0.7 * lifted, "the stroke to show")
         d.shot("falcon_stroke")
         # ctrl+z while the Falcon still sculpts: the flat patch shows at once, the session runs on
-        d.xdo("key", "ctrl+z")
+        d.shortcut("ctrl+z", "Std_Undo")
         s = d.wait(lambda s: undo(s)[0] == before and np.abs(np.array(sculpt(s)["shape_poles"])[:, 2]).max() < 1e-3,
                    "Undo to show the flat patch")
         assert sculpt(s)["session"] and sculpt(s)["device"] == "falcon"

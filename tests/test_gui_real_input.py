@@ -86,7 +86,7 @@ class Desktop:
         """ctrl+s into FreeCAD's save dialog: the path typed, then Return until the document has it
         (the dialog's file-name completer can pop up as the path is typed, and a Return then only
         closes the popup, as it does for a user, who presses it again). The state."""
-        self.xdo("key", "ctrl+s")
+        self.shortcut("ctrl+s", "Std_Save")
         self.wait_window("Save FreeCAD Document")
         self.xdo("type", path)
         for attempt in range(3):
@@ -144,14 +144,26 @@ class Desktop:
         if shot:
             self.shot("timeout")  # what the screen showed (the Python console has any traceback)
         s = self.state()
-        brief = {k: v for k, v in s.items() if k != "docs"}
+        brief = {}  # the documents first, the toolbars' long layout last
         for name, doc in s.get("docs", {}).items():
             brief[name] = {"undo": doc["undo"][:4], "redo": doc["redo"][:4],
                            "sculpts": [{k: v for k, v in c.items() if "poles" not in k} |
                                        {"max_z": float(np.abs(np.array(c["shape_poles"])[:, 2]).max()),
                                         "max_z_stored": float(np.abs(np.array(c["poles"]).reshape(-1, 3)[:, 2]).max())}
                                        for c in doc["sculpts"]]}
-        raise AssertionError(f"timed out waiting for {what}; last state: {json.dumps(brief)[:3000]}")
+        brief |= {k: v for k, v in s.items() if k not in ("docs", "toolbars")} | {"toolbars": s.get("toolbars")}
+        raise AssertionError(f"timed out waiting for {what}; {self.alive_or_exit()}; last state: "
+                             f"{json.dumps(brief)[:3000]}\nFreeCAD's output ended:\n{self.log_tail()}")
+
+    def alive_or_exit(self) -> str:
+        """Whether FreeCAD still runs (a state written by a FreeCAD that died stays the last one)."""
+        code = self.freecad.poll()
+        return "FreeCAD still running" if code is None else f"FreeCAD EXITED with {code}"
+
+    def log_tail(self, chars: int = 3000) -> str:
+        self.log.flush()
+        with open(self.log.name, errors="replace") as f:
+            return f.read()[-chars:]
 
     def wait_still(self, value, what: str, writes: int = 5, timeout: float = 20.0):
         """``value(state)`` once it has stayed the same over ``writes`` of the observer's writes in a
@@ -286,6 +298,14 @@ class Desktop:
                 continue
         return self.wait(condition, what)
 
+    def shortcut(self, keys: str, command: str) -> None:
+        """``keys`` pressed once FreeCAD offers ``command`` (its Edit menu entry enabled): FreeCAD
+        enables a command's key on its next command check, a moment after the selection or the
+        undo step that allows it, and a key pressed before then does nothing (seen: Delete right
+        after a click in the tree)."""
+        self.wait(lambda s: s["toolbars"]["menu_enabled"].get(command), f"{command} to be offered")
+        self.xdo("key", keys)
+
     def drag(self, points: list[tuple[int, int]], seconds: float = 0.3) -> None:
         """A left drag through ``points`` taking ``seconds``, as a hand makes one (a drag of no
         duration, which xdotool can send and no hand can, may lose its release under Xvfb)."""
@@ -382,13 +402,13 @@ def test_workbench_first_keys_stroke_undo_redo_paint(tmp_path, style):
         assert after > 0.7 * lifted, f"the stroke sprang back: {lifted} -> {after} mm"
         pulled = d.shot(f"{style}_stroke")
         # ctrl+z: the view shows the shape before the stroke at once, the session keeps running
-        d.xdo("key", "ctrl+z")
+        d.shortcut("ctrl+z", "Std_Undo")
         s = d.wait(lambda s: undo(s)[0] == "Add curvature constraint" and
                    np.abs(np.array(sculpt(s)["shape_poles"])[:, 2]).max() < 1e-3, "Undo to show")  # (flat; the
         # restored patch settles under its constraints by ~1e-7 mm)
         assert sculpt(s)["session"]
         d.shot_changed(f"{style}_undone", pulled, "Undo")
-        d.xdo("key", "ctrl+shift+z")
+        d.shortcut("ctrl+shift+z", "Std_Redo")
         s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "Redo")
         assert np.array_equal(np.array(sculpt(s)["poles"]), stroke_poles), "Redo must restore the exact poles"
         d.wait(lambda s: np.abs(np.array(sculpt(s)["shape_poles"])[:, 2]).max() > 0.5 * lifted, "Redo to show")
@@ -458,7 +478,7 @@ def test_hold_edges_goes_free_g0_g1_g2_and_skips_what_the_net_cannot_hold(tmp_pa
                                f"Hold edges: {kind}")
             assert undo(s)[0] == "Hold edges"
         assert undo(s)[:4] == ["Hold edges"] * 4
-        d.xdo("key", "ctrl+z")
+        d.shortcut("ctrl+z", "Std_Undo")
         d.wait(lambda s: set(sculpt(s)["edges"].values()) == {"G2"}, "ctrl+z: back to G2")
         d.shot("hold_edges_g2")
     finally:

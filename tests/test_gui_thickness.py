@@ -74,7 +74,7 @@ def test_new_patch_without_a_document_then_thicken_choosing_the_thickness(tmp_pa
         assert thickness(s)["valid"] and 0.85 * 2e4 < thickness(s)["volume"] < 1.15 * 2e4, thickness(s)
         assert undo(s)[:2] == ["Edit thickness", "Thicken"], undo(s)[:3]
         d.shot("thick_edited")
-        d.xdo("key", "ctrl+z")
+        d.shortcut("ctrl+z", "Std_Undo")
         s = d.wait(lambda s: thickness(s)["thickness"] == 5.0 and abs(thickness(s)["volume"] - made["volume"]) < 1e-6,
                    "Undo of the edit")
     finally:

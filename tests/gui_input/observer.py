@@ -317,7 +317,10 @@ def _toolbars():
             menus[title] = _rect(mw.menuBar(), mw.menuBar().actionGeometry(a))
             if a.menu().isVisible():
                 open_menus[title] = _entries(a.menu())
+    enabled = {_command_name(b): b.isEnabled() for a in mw.menuBar().actions() if a.menu() is not None
+               for b in a.menu().actions() if not b.isSeparator()}  # (a shortcut does nothing while greyed)
     return {"bars": bars, "buttons": buttons, "groups": groups, "disabled": disabled, "menus": menus, "open": open_menus,
+            "menu_enabled": enabled,
             "commands": [c for c in Gui.listCommands() if c.startswith("HapticSculpt_")]}
 
 
