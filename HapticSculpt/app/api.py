@@ -137,6 +137,7 @@ def _sculpt_state(made: Any, mesh: tuple[int, int], material: str, held: Sequenc
     surface = core.DynamicSurface(made.surface, mesh)
     _apply_material(surface, material)
     surface.bending_map.set_uniform(FAIR_BENDING)
+    sculpt_state.choose_tool(surface, surface.tool.name)  # (its lengths fitted to the sculpt's size)
     if held or links:
         surface.hold_poles(list(held), list(links))
     if walls:
@@ -298,7 +299,8 @@ def set_tool(obj: Any, tool: str, falloff: str | None = None, **settings: float)
     "cylindrical", "conical"); ``settings`` set its parameters by name (``radius=25``; the names,
     defaults and meanings in ``core.TOOL_INFO[tool]["parameters"]``, plus ``max_force`` and
     ``ramp_time``). The current tool keeps the settings not given; another tool starts from its
-    defaults. One undo step; a running session takes it at once."""
+    defaults, its lengths (``length`` there) shorter on a sculpt smaller than a 100 mm patch
+    (``sculpt_state.tool_scale``). One undo step; a running session takes it at once."""
     obj = _sculpt(obj, solids=True)
     if tool not in core.TOOLS:
         raise ValueError(f"tool: unknown tool {tool!r} (one of {', '.join(core.TOOLS)})")
@@ -318,7 +320,7 @@ def set_tool(obj: Any, tool: str, falloff: str | None = None, **settings: float)
 
     def change(s: core.DynamicSurface) -> None:
         if s.tool.name != tool:  # (the current tool keeps the settings not given)
-            s.set_tool(tool)
+            sculpt_state.choose_tool(s, tool)
         if falloff is not None:
             s.tool.falloff = falloff
         for key, value in values.items():
@@ -484,7 +486,7 @@ def run(obj: Any, seconds: float, device: CursorSource | None = None, tool: str 
         raise ValueError(f"integrator: unknown integrator {integrator!r} (one of {', '.join(core.INTEGRATORS)})")
     surface = obj.Proxy.live.surface  # (raises while a session steps it)
     if tool is not None and surface.tool.name != tool:
-        surface.set_tool(tool)
+        sculpt_state.choose_tool(surface, tool)
     if integrator is not None:
         surface.integrator = integrator
     steps = int(round(seconds / dt))

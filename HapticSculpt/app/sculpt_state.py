@@ -53,8 +53,38 @@ def tool_settings(surface: core.DynamicSurface) -> dict[str, Any]:
     return {"name": tool.name, "params": {k: getattr(tool, k) for k in core.tool_settings_of(tool.name)}}
 
 
+#: The diagonal of the part a tool's lengths (a rope's slack, a brush's radius: ``length`` in
+#: ``core.TOOL_INFO``) are declared for: a 100 mm square patch. On a smaller sculpt they shrink with
+#: it, so a 10 mm part's rope turns taut and its brush covers a tenth of it, as on the patch (with
+#: the patch's 5 mm slack, a rope on the top of a 10 mm cube stayed slack: the top rose a third as
+#: far). A larger sculpt keeps them.
+TOOL_PART_DIAGONAL = 100.0 * math.sqrt(2.0)
+
+
+def tool_scale(surface: core.DynamicSurface) -> float:
+    """What a tool's lengths are scaled by on ``surface``: its size over ``TOOL_PART_DIAGONAL``, at most 1."""
+    ratio = float(surface.size) / TOOL_PART_DIAGONAL
+    return 1.0 if ratio >= 1.0 - 1e-9 else max(ratio, 1e-3)
+
+
+def tool_defaults(name: str, scale: float = 1.0) -> dict[str, float]:
+    """Tool ``name``'s default settings, its lengths times ``scale``."""
+    return {k: p["default"] * (scale if p.get("length") else 1.0)
+            for k, p in core.TOOL_INFO[name]["parameters"].items()}
+
+
+def choose_tool(surface: core.DynamicSurface, name: str) -> None:
+    """Selects tool ``name`` with its defaults, its lengths fitted to the surface's size."""
+    surface.set_tool(name)
+    scale = tool_scale(surface)
+    if scale != 1.0:
+        for key, value in tool_defaults(name, scale).items():
+            setattr(surface.tool, key, value)
+
+
 def apply_tool(surface: core.DynamicSurface, settings: dict[str, Any]) -> None:
-    """Select a tool and set its parameters (unknown names raise ``ValueError``)."""
+    """Select a tool and set its parameters (unknown names raise ``ValueError``; those not given
+    take their defaults, fitted to the surface's size)."""
     name = settings.get("name")
     if name not in core.TOOLS:
         raise ValueError(f"tool: unknown tool {name!r} (one of {', '.join(core.TOOLS)})")
@@ -63,7 +93,7 @@ def apply_tool(surface: core.DynamicSurface, settings: dict[str, Any]) -> None:
     unknown = set(params) - allowed
     if unknown:
         raise ValueError(f"tool: {name} has no parameter(s) {', '.join(sorted(unknown))}")
-    surface.set_tool(name)
+    choose_tool(surface, name)
     for key, value in params.items():
         setattr(surface.tool, key, value)
 

@@ -305,7 +305,7 @@ class Overlay:
 
     def panel_press(self, x: float, y: float) -> bool:
         """Button down at view pixel (x, y): True if it took a slider (shown at once)."""
-        if not self.panel.press(x, y, self.tracks()):
+        if not self.panel.press(x, y, self.tracks(), self.obj):
             return False
         self.frame()
         return True

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from .. import core
+from ..app import sculpt_state
 
 # name, label, low, high (log scale)
 SLIDERS = (("mass", "mass", 1e-2, 1e2), ("damping", "damping", 1e-2, 1e3), ("stiffness", "stiffness", 1e0, 1e5),
@@ -29,25 +30,30 @@ ZERO_AT_LEFT = ("bending", "pull")
 TOOL_RANGE = 10.0
 
 
-def tool_sliders(tool: str) -> list[tuple[str, str, float, float]]:
-    """The sliders of ``tool``'s settings: "tool.<tool>.<setting>", its label, its range."""
+def tool_sliders(tool: str, scale: float = 1.0) -> list[tuple[str, str, float, float]]:
+    """The sliders of ``tool``'s settings: "tool.<tool>.<setting>", its label, its range (about the
+    default; a length's default times ``scale``, the sculpt's ``sculpt_state.tool_scale``)."""
     out = []
-    for name, p in core.TOOL_INFO[tool]["parameters"].items():
-        default = p["default"] if p["default"] > 0 else 1.0
-        out.append((f"tool.{tool}.{name}", f"{tool} {p['label']}", default / TOOL_RANGE,
-                    default * TOOL_RANGE))
+    for name, default in sculpt_state.tool_defaults(tool, scale).items():
+        default = default if default > 0 else 1.0
+        out.append((f"tool.{tool}.{name}", f"{tool} {core.TOOL_INFO[tool]['parameters'][name]['label']}",
+                    default / TOOL_RANGE, default * TOOL_RANGE))
     return out
+
+
+def _scale(obj: Any) -> float:
+    return sculpt_state.tool_scale(obj.Proxy.live.snapshot())
 
 
 def sliders(obj: Any) -> list[tuple[str, str, float, float]]:
     """The panel's sliders for ``obj``: the material's and curvature's, then its current tool's."""
-    return [*SLIDERS, *tool_sliders(obj.Proxy.live.snapshot().tool.name)]
+    return [*SLIDERS, *tool_sliders(obj.Proxy.live.snapshot().tool.name, _scale(obj))]
 
 
-def _spec(name: str) -> tuple[str, str, float, float]:
+def _spec(name: str, scale: float) -> tuple[str, str, float, float]:
     if name.startswith("tool."):
         tool = name.split(".")[1]
-        return next(s for s in tool_sliders(tool) if s[0] == name)
+        return next(s for s in tool_sliders(tool, scale) if s[0] == name)
     return next(s for s in SLIDERS if s[0] == name)
 
 
@@ -69,6 +75,7 @@ class SliderPanel:
         self.held: str | None = None
         self.pending: float | None = None  # the held slider's value while dragging
         self._track: Box | None = None  # the held slider's track
+        self._scale = 1.0  # the held sculpt's tool scale
 
     # --- values -----------------------------------------------------------------------------------
     @staticmethod
@@ -104,15 +111,17 @@ class SliderPanel:
                                          "constraints, and this sculpt has none: press C over the surface to add one\n")
 
     @staticmethod
-    def fraction(name: str, value: float) -> float:
-        _, _, low, high = _spec(name)
+    def fraction(name: str, value: float, scale: float = 1.0) -> float:
+        """Where ``value`` sits along slider ``name`` (0..1), its lengths' range times ``scale``."""
+        _, _, low, high = _spec(name, scale)
         if value <= 0:
             return 0.0
         return float(np.clip((math.log10(value) - math.log10(low)) / (math.log10(high) - math.log10(low)), 0, 1))
 
     @staticmethod
-    def from_fraction(name: str, f: float) -> float:
-        _, _, low, high = _spec(name)
+    def from_fraction(name: str, f: float, scale: float = 1.0) -> float:
+        """The value at ``f`` (0..1) along slider ``name``, its lengths' range times ``scale``."""
+        _, _, low, high = _spec(name, scale)
         if f <= 0 and _zero_at_left(name):
             return 0.0
         return 10 ** (math.log10(low) + float(np.clip(f, 0, 1)) * (math.log10(high) - math.log10(low)))
@@ -124,12 +133,12 @@ class SliderPanel:
         return next((name for name, (x0, y0, x1, y1) in tracks.items()
                      if x0 - REACH <= x <= x1 + REACH and y0 <= y <= y1), None)
 
-    def press(self, x: float, y: float, tracks: dict[str, Box]) -> bool:
-        """Button down at (x, y): takes the slider there, if any (True)."""
+    def press(self, x: float, y: float, tracks: dict[str, Box], obj: Any) -> bool:
+        """Button down at (x, y) over the sliders of ``obj``: takes the slider there, if any (True)."""
         name = self.track_at(x, y, tracks)
         if name is None:
             return False
-        self.held, self._track = name, tracks[name]
+        self.held, self._track, self._scale = name, tracks[name], _scale(obj)
         self.drag(x)
         return True
 
@@ -137,7 +146,7 @@ class SliderPanel:
         """The held slider follows the mouse along its track."""
         if self.held is not None and self._track is not None:
             x0, _, x1, _ = self._track
-            self.pending = self.from_fraction(self.held, (x - x0) / max(x1 - x0, 1.0))
+            self.pending = self.from_fraction(self.held, (x - x0) / max(x1 - x0, 1.0), self._scale)
 
     def release(self, obj: Any) -> bool:
         """Button up: the held slider's value becomes one undo step (True if one was held)."""
@@ -155,8 +164,8 @@ class SliderPanel:
 
     def values(self, obj: Any) -> list[tuple[str, float, bool, float]]:
         """(label, shown value, held, knob position 0..1) of each slider in order, for the HUD."""
-        out = []
+        out, scale = [], _scale(obj)
         for name, label, _, _ in sliders(obj):
             v = self.shown_value(obj, name)
-            out.append((label, v, self.held == name, self.fraction(name, v)))
+            out.append((label, v, self.held == name, self.fraction(name, v, scale)))
         return out

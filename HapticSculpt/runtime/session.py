@@ -121,7 +121,7 @@ class Session:
             live.session.stop()  # its loops ended by themselves (a replay played out): commit and let go
         surface = live.surface
         if surface.tool.name != tool:
-            surface.set_tool(tool)
+            sculpt_state.choose_tool(surface, tool)
         defaults = core.DEFAULTS
         haptic_rate = defaults["haptic_rate"] if haptic_rate is None else haptic_rate
         sim_dt = defaults["sim_dt"] if sim_dt is None else sim_dt

@@ -26,10 +26,11 @@ py::dict parameterDict(const ParameterInfo& p) {
     d["allow_zero"] = p.allowZero;
     d["label"] = *p.label ? p.label : p.name;
     d["doc"] = p.doc;
+    d["length"] = p.length;
     return d;
 }
 
-/// TOOL_INFO[name]: title, tip, order, falloff (bool), parameters {name: {default, allow_zero, doc, label}}, readouts {name: doc}.
+/// TOOL_INFO[name]: title, tip, order, falloff (bool), parameters {name: {default, allow_zero, doc, label, length}}, readouts {name: doc}.
 py::dict toolInfo() {
     py::dict all;
     for (const std::string& name : toolNames()) {

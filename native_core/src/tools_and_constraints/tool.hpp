@@ -53,6 +53,7 @@ struct ParameterInfo {
     bool allowZero = false;
     const char* doc = "";
     const char* label = "";  ///< a slider's few words, with the unit (the name where empty)
+    bool length = false;     ///< a length in mm: its default is for a 100 mm part (a smaller one scales it)
 };
 
 /// A value a tool reports about its grab (read-only).

@@ -21,7 +21,7 @@ constexpr ToolInfo kInfo{"flatten", "Flatten",
                          "Flatten: presses the surface within its radius flat, toward its tangent plane where "
                          "it grabs, at its mean height there",
                          4, true,
-                         {{{"radius", 10.0, false, "radius of the region pressed flat", "radius (mm)"},
+                         {{{"radius", 10.0, false, "radius of the region pressed flat", "radius (mm)", true},
                            {"stiffness", 10.0, false, "spring stiffness per point toward the plane", "stiffness"}}},
                          {{{"selected", "how many mass points the grab presses"}}}};
 

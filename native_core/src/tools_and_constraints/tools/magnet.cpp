@@ -12,7 +12,7 @@ enum { Radius, Stiffness };
 enum { Selected };
 constexpr ToolInfo kInfo{"magnet", "Magnet", "Magnet: pulls every mass point within its radius, weighted by its falloff",
                          1, true,
-                         {{{"radius", 10.0, false, "selection radius", "radius (mm)"},
+                         {{{"radius", 10.0, false, "selection radius", "radius (mm)", true},
                            {"stiffness", 10.0, false, "spring stiffness per point", "stiffness"}}},
                          {{{"selected", "how many mass points the grab holds"}}}};
 

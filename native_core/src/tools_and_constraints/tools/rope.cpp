@@ -16,7 +16,7 @@ constexpr ToolInfo kInfo{"rope", "Rope", "Rope: grabs the nearest mass point; pu
                          0, false,
                          {{{"stiffness", 10.0, false, "force per length below the threshold", "stiffness"},
                            {"stiff_stiffness", 200.0, false, "force per length past the threshold", "taut stiffness"},
-                           {"threshold", 5.0, true, "extension beyond rest length where the rope turns stiff", "slack (mm)"},
+                           {"threshold", 5.0, true, "extension beyond rest length where the rope turns stiff", "slack (mm)", true},
                            {"reel_time", 1.0, true, "seconds for the rest length to reel in to zero", "reel time (s)"}}},
                          {{{"rest_length", "the rope's rest length now"},
                            {"gain", "its pull over its settings where it is tied: 1 + ROPE_PLATE_GAIN x the bending ratio there"}}}};

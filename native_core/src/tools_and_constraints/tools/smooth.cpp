@@ -11,7 +11,7 @@ namespace {
 enum { Radius, Strength };
 constexpr ToolInfo kInfo{"smooth", "Smooth", "Smooth: a fairing brush toward lower curvature variation under the cursor",
                          3, true,
-                         {{{"radius", 10.0, false, "brush radius", "radius (mm)"},
+                         {{{"radius", 10.0, false, "brush radius", "radius (mm)", true},
                            {"strength", 1.0, false, "fairing force per unit of U^3 x", "strength"}}}};
 
 // Umbrella operator: mean of the 4-neighbours minus the point.
