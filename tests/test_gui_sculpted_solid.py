@@ -89,13 +89,13 @@ def test_a_face_of_a_part_sculpted_in_place(tmp_path):
         assert pulled["wires"] == made["wires"], "the hole is still a hole"
         assert max(r["g0_mm"] for r in pulled["seams"]) <= 1e-7, pulled["seams"]
         assert undo(s)[:2] == ["Sculpt stroke", "Sculpt solid"], undo(s)[:3]  # (Stop adds no step of its own)
-        d.xdo("key", "ctrl+z")
+        d.shortcut("ctrl+z", "Std_Undo")
         s = d.wait(lambda s: undo(s)[0] == "Sculpt solid" and
                    abs(solid(s)["volume"] - made["volume"]) < 1e-6 * made["volume"], "Undo of the stroke to show")
         # (a bump on a grey face is a change of shading: FreeCAD 1.1 lights it paler, and no pixel
         # changes by a tenth there; 4 % of the picture by more than 2 %)
         d.shot_changed("solid_undone", picture, "Undo of the stroke", level=0.02)
-        d.xdo("key", "ctrl+shift+z")
+        d.shortcut("ctrl+shift+z", "Std_Redo")
         d.wait(lambda s: undo(s)[0] == "Sculpt stroke" and abs(solid(s)["volume"] - made["volume"]) > 1.0, "Redo to show")
         frames = sum(o["frames"] for o in d.state()["overlays"])
         d.click_button("Zebra")  # (once: it toggles; the first frame finds which cells are on the face)
@@ -111,6 +111,51 @@ def test_a_face_of_a_part_sculpted_in_place(tmp_path):
         assert any(o["trimmed"] and o["neighbours_drawn"] >= 5 for o in state["overlays"]), state["overlays"]
         hole = d.to_screen(state["docs"][s["active"]]["screen"]["Housing"][1])  # x = 45 mm: in the hole
         assert not np.allclose(zebra[hole[1], hole[0]], picture[hole[1], hole[0]], atol=0.1), "the wall unstriped"
+    finally:
+        d.close()
+
+
+#: A 10 mm cube, made and saved by FreeCAD's GUI.
+CUBE = """
+import json, os
+import FreeCAD, FreeCADGui, Part
+doc = FreeCAD.newDocument("Cube")
+part = doc.addObject("Part::Feature", "Cube")
+part.Shape = Part.makeBox(10, 10, 10)
+doc.recompute()
+doc.saveAs(PATH)
+json.dump({"volume": part.Shape.Volume}, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_a_small_part_rises_under_a_quick_drag(tmp_path):
+    """The top of a 10 mm cube, grabbed at its middle and dragged up the screen for half a second in
+    the isometric view, rises by a millimetre, as a 100 mm box's top by ten. (Before, the rope's
+    slack was the 100 mm patch's 5 mm, and during the grab the cursor went onto the surface under
+    the pointer, the solid all around it: the top rose half as far.)"""
+    path = str(tmp_path / "cube.FCStd")
+    run_freecad_gui(f"PATH = {path!r}\n" + CUBE, str(tmp_path))
+    d = Desktop(str(tmp_path), "CAD", open_file=path)
+    try:
+        s = view_part(d, "Cube")
+        screen = s["docs"][s["active"]]["screen"]["Cube"]
+        centre, west = d.to_screen(screen[0]), d.to_screen(screen[2])
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.wait(lambda s: s["mouse_point"] is not None and abs(s["mouse_point"][2] - 10) < 0.1, "the mouse on the top")
+        d.xdo("click", "1")
+        d.wait(lambda s: [o for o, _ in s["selection"]] == ["Cube"], "the top face selected")
+        s = d.press_button("SculptFace", lambda s: s["docs"][s["active"]]["solids"], "the SculptedSolid")
+        name = solid(s)["name"]
+        # up the screen by half the top's width on screen (about 2 mm), in half a second
+        rise = max(2, int(abs(centre[0] - west[0])) // 6)
+        s = stroke_in_session(d, centre, rise, 6, 0.5)
+        pulled = solid(s)
+        assert pulled["valid"] and pulled["solids"] == 1 and pulled["closed"] and not pulled["error"], pulled
+        bump = s["docs"][s["active"]]["features"][name]["zmax"] - 10.0
+        d.shot("solid_small_pulled")
+        assert bump > 0.75, f"the top rose {bump:.3f} mm"  # (1.0 measured; 0.53 before)
     finally:
         d.close()
 

@@ -23,6 +23,7 @@ class MouseDevice:
         self._callbacks: list[Any] = []
         self._buttons = 0
         self._position = (0.0, 0.0, 0.0)
+        self._grab_plane: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None
         self._pressed: tuple[Any, int, int] | None = None  # view and pixel of a press not yet a grab
 
     def attach(self, view: Any) -> None:
@@ -51,21 +52,31 @@ class MouseDevice:
         self._callbacks = []
 
     def move_to(self, view: Any, pixel: Sequence[int]) -> tuple[float, float, float]:
-        """Puts the cursor under ``pixel`` of ``view`` (surface point if any, else the focal plane)."""
+        """Puts the cursor under ``pixel`` of ``view``: on the surface there if any, else on the
+        focal plane; during a grab, on the plane through the grab point that faces the screen."""
         x, y = int(pixel[0]), int(pixel[1])
-        info = view.getObjectInfo((x, y))
-        if info and all(k in info for k in ("x", "y", "z")):
-            p = (float(info["x"]), float(info["y"]), float(info["z"]))
+        if self._buttons and self._grab_plane is not None:
+            p = _on_plane(view, x, y, *self._grab_plane)
         else:
-            v = view.getPoint(x, y)
-            p = (float(v.x), float(v.y), float(v.z))
+            info = view.getObjectInfo((x, y))
+            if info and all(k in info for k in ("x", "y", "z")):
+                p = (float(info["x"]), float(info["y"]), float(info["z"]))
+            else:
+                v = view.getPoint(x, y)
+                p = (float(v.x), float(v.y), float(v.z))
         self._position = p
         self.native.push(list(p), buttons=self._buttons)
         return p
 
-    def press(self, held: bool) -> None:
-        """Button 1 (grab) held or released at the current cursor."""
+    def press(self, held: bool, view: Any = None) -> None:
+        """Button 1 (grab) held or released at the current cursor. A grab in ``view`` then moves the
+        cursor in the plane through the grab point that faces the screen: the pointer dragged up in
+        a view from above and aside lifts the surface. (The surface under the pointer, as before
+        the grab, is the surface being pulled: a cursor put on it slid along it, and a face of a
+        solid, with the solid all around under the pointer, barely rose.)"""
         self._buttons = 1 if held else 0
+        d = view.getViewDirection() if held and view is not None else None
+        self._grab_plane = (self._position, (float(d.x), float(d.y), float(d.z))) if d is not None else None
         self.native.push(list(self._position), buttons=self._buttons)
 
     def _on_move(self, view: Any, cb: Any) -> None:
@@ -73,7 +84,7 @@ class MouseDevice:
         if self._pressed is not None and self._pressed[0] is view and \
                 max(abs(int(pos[0]) - self._pressed[1]), abs(int(pos[1]) - self._pressed[2])) >= GRAB_PIXELS:
             self.move_to(view, self._pressed[1:])
-            self.press(True)  # the grab starts where the button went down
+            self.press(True, view)  # the grab starts where the button went down
             self._pressed = None
         self.move_to(view, (pos[0], pos[1]))
         if self._buttons or self._pressed is not None:
@@ -96,3 +107,22 @@ class MouseDevice:
                 self._pressed = None
                 self.press(False)
             cb.setHandled()
+
+
+def _on_plane(view: Any, x: int, y: int, point: Sequence[float], normal: Sequence[float]) -> tuple[float, float, float]:
+    """Where the ray under pixel (x, y) of ``view`` meets the plane through ``point`` with
+    ``normal`` (the view direction at the grab): straight along the view direction for an
+    orthographic camera, from the eye for a perspective one."""
+    q = view.getPoint(x, y)  # (on the focal plane)
+    q = (float(q.x), float(q.y), float(q.z))
+    ray = tuple(normal)
+    origin = q
+    if "erspective" in str(view.getCameraType()):
+        eye = view.getCameraNode().position.getValue()
+        origin = (float(eye[0]), float(eye[1]), float(eye[2]))
+        ray = tuple(qi - oi for qi, oi in zip(q, origin))
+    along = sum(r * n for r, n in zip(ray, normal))
+    if abs(along) < 1e-12:  # (a ray in the plane: none to meet)
+        return q
+    t = sum((p - o) * n for p, o, n in zip(point, origin, normal)) / along
+    return tuple(o + t * r for o, r in zip(origin, ray))
