@@ -99,6 +99,34 @@ class TestWriteBack(DocumentTestCase):
         self.assertTrue(np.array_equal(np.asarray(obj.Proxy.surface.poles), after))
         self.assertEqual([c["id"] for c in obj.Proxy.surface.constraints], [cid])
 
+    def test_undo_and_redo_leave_sculpts_solids_and_thicknesses_up_to_date(self):
+        """Their Shape comes back with their state: the tree must not ask for a recompute, and one
+        changes nothing. An edited base still waits for its recompute, and so does what it feeds."""
+        box = self.doc.addObject("Part::Box", "Box")
+        self.doc.recompute()
+        solid = hs.sculpt_solid(self.doc, box, ["Face6"])
+        patch = hs.make_sculpt(self.doc, mesh=(24, 24))
+        thick = hs.make_thickness(patch, 2.0)
+        self.doc.recompute()
+        stroke(patch)
+        hs.run(solid, 0.4, device=hs.ReplayDevice.stroke((5, 5, 10), (5, 5, 13.0), seconds=0.3, hold=0.1))
+        self.doc.recompute()
+        ours = (patch, solid, solid.Sculpts[0], thick)
+        for step in (self.doc.undo, self.doc.undo, self.doc.redo, self.doc.redo):
+            step()
+            self.assertEqual([o.State for o in ours], [["Up-to-date"]] * 4, step.__name__)
+        volume = solid.Shape.Volume
+        self.doc.recompute()
+        self.assertEqual(solid.Shape.Volume, volume)
+        self.doc.openTransaction("Height")  # (a base edited, then its edit undone and redone: still to recompute)
+        box.Height = 12.0
+        self.doc.recompute()
+        self.doc.commitTransaction()
+        self.doc.undo()
+        self.doc.redo()
+        self.assertIn("Touched", box.State)
+        self.assertIn("Touched", solid.State)
+
     def test_each_stroke_is_one_transaction(self):
         obj = hs.make_sculpt(self.doc)
         n = self.doc.UndoCount

@@ -14,6 +14,7 @@ from .. import core
 from . import scan_deviation, sculpt_state
 from .live_surface import LiveSurface
 from .sculpt_properties import STATE_PROPERTIES, ensure_properties, face_of, read_state, set_error, write_state
+from .undo_up_to_date import ensure_observer
 from .view_provider_hook import ViewProviderHook
 
 TYPE = "HapticSculpt::Sculpt"
@@ -33,6 +34,7 @@ class SculptFeature:
         self.Type = TYPE
         self._obj = obj
         self.live = LiveSurface(obj)
+        ensure_observer()
         ensure_properties(obj)
         obj.Proxy = self
         self.live.writing = True
@@ -82,6 +84,7 @@ class SculptFeature:
         """Opening a file: add properties older files lack, then load the state (errors are reported
         on this object only; the rest of the document is unaffected)."""
         self._attach(obj)
+        ensure_observer()
         migrated = ensure_properties(obj)
         try:
             self.live.surface  # noqa: B018 - loads and validates
