@@ -56,7 +56,9 @@ def unevenness(p: np.ndarray) -> float:
 def test_flatten_presses_the_bump_flatter_in_one_undo_step(tmp_path):
     os.makedirs(SHOTS, exist_ok=True)
     path = str(tmp_path / "bump.FCStd")
-    run_freecad_gui(f"PATH = {path!r}\n" + SCENE, str(tmp_path))
+    made = run_freecad_gui(f"PATH = {path!r}\n" + SCENE, str(tmp_path))
+    # the 60 mm patch's tool lengths: the 100 mm patch's, scaled to its size (10 mm -> 6 mm radius)
+    default = 10.0 * min(1.0, made["size"] / (100.0 * np.sqrt(2.0)))
     d = Desktop(str(tmp_path), "CAD", open_file=path)
     try:
         s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["sculpts"] and sculpt(s)["screen"], "the file")
@@ -71,9 +73,10 @@ def test_flatten_presses_the_bump_flatter_in_one_undo_step(tmp_path):
                            "the slider panel with the flatten tool's two settings")
         calibrate(d)
         label, radius, _, f = overlay(s)["sliders"][7]
-        assert label == "flatten radius (mm)" and radius == 10.0, overlay(s)["sliders"][7]
+        assert label == "flatten radius (mm)" and abs(radius - default) < 1e-9, (overlay(s)["sliders"][7], default)
         x0, y0, x1, y1 = overlay(s)["hud"]["track8"]
-        d.drag([d.to_screen([x0 + (f + (0.65 - f) * t) * (x1 - x0), (y0 + y1) / 2]) for t in np.linspace(0, 1, 8)],
+        to = (np.log10(20.0) - np.log10(default / 10.0)) / 2.0  # (20 mm on the log track, default/10 .. default*10)
+        d.drag([d.to_screen([x0 + (f + (to - f) * t) * (x1 - x0), (y0 + y1) / 2]) for t in np.linspace(0, 1, 8)],
                seconds=0.5)
         s = d.wait(lambda s: undo(s)[:2] == ["Tool: flatten", "Tool: flatten"] and 15 < overlay(s)["sliders"][7][1] < 25,
                    "the radius set to about 20 mm as one undo step")
