@@ -211,15 +211,20 @@ class Desktop:
         ``level`` (of full scale): the state the observer reports is the scene graph's; the window
         shows it after Qt's next paint, which FreeCAD 1.1 (Qt6) may run a few frames later. Fails if
         the picture does not change."""
-        end, t0 = time.monotonic() + timeout, time.monotonic()
+        changed = lambda picture: float(np.mean(np.abs(picture - before).max(axis=2) > level))  # noqa: E731
+        picture = self.shot_showing(name, lambda picture: changed(picture) > share, what, timeout)
+        print(f"{what}: the picture changed ({changed(picture):.2%} of it)")
+        return picture
+
+    def shot_showing(self, name: str, condition, what: str, timeout: float = 10.0) -> np.ndarray:
+        """The first screenshot for which ``condition(picture)`` holds (see ``shot_changed``)."""
+        end = time.monotonic() + timeout
         while True:
             picture = self.shot(name)
-            changed = float(np.mean(np.abs(picture - before).max(axis=2) > level))
-            if changed > share:
-                print(f"{what}: the picture changed ({changed:.2%} of it) after {time.monotonic() - t0:.2f} s")
+            if condition(picture):
                 return picture
             if time.monotonic() > end:
-                raise AssertionError(f"{what} did not change the picture ({changed:.4%} of it in {timeout} s; "
+                raise AssertionError(f"{what} not shown in {timeout} s; "
                                      f"renders {[v.get('renders') for v in self.state().get('views', [])]})")
 
     def click_button(self, button: str) -> bool:
