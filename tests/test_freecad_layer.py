@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 import sys
+import time
 
 import numpy as np
 
@@ -126,6 +127,26 @@ class TestWriteBack(DocumentTestCase):
         self.doc.redo()
         self.assertIn("Touched", box.State)
         self.assertIn("Touched", solid.State)
+
+    def test_a_session_and_hold_edges_leave_a_sculpted_solid_up_to_date(self):
+        """A threaded session on a solid's face (its frames and its last reset rebuild the solid),
+        then Hold edges: the tree must not ask for a recompute (it marked the solid touched)."""
+        box = self.doc.addObject("Part::Box", "Box")
+        self.doc.recompute()
+        solid = hs.sculpt_solid(self.doc, box, ["Face6"])
+        self.doc.recompute()
+        face = solid.Sculpts[0]
+        session = hs.Session().start(face, hs.ReplayDevice.stroke((5, 5, 10), (5, 5, 13.0), seconds=0.3, hold=0.1),
+                                     stop_when_finished=True)
+        deadline = time.monotonic() + 60.0
+        while session.running and time.monotonic() < deadline:
+            time.sleep(0.02)
+        session.stop()
+        self.assertEqual(self.doc.UndoNames[0], "Sculpt stroke")
+        self.assertEqual([o.State for o in (box, face, solid)], [["Up-to-date"]] * 3)
+        hs.hold_boundary(face, "G1")
+        self.assertEqual(self.doc.UndoNames[0], "Hold edges")
+        self.assertEqual([o.State for o in (box, face, solid)], [["Up-to-date"]] * 3)
 
     def test_each_stroke_is_one_transaction(self):
         obj = hs.make_sculpt(self.doc)

@@ -56,6 +56,24 @@ class TestThickness(DocumentTestCase):
         self.doc.undo()
         self.assertIsNone(self.doc.getObject(name))
 
+    def test_its_sculpt_deleted_then_undone_leaves_it_to_recompute(self):
+        """Deleting the sculpt puts the thickness in error; Undo brings the sculpt back and leaves the
+        thickness touched, so the next recompute mends it (the undo's own clean-up cleared its mark:
+        it stayed in error, Recompute greyed)."""
+        feature = hs.make_thickness(self.sculpt, 2.0)
+        name = self.sculpt.Name
+        self.doc.openTransaction("Delete")
+        self.doc.removeObject(name)
+        self.doc.commitTransaction()
+        self.doc.recompute()
+        self.assertIn("Invalid", feature.State)
+        self.doc.undo()
+        self.sculpt = self.doc.getObject(name)
+        self.assertEqual(feature.Source, self.sculpt)
+        self.assertIn("Touched", feature.State)
+        self.doc.recompute()
+        self.check(feature, 2.0)
+
     def test_recomputes_after_each_stroke_and_its_undo(self):
         feature = hs.make_thickness(self.sculpt, 2.0)
         before = feature.Shape.Volume
@@ -66,6 +84,23 @@ class TestThickness(DocumentTestCase):
         self.doc.undo()  # the stroke: the thickness goes back with it
         self.assertAlmostEqual(feature.Shape.Volume, before, delta=1e-9 * before)
         self.assertAlmostEqual(feature.Shape.BoundBox.ZMax, top, delta=1e-9)
+
+    def test_a_held_strokes_frames_show_on_it_and_go_at_the_end(self):
+        """A GUI session's frames while a stroke is held show on the thickness (the sculpt hides
+        behind it: a drag showed only the rope); the frames gone, it is the stored face's again,
+        up to date (not touched), with no undo step of its own."""
+        from HapticSculpt.app.live_surface import read_state
+        feature = hs.make_thickness(self.sculpt, 2.0)
+        top, volume, steps = feature.Shape.BoundBox.ZMax, feature.Shape.Volume, self.doc.UndoCount
+        base = read_state(self.sculpt)
+        raised = np.asarray(self.sculpt.Proxy.surface.poles, float) + np.array([0.0, 0.0, 5.0])
+        self.sculpt.Proxy.live.show_poles(raised, base, preview=True)
+        self.assertAlmostEqual(feature.Shape.BoundBox.ZMax, top + 5.0, delta=1e-6)
+        self.sculpt.Proxy.live.reset_shape()
+        self.assertAlmostEqual(feature.Shape.BoundBox.ZMax, top, delta=1e-9)
+        self.assertAlmostEqual(feature.Shape.Volume, volume, delta=1e-9 * volume)
+        self.assertEqual(feature.State, ["Up-to-date"])
+        self.assertEqual(self.doc.UndoCount, steps)
 
     def test_recomputes_after_each_stroke_of_a_threaded_session(self):
         feature = hs.make_thickness(self.sculpt, 2.0)

@@ -352,7 +352,10 @@ def notify_dependents(obj: Any, frame: sculpt_state.SculptState | None = None) -
         proxy = getattr(parent, "Proxy", None)
         hook = getattr(proxy, "sculpt_changed" if frame is None else "sculpt_frame", None)
         if hook is not None:
+            touched = "Touched" in parent.State
             hook(parent) if frame is None else hook(parent, frame)
+            if not touched:  # (rebuilt, or showing a frame: nothing for a recompute to do; the tree
+                parent.purgeTouched()  # showed a solid touched after every session)
 
 
 def recompute_dependents(obj: Any) -> None:

@@ -125,12 +125,16 @@ def sculpt_of(obj: Any) -> Any:
 
 
 def sculpt_for(obj: Any) -> Any:
-    """The Sculpt to sculpt when ``obj`` is picked: itself, a SculptedSolid's sculpt, or None."""
+    """The Sculpt to sculpt when ``obj`` is picked: itself, a SculptedSolid's sculpt, a Thickness's
+    (the object a designer sees and selects: its sculpt is hidden behind it), or None."""
     from .sculpt_feature import is_sculpt
+    from .thickness import is_thickness
     if is_sculpt(obj):
         return obj
     if is_sculpted_solid(obj) and obj.Sculpts:
         return obj.Sculpts[0]
+    if is_thickness(obj) and obj.Source is not None:
+        return sculpt_for(obj.Source)
     return None
 
 

@@ -2,9 +2,10 @@
 by its ``Thickness`` along the face's normal, the gap closed into one solid (OCCT's offset with
 fill, as Part's Offset with Fill does).
 
-It is parametric: it links its Source sculpt, so it recomputes after each stroke (the sculpt's
-commit recomputes what is built on it, see :func:`live_surface.recompute_dependents`) and when its
-Thickness is edited. All state is in its two properties.
+It is parametric: it links its Source sculpt, so it is thickened again after each stroke, in the
+stroke's undo step (the sculpt's commit tells what is built on it, see
+:func:`live_surface.notify_dependents`), shows a session's held stroke as it goes, and recomputes
+when its Thickness is edited. All state is in its two properties.
 """
 from __future__ import annotations
 
@@ -60,10 +61,41 @@ class ThicknessFeature(TaggedProxy):
 
     def execute(self, obj: Any) -> None:
         """Recompute: the Source's face thickened (raises, marking the object, when it cannot be)."""
+        obj.Shape = self._solid(obj)
+
+    def sculpt_changed(self, obj: Any) -> None:
+        """Its sculpt's geometry was written (a stroke, an edit, the end of a session's preview):
+        thickened again now, in the same transaction. One that cannot be keeps its last shape and
+        says why in the report view (the stroke itself is kept)."""
+        try:
+            obj.Shape = self._solid(obj)
+        except ValueError as exc:
+            import FreeCAD
+            FreeCAD.Console.PrintError(f"HapticSculpt: {obj.Label}: {exc}\n")
+
+    def sculpt_frame(self, obj: Any, frame: Any) -> None:
+        """A session's frame while a stroke is held (GUI): the frame's face thickened, not stored
+        (the sculpt is hidden behind its thickness: a drag showed only the rope until let go). It
+        costs about 7 ms; a frame is skipped unless twice the last one's cost has passed since it."""
+        import time
+
+        from .sculpt_properties import face_of
+        now = time.perf_counter()
+        last, cost = getattr(self, "_preview", (-1.0, 0.0))
+        if now - last < 2.0 * cost:
+            return
+        try:
+            obj.Shape = thickened(face_of(frame), float(obj.Thickness.Value))
+        except ValueError:
+            pass  # (the last frame stays; the commit says what is wrong)
+        self._preview = (now, time.perf_counter() - now)
+
+    @staticmethod
+    def _solid(obj: Any) -> Any:
         source = obj.Source
         if source is None or not getattr(source, "Shape", None) or not source.Shape.Faces:
             raise ValueError(f"{obj.Label}: its Source has no face to thicken")
-        obj.Shape = thickened(source.Shape.Faces[0], float(obj.Thickness.Value))
+        return thickened(source.Shape.Faces[0], float(obj.Thickness.Value))
 
     def onDocumentRestored(self, obj: Any) -> None:
         ensure_properties(obj)

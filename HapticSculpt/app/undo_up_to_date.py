@@ -31,12 +31,16 @@ def ensure_observer() -> None:
 
 def purge_restored(doc: Any) -> None:
     """Clears the touched mark of each of ``doc``'s sculpts, solids and thicknesses that nothing it
-    is made from (a base solid, a face sculpt) still waits for a recompute."""
+    is made from (a base solid, a face sculpt) still waits for a recompute; one in error is marked
+    touched instead, so that Recompute mends it (its Source deleted, then brought back by Undo)."""
     ours = [o for o in doc.Objects if getattr(getattr(o, "Proxy", None), "Type", None) in TYPES]
+    for obj in ours:  # (one in error, its Source deleted and brought back: left to recompute)
+        if "Invalid" in obj.State or "Error" in obj.State:
+            obj.touch()
     cleared = True
     while cleared:  # (again after each clearing: a solid waits on its face sculpt's mark)
         cleared = False
         for obj in ours:
-            if "Touched" in obj.State and not any("Touched" in dep.State for dep in obj.OutListRecursive):
+            if "Touched" in obj.State and "Invalid" not in obj.State and not any("Touched" in dep.State for dep in obj.OutListRecursive):
                 obj.purgeTouched()
                 cleared = True
