@@ -413,6 +413,9 @@ def test_workbench_first_keys_stroke_undo_redo_paint(tmp_path, style):
         # restored patch settles under its constraints by ~1e-7 mm)
         assert sculpt(s)["session"]
         d.shot_changed(f"{style}_undone", pulled, "Undo")
+        # the cursor goes back onto the flat patch under the still pointer (it stayed in the air)
+        d.wait(lambda s: abs(next(o["cursor_at"] for o in s["overlays"] if o["cursor_at"])[2]) < 0.1,
+               "the cursor on the restored surface")
         d.shortcut("ctrl+shift+z", "Std_Redo")
         s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "Redo")
         assert np.array_equal(np.array(sculpt(s)["poles"]), stroke_poles), "Redo must restore the exact poles"
@@ -819,5 +822,41 @@ def test_a_clay_stroke_stays_where_it_was_left(tmp_path):
         kept = float(np.array(sculpt(s)["poles"]).reshape(-1, 3)[:, 2].max())
         assert abs(kept - rest) < 0.05, f"Stop kept {kept:.3f} mm, the face rested at {rest:.3f} mm"
         d.shot("clay_stroke_at_rest")
+    finally:
+        d.close()
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_the_airbrush_paints_its_own_sculpt_only_and_only_on_it(tmp_path):
+    """The airbrush turned on for one patch: a click on the background beside it (to give the view
+    the keyboard) paints nothing, where it painted the patch's nearest edge; a session on a second
+    patch sculpts it, where the drag painted the first one's map unseen, and the airbrush goes off."""
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        d.xdo("mousemove", "640", "400")
+        d.new_patch()
+        d.press_button("PaintStiffness", lambda s: s["painting"] == "stiffness", "the airbrush")
+        d.xdo("mousemove", "150", "650")  # (the view's lower left corner: background)
+        d.wait(lambda s: s["mouse_point"] is not None and not s["preselection"], "the mouse off the patch")
+        steps, plain = undo(d.state()), sculpt(d.state())["stiffness_map"]
+        d.xdo("click", "1")
+        s = d.wait_still(lambda s: (undo(s), sculpt(s)["stiffness_map"]), "the click's aftermath")
+        assert s == (steps, plain), f"a click on the background painted: {s}"
+        s = d.press_button("NewPatch", lambda s: len(s["docs"][s["active"]]["sculpts"]) == 2, "a second patch")
+        d.xdo("mousemove", "640", "400", "key", "--delay", "150", "v", "f")  # fit all
+        d.calibrate()
+        s = d.wait(lambda s: s["docs"][s["active"]]["sculpts"][1]["screen"], "the second patch on screen")
+        centre = d.to_screen(s["docs"][s["active"]]["sculpts"][1]["screen"][0])
+        d.xdo("mousemove", str(centre[0]), str(centre[1]), "click", "1")
+        name = s["docs"][s["active"]]["sculpts"][1]["name"]
+        d.wait(lambda s: [o for o, _ in s["selection"]] == [name], "the second patch selected")
+        s = d.press_button("Session", lambda s: s["session"], "the session on the second patch")
+        assert s["painting"] is None, "the first patch's airbrush stayed on for the second"
+        d.drag([centre] + [(centre[0], centre[1] - 10 * k) for k in range(1, 13)], seconds=0.8)
+        s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke's undo step")
+        lifted = next(x for x in s["docs"][s["active"]]["sculpts"] if x["name"] == name)
+        assert np.abs(np.array(lifted["poles"]).reshape(-1, 3)[:, 2]).max() > 2.0, "the drag did not sculpt"
+        assert sculpt(s)["stiffness_map"] == plain, "the drag painted the first patch"
+        d.press_button("Session", lambda s: not s["session"], "the session to stop")
     finally:
         d.close()

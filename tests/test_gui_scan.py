@@ -164,7 +164,8 @@ os._exit(0)
 @pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
 def test_a_session_beside_a_deviation_display_shows_one_hud(tmp_path):
     """One patch shows its deviation (legend, status line); a session on the other takes the view's
-    HUD while it runs (both printed in one place), and gives it back when it stops."""
+    HUD while it runs (both printed in one place), and gives it back when it stops. One cursor
+    shows, the session's."""
     os.makedirs(SHOTS, exist_ok=True)
     path = str(tmp_path / "two.FCStd")
     run_freecad_gui(f"PATH = {path!r}\n" + TWO, str(tmp_path))
@@ -185,6 +186,8 @@ def test_a_session_beside_a_deviation_display_shows_one_hud(tmp_path):
         d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sculpt001"], "the other patch selected")
         s = d.press_button("Session", lambda s: of(s, "Sculpt001")["session"] and "status" in hud(s, "Sculpt001")
                            and not hud(s, "Sculpt"), "the session's HUD alone")
+        d.wait(lambda s: [o["object"] for o in s["overlays"] if o["cursor"]] == ["Sculpt001"],
+               "one cursor, the session's (the deviation's overlay kept the mouse's last one)")
         # (the window shows the observer's state after Qt's next paint: wait for the legend to go)
         d.shot_showing("two_huds_session", lambda p: not legend_blue(p), "the legend gone")
         d.click_button("Session")

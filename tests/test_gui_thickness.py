@@ -1,7 +1,8 @@
 """A designer's first minutes, with real X events (xdotool) in FreeCAD's GUI under Xvfb: New patch
 with no document open makes one (its button is never greyed); Thicken asks the thickness in a task
 panel (typed, Enter), makes a Thickness that is one undo step and follows the next stroke, and a
-double-click on it opens the panel again to change it. Screenshots in build/screenshots/real_thick_*.png."""
+double-click on it opens the panel again to change it; a session on it shows a held drag on the
+slab as it goes (the sculpt is hidden behind it). Screenshots in build/screenshots/real_thick_*.png."""
 from __future__ import annotations
 
 import os
@@ -77,5 +78,26 @@ def test_new_patch_without_a_document_then_thicken_choosing_the_thickness(tmp_pa
         d.shortcut("ctrl+z", "Std_Undo")
         s = d.wait(lambda s: thickness(s)["thickness"] == 5.0 and abs(thickness(s)["volume"] - made["volume"]) < 1e-6,
                    "Undo of the edit")
+        # a session on it (the Thickness selected: its sculpt's): a held drag shows on the slab as it goes
+        d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
+        d.xdo("mousemove", "640", "500", "key", "1")  # front view: the slab's top rises up the screen
+        d.calibrate()
+        centre = d.to_screen(sculpt(d.state())["screen"][0])
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.wait(lambda s: s["preselection"], "the mouse over the slab")
+        d.xdo("mousedown", "1")
+        try:
+            for k in range(1, 13):
+                d.xdo("mousemove", str(centre[0]), str(centre[1] - 6 * k))
+                time.sleep(0.03)  # (a hand's pace)
+            d.wait(lambda s: thickness(s)["zmax"] > made["zmax"] + 2.0, "the slab following the held drag")
+            d.shot("thick_held_drag")
+        finally:
+            d.xdo("mouseup", "1")
+        s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke" and thickness(s)["state"] == ["Up-to-date"],
+                   "the stroke's undo step, the slab up to date")
+        assert thickness(s)["valid"] and thickness(s)["solids"] == 1 and thickness(s)["zmax"] > made["zmax"] + 2.0
+        d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
+        s = d.wait(lambda s: thickness(s)["state"] == ["Up-to-date"], "the slab up to date after the session")
     finally:
         d.close()

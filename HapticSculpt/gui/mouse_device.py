@@ -25,6 +25,7 @@ class MouseDevice:
         self._position = (0.0, 0.0, 0.0)
         self._grab_plane: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None
         self._pressed: tuple[Any, int, int] | None = None  # view and pixel of a press not yet a grab
+        self._pointer: tuple[Any, tuple[int, int]] | None = None  # view and pixel of the last move
 
     def attach(self, view: Any) -> None:
         """Follows the mouse in ``view`` (a FreeCADGui 3D view) until :meth:`detach`."""
@@ -64,9 +65,19 @@ class MouseDevice:
             else:
                 v = view.getPoint(x, y)
                 p = (float(v.x), float(v.y), float(v.z))
-        self._position = p
+        self._position, self._pointer = p, (view, (x, y))
         self.native.push(list(p), buttons=self._buttons)
         return p
+
+    def hover_again(self) -> None:
+        """The surface changed under a pointer that did not move (Undo, Redo): the cursor goes onto
+        it again, unless it grabs (it stayed where the surface was before)."""
+        if self._pointer is None or self._buttons or self._pressed is not None:
+            return
+        try:
+            self.move_to(*self._pointer)
+        except Exception:  # noqa: BLE001 - its view was closed: the cursor stays
+            self._pointer = None
 
     def press(self, held: bool, view: Any = None) -> None:
         """Button 1 (grab) held or released at the current cursor. A grab in ``view`` then moves the

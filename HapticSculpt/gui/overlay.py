@@ -78,6 +78,7 @@ class Overlay:
         self._curve_rows: tuple[str, list[tuple[str, Any]]] = ("", [])  # CurveConstraints text -> (kind, rows)
         self.hud: Hud | None = None  # the screen-space layer, made when the overlay first draws
         self.speaks: Any = lambda overlay: True  # whether its HUD is the view's one (set by the Controller)
+        self.mouse: Any = lambda overlay: None  # the mouse's cursor it shows, if any (set by the Controller)
         self.hidden_scan: Any = None  # the target's mesh the deviation display hid (it draws the points)
         self._root = coin.SoSeparator()
         self._root.setName("HapticSculptOverlay")
@@ -92,15 +93,15 @@ class Overlay:
     def needed(self) -> bool:
         """True while anything is to be drawn each frame."""
         return bool((self._session() is not None and self.live) or self.panel_visible
-                    or ((self.display != "shading" or self.combs or self.continuity) and self._visible()))
+                    or ((self.display != "shading" or self.combs or self.continuity) and self.visible()))
 
     @property
     def shown(self) -> bool:
         """True while anything is to be drawn at all: what runs each frame, and the constraint jacks,
         which show whenever the sculpt does (drawn once per change, no timer)."""
-        return self.needed or bool(self._visible() and (self.snapshot().constraints or self._curves_text()))
+        return self.needed or bool(self.visible() and (self.snapshot().constraints or self._curves_text()))
 
-    def _visible(self) -> bool:
+    def visible(self) -> bool:
         """The surface shows: the sculpt itself, or a shown SculptedSolid it is a face of."""
         from ..app.sculpted_solid import solid_of
         vobj = getattr(self.obj, "ViewObject", None)
@@ -208,8 +209,11 @@ class Overlay:
         return self.obj.Proxy.live.snapshot()
 
     def _update_cursor(self) -> None:
+        """A session's device cursor, else the mouse's, if the controller gives it this overlay."""
         session = self._session()
-        if session is not None:
+        if session is None:
+            self.cursor = self.mouse(self)
+        else:
             st = session.status()
             if "cursor" in st:
                 self.cursor = (np.asarray(st["cursor"], float), np.asarray(st["orientation"], float), bool(st["grab"]))
@@ -220,9 +224,11 @@ class Overlay:
         """Rebuilds the whole overlay from the current state."""
         from pivy import coin
         t0 = time.perf_counter()
-        if self.hidden_scan is not None and (self.display != "deviation" or getattr(self.obj, "Target", None) != self.hidden_scan):
-            self.show_scan()  # (the target cleared or changed, its Set target undone)
-        if self.display == "deviation" and self.hidden_scan is None and getattr(self.obj, "Target", None) is not None:
+        seen = self.visible()
+        if self.hidden_scan is not None and (self.display != "deviation" or not seen
+                                             or getattr(self.obj, "Target", None) != self.hidden_scan):
+            self.show_scan()  # (the target cleared or changed, its Set target undone, the sculpt hidden)
+        if self.display == "deviation" and seen and self.hidden_scan is None and getattr(self.obj, "Target", None) is not None:
             self.hide_scan()  # (a new target's mesh, or one set again by Redo)
         if not self.shown:
             self.stop()
@@ -237,7 +243,6 @@ class Overlay:
         light = coin.SoLightModel()
         light.model = coin.SoLightModel.BASE_COLOR
         legend = None
-        seen = self._visible()
         display = self.display if seen else "shading"
         glsl = stripe_shading.shaders_work() if self.per_pixel else False
         if display == "zebra" and glsl is None:
@@ -274,10 +279,7 @@ class Overlay:
         self.surface_drawn = seen and (display != "shading" or (self.combs or self.continuity or bool(s.constraints)
                                                                  or bool(self._curves_text())))
         self.cursor_shown = self.cursor is not None and self.needed  # (the jacks alone are not redrawn as the mouse moves)
-        if self.cursor_shown:
-            pickable = coin.SoPickStyle()  # (as it always was: a mouse grab that picks the cursor, not
-            pickable.style = coin.SoPickStyle.SHAPE  # the face, moves on the focal plane and lifts the face)
-            decor.addChild(pickable)
+        if self.cursor_shown:  # (unpickable too: the mouse put the cursor on its own ball, not the surface)
             decor.addChild(self._cursor(s, mesh))
         scene.addChild(decor)
         self._root.removeAllChildren()

@@ -120,6 +120,7 @@ class Controller:
         self.overlays: dict[tuple[int, str], Overlay] = {}
         self.inputs: list[ViewInput] = []
         self.mouse_point: np.ndarray | None = None
+        self._mouse_pixel: tuple[int, int] | None = None  # where mouse_point was taken, in mouse_view
         self.mouse_view: Any = None  # the view the mouse was last seen in
         self.mouse_object: Any = None  # the sculpt under the mouse there, if any
         self.session: Any = None
@@ -128,6 +129,7 @@ class Controller:
         self._observer: Any = None
         self.last_map = "mass"
         self.painting: str | None = None  # the map the airbrush paints, None when off
+        self._painting_sculpt: Any = None  # the sculpt it was turned on for (it paints no other)
         self._paint_stroke: Any = None  # the sculpt being painted while the button is held
         self._paint_target = 0.0
         self._paint_path: list[tuple[float, float]] = []  # where the stroke's dabs went (map coordinates)
@@ -203,9 +205,9 @@ class Controller:
         sel = [sculpt_for(o) for o in Gui.Selection.getSelection() if sculpt_for(o) is not None]
         if sel:
             return sel[0]
-        if self.mouse_object is not None and _alive(self.mouse_object):
-            return self.mouse_object
         doc = FreeCAD.ActiveDocument
+        if self.mouse_object is not None and _alive(self.mouse_object) and self.mouse_object.Document == doc:
+            return self.mouse_object  # (another document's, last under the mouse: a session started there, unseen)
         sculpts = [o for o in doc.Objects if is_sculpt(o)] if doc is not None else []
         return sculpts[0] if len(sculpts) == 1 else None
 
@@ -223,6 +225,7 @@ class Controller:
             self.overlays[key] = Overlay(view, obj)
             self.overlays[key].mode = f"airbrush: {self.painting}" if self.painting else ""
             self.overlays[key].speaks = self.speaks
+            self.overlays[key].mouse = self.mouse_cursor
         return self.overlays[key]
 
     def speaks(self, overlay: Overlay) -> bool:
@@ -240,6 +243,16 @@ class Controller:
             if active is not None and ov.obj == active:
                 return ov is overlay
         return drawing[0] is overlay
+
+    def mouse_cursor(self, overlay: Overlay) -> tuple[np.ndarray, np.ndarray, bool] | None:
+        """The mouse's cursor (position, orientation, grab) if ``overlay`` shows it: the airbrush's,
+        on the active sculpt's overlay in the view the mouse is in, while no session runs (its
+        device's cursor is the one). (Each overlay kept the last point it had: a view showed a
+        cursor per sculpt; and one following the mouse with a display on looked like a session.)"""
+        if self.mouse_point is None or self.painting is None or overlay.view is not self.mouse_view or (
+                self.session is not None and self.session.running) or overlay.obj != self.active_sculpt():
+            return None
+        return self.mouse_point, np.array([1.0, 0, 0, 0]), self._paint_stroke is not None
 
     def view_of(self, obj: Any) -> Any:
         """A 3D view of ``obj``'s document: the one the mouse was last in, else the active one, else
@@ -291,13 +304,12 @@ class Controller:
         if view is not self.mouse_view:
             self._follow(view)
         self.mouse_view = view
-        self.mouse_point = self.point_at(view, int(pos[0]), int(pos[1]))
+        self._mouse_pixel = (int(pos[0]), int(pos[1]))
+        self.mouse_point = self.point_at(view, *self._mouse_pixel)
         if self._paint_stroke is not None:
             self._dab_to(self._paint_stroke, self.mouse_point)
             cb.setHandled()
-        ov = self.overlay(view=view)
-        if ov is not None and ov.obj.Proxy.live.session is None:
-            ov.cursor = (self.mouse_point, np.array([1.0, 0, 0, 0]), self._paint_stroke is not None)
+        self.overlay(view=view)  # (the active sculpt's, drawing the mouse's cursor: see mouse_cursor)
 
     def on_button(self, view: Any, cb: Any) -> None:
         from pivy import coin
@@ -315,10 +327,11 @@ class Controller:
         self.mouse_view = view
         if event.getState() == coin.SoButtonEvent.DOWN:
             self.mouse_point = self.point_at(view, int(pos[0]), int(pos[1]))
-            self.begin_paint_stroke()
-        else:
+            if self.begin_paint_stroke():
+                cb.setHandled()
+        elif self._paint_stroke is not None:
             self.end_paint_stroke()
-        cb.setHandled()
+            cb.setHandled()
 
     def panel_at(self, view: Any, pixel: tuple[int, int]) -> bool:
         """True if a slider of a panel shown in ``view`` is under ``pixel`` (the mouse device leaves
@@ -375,6 +388,7 @@ class Controller:
         if which is not None and which not in MAP_CYCLE:
             raise ValueError(f"which: one of {', '.join(MAP_CYCLE)}")
         self.painting = None if which is None or which == self.painting else which
+        self._painting_sculpt = self.active_sculpt() if self.painting is not None else None
         if self.session is not None and self.session.running:
             self.session.set_airbrush(self.painting, factor=airbrush_factor(self.painting))
         for ov in self.overlays.values():
@@ -383,19 +397,38 @@ class Controller:
             self.set_display(self.painting)
         return self.painting
 
-    def begin_paint_stroke(self) -> None:
-        """Button down with the airbrush on: the first dab at the cursor."""
+    def airbrush_for(self, obj: Any) -> bool:
+        """Whether the airbrush is on for ``obj``; turned off (said in the report view) if it was on
+        for another sculpt: a stroke on a new patch, in another document, painted that map unseen
+        where a designer meant to sculpt."""
+        if self.painting is None:
+            return False
+        if obj is not None and obj == self._painting_sculpt:
+            return True
+        import FreeCAD
+        was, which = self._painting_sculpt, self.painting
+        was = was.Label if was is not None and _alive(was) else "another sculpt"
+        self.set_painting(None)
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: the airbrush is off: it painted the {which} map of {was} (Paint "
+                                     f"{which}, in the Material drop-down or the HapticSculpt menu, turns it on here)\n")
+        return False
+
+    def begin_paint_stroke(self) -> bool:
+        """Button down with the airbrush on: the first dab at the cursor. False (no stroke) where the
+        press is off the sculpt (a click on the background to take the keyboard painted its nearest
+        edge) or the airbrush is another sculpt's (it goes off)."""
         if self._paint_stroke is not None:
             self.end_paint_stroke()  # a release that never reached the view still ends its stroke
         obj = self.active_sculpt()
-        if obj is None or self.painting is None or self.mouse_point is None:
-            return
+        if obj is None or self.mouse_point is None or self.mouse_object != obj or not self.airbrush_for(obj):
+            return False
         self._paint_stroke = obj
         surface = obj.Proxy.live.surface
         # One target for the whole stroke (as the session's airbrush), so dabs saturate at it.
         self._paint_target = airbrush_factor(self.painting) * float(np.mean(getattr(surface, self.painting + "_map").values))
         self._paint_path = []
         self._dab_to(obj, self.mouse_point)
+        return True
 
     def end_paint_stroke(self) -> None:
         """Button up: the stroke becomes one undo step, as the scripting call that paints it (the
@@ -455,7 +488,11 @@ class Controller:
         ov = self.overlay()
         if ov is None:
             return
-        if display == "deviation" and ov.display != "deviation":
+        if display != "shading" and not ov.visible():
+            import FreeCAD  # (the scan stayed hidden, nothing drawn in its place, nothing said)
+            FreeCAD.Console.PrintWarning(f"HapticSculpt: {ov.obj.Label} is hidden{hidden_by(ov.obj)}: its {display} "
+                                         "display shows once it is shown (select it, Space)\n")
+        elif display == "deviation" and ov.display != "deviation":
             ov.hide_scan()
         elif display != "deviation" and ov.display == "deviation":
             ov.show_scan()
@@ -514,6 +551,7 @@ class Controller:
             device = MouseDevice(yields=self.panel_at)
             device.attach_all([i.view for i in self.inputs] or [self.view()])
         self.mouse = device if isinstance(device, MouseDevice) else None
+        self.airbrush_for(obj)
         session = Session()
         session.set_airbrush(self.painting, factor=airbrush_factor(self.painting))  # before the first tick can grab
         self.session = session.start(obj, device, tool=obj.Proxy.live.snapshot().tool.name, haptic_rate=rate)
@@ -522,7 +560,8 @@ class Controller:
         if pull["target"] and pull["enabled"]:
             import FreeCAD  # (it moves the surface from the first step, a stroke or none)
             FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label} is pulled toward its scan while the session "
-                                         "runs (Displays > Pull toward scan switches it off)\n")
+                                         "runs (Pull toward scan, in the Displays drop-down or the HapticSculpt "
+                                         "menu, switches it off)\n")
         return self.session
 
     @staticmethod
@@ -565,7 +604,14 @@ class Controller:
             ov.refresh()
 
     def refresh_all(self) -> None:
-        """Redraws every overlay (after Undo or Redo)."""
+        """Redraws every overlay (after Undo or Redo), the cursor on the restored surface."""
+        if self.mouse is not None:
+            self.mouse.hover_again()
+        elif self.mouse_view is not None and self._mouse_pixel is not None:
+            try:
+                self.mouse_point = self.point_at(self.mouse_view, *self._mouse_pixel)
+            except Exception:  # noqa: BLE001 - its view was closed
+                self._mouse_pixel = None
         for ov in list(self.overlays.values()):
             if _alive(ov.obj):
                 ov.refresh()
@@ -605,6 +651,12 @@ class _UndoObserver:
 
     def slotRedoDocument(self, doc: Any) -> None:
         self.ctl.refresh_all()
+
+
+def hidden_by(sculpt: Any) -> str:
+    """The text ' behind X' naming the shown objects made from ``sculpt`` (a Thickness hides it), or ''."""
+    shown = [o.Label for o in sculpt.InList if getattr(getattr(o, "ViewObject", None), "Visibility", False)]
+    return f" behind {', '.join(shown)}" if shown else ""
 
 
 def _alive(obj: Any) -> bool:
