@@ -836,8 +836,11 @@ def test_the_airbrush_paints_its_own_sculpt_only_and_only_on_it(tmp_path):
         d.xdo("mousemove", "640", "400")
         d.new_patch()
         d.press_button("PaintStiffness", lambda s: s["painting"] == "stiffness", "the airbrush")
-        d.xdo("mousemove", "150", "650")  # (the view's lower left corner: background)
-        d.wait(lambda s: s["mouse_point"] is not None and not s["preselection"], "the mouse off the patch")
+        d.calibrate()
+        corner = d.to_screen([30, 30])  # (a corner of the 3D view, whichever FreeCAD lays out around it)
+        over = d.state()["mouse_point"]
+        d.xdo("mousemove", str(corner[0]), str(corner[1]))
+        d.wait(lambda s: s["mouse_point"] not in (None, over) and not s["preselection"], "the mouse off the patch")
         steps, plain = undo(d.state()), sculpt(d.state())["stiffness_map"]
         d.xdo("click", "1")
         s = d.wait_still(lambda s: (undo(s), sculpt(s)["stiffness_map"]), "the click's aftermath")
