@@ -76,19 +76,10 @@ class ThicknessFeature(TaggedProxy):
     def sculpt_frame(self, obj: Any, frame: Any) -> None:
         """A session's frame while a stroke is held (GUI): the frame's face thickened, not stored
         (the sculpt is hidden behind its thickness: a drag showed only the rope until let go). It
-        costs about 7 ms; a frame is skipped unless twice the last one's cost has passed since it."""
-        import time
-
+        costs about 7 ms (see :func:`frame_preview.show_frame`)."""
+        from .frame_preview import show_frame
         from .sculpt_properties import face_of
-        now = time.perf_counter()
-        last, cost = getattr(self, "_preview", (-1.0, 0.0))
-        if now - last < 2.0 * cost:
-            return
-        try:
-            obj.Shape = thickened(face_of(frame), float(obj.Thickness.Value))
-        except ValueError:
-            pass  # (the last frame stays; the commit says what is wrong)
-        self._preview = (now, time.perf_counter() - now)
+        show_frame(self, obj, lambda: thickened(face_of(frame), float(obj.Thickness.Value)))
 
     @staticmethod
     def _solid(obj: Any) -> Any:
