@@ -827,15 +827,24 @@ def test_a_clay_stroke_stays_where_it_was_left(tmp_path):
 
 
 @pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
-def test_the_airbrush_paints_its_own_sculpt_only(tmp_path):
-    """The airbrush turned on for one patch: a session on a second patch sculpts it, where the drag
-    painted the first one's map unseen, and the airbrush goes off."""
+def test_the_airbrush_paints_its_own_sculpt_only_and_only_on_it(tmp_path):
+    """The airbrush turned on for one patch: a click on the background beside it (to give the view
+    the keyboard) paints nothing, where it painted the patch's nearest edge; a session on a second
+    patch sculpts it, where the drag painted the first one's map unseen, and the airbrush goes off."""
     d = Desktop(str(tmp_path), "CAD")
     try:
         d.xdo("mousemove", "640", "400")
         d.new_patch()
         d.press_button("PaintStiffness", lambda s: s["painting"] == "stiffness", "the airbrush")
-        plain = sculpt(d.state())["stiffness_map"]
+        d.calibrate()
+        corner = d.to_screen([30, 30])  # (a corner of the 3D view, whichever FreeCAD lays out around it)
+        over = d.state()["mouse_point"]
+        d.xdo("mousemove", str(corner[0]), str(corner[1]))
+        d.wait(lambda s: s["mouse_point"] not in (None, over) and not s["preselection"], "the mouse off the patch")
+        steps, plain = undo(d.state()), sculpt(d.state())["stiffness_map"]
+        d.xdo("click", "1")
+        s = d.wait_still(lambda s: (undo(s), sculpt(s)["stiffness_map"]), "the click's aftermath")
+        assert s == (steps, plain), f"a click on the background painted: {s}"
         s = d.press_button("NewPatch", lambda s: len(s["docs"][s["active"]]["sculpts"]) == 2, "a second patch")
         d.xdo("mousemove", "640", "400", "key", "--delay", "150", "v", "f")  # fit all
         d.calibrate()

@@ -415,11 +415,12 @@ class Controller:
 
     def begin_paint_stroke(self) -> bool:
         """Button down with the airbrush on: the first dab at the cursor. False (no stroke) where the
-        airbrush is another sculpt's (it goes off)."""
+        press is off the sculpt (a click on the background to take the keyboard painted its nearest
+        edge) or the airbrush is another sculpt's (it goes off)."""
         if self._paint_stroke is not None:
             self.end_paint_stroke()  # a release that never reached the view still ends its stroke
         obj = self.active_sculpt()
-        if obj is None or self.mouse_point is None or not self.airbrush_for(obj):
+        if obj is None or self.mouse_point is None or self.mouse_object != obj or not self.airbrush_for(obj):
             return False
         self._paint_stroke = obj
         surface = obj.Proxy.live.surface
