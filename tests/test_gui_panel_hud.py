@@ -137,6 +137,24 @@ def test_each_slider_drag_is_one_undo_step_and_never_a_stroke(tmp_path):
             for k in range(len(SLIDERS)):
                 check_drag(d, k, 1e-6, f"{view} view")
             d.shot(f"panel_{view}_idle")
+        # Shift held during the drag: the knob moves a tenth as far as the mouse (60 pixels took
+        # stiffness from 100 to 2190); the mouse lets go before Shift does
+        k = 2
+        s = d.state()
+        x0, y0, x1, y1 = overlay(s)["hud"][f"track{k + 1}"]
+        f, before = overlay(s)["sliders"][k][3], undo(s)
+        x, y = d.to_screen([x0 + f * (x1 - x0), (y0 + y1) / 2])
+        d.xdo("mousemove", str(x), str(y))
+        time.sleep(0.2)
+        d.xdo("mousedown", "1", "keydown", "shift", "mousemove", str(x + 1), str(y))
+        for dx in (20, 40, 61):
+            time.sleep(0.1)
+            d.xdo("mousemove", str(x + dx), str(y))
+        time.sleep(0.1)
+        d.xdo("mouseup", "1", "keyup", "shift")
+        s = d.wait(lambda s: undo(s)[0] == "Set stiffness" and undo(s)[1:6] == before[:5], "the fine drag's step")
+        moved = overlay(s)["sliders"][k][3] - f
+        assert abs(moved - 60 / (x1 - x0) / 10) < 0.008, (f, moved, 60 / (x1 - x0))
         assert sculpt(d.state())["strokes"] == 0
     finally:
         d.close()

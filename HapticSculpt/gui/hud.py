@@ -12,6 +12,7 @@ so its white text reads on any background (white zebra stripes too).
 """
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -37,6 +38,16 @@ TRACK_COLOUR, KNOB_COLOUR = (0.6, 0.6, 0.6), (0.3, 0.8, 1.0)
 PAD = 6  # a backing's margin around what it backs
 BACKING, BACKING_ALPHA = (0.08, 0.08, 0.1), 0.75  # dark, and opaque enough for white text on white
 BACK_Z, FRONT_Z = -0.5, 0.0  # backings behind the items they back (the camera looks down -z from z = 1)
+
+
+def readable(value: float) -> str:
+    """A slider's value in plain decimals to three significant figures: 2190, 0.0123, 0.0001 (never
+    2.19e+03)."""
+    if value == 0 or not math.isfinite(value):
+        return f"{value:g}"
+    decimals = max(0, 2 - math.floor(math.log10(abs(value))))
+    text = f"{value:.{decimals}f}"
+    return text.rstrip("0").rstrip(".") if "." in text else text
 
 
 class Hud:
@@ -109,7 +120,7 @@ class Hud:
         top-left corner to the status lines (``floor``), left of the navigation cube's corner. The
         first layout that fits: each text over its track in one column; text and track side by
         side (a low view); either in more columns; else the first, running past the floor."""
-        texts = [f"{k + 1}  {label} {value:.3g}" for k, (label, value, _, _) in enumerate(sliders)]
+        texts = [f"{k + 1}  {label} {readable(value)}" for k, (label, value, _, _) in enumerate(sliders)]
         chars = max(len(f"{k + 1}  {label} ") + 9 for k, (label, *_) in enumerate(sliders))  # (9: any value)
         top, room = h - MARGIN - PAD, w - CUBE_CORNER - MARGIN  # (room: where a column may end)
         layouts = []  # (row height, track's offset right of the text, column width)

@@ -312,11 +312,12 @@ class Overlay:
         self.frame()
         return True
 
-    def panel_drag(self, x: float) -> bool:
-        """The mouse moved to view pixel column x: True if a slider is held (it followed)."""
+    def panel_drag(self, x: float, fine: bool = False) -> bool:
+        """The mouse moved to view pixel column x (``fine``: Shift held): True if a slider is held
+        (it followed)."""
         if self.panel.held is None:
             return False
-        self.panel.drag(x)
+        self.panel.drag(x, fine)
         self.frame()
         return True
 

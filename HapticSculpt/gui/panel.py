@@ -6,7 +6,9 @@ The HUD lays the tracks out (in a column, one under another, so they never overl
 tells where they went; :class:`SliderPanel` reads the mouse against them: a press on a track takes
 that slider (the value jumps to the press), a drag sets its value (shown at once), the release
 commits it as one undo step through the scripting call. A slider drag never reaches the 3D cursor,
-so it is never a stroke. Nothing is retained but which slider is held.
+so it is never a stroke. With Shift held the knob moves a tenth as far as the mouse (a track spans
+up to five decades: 60 pixels took stiffness from 100 to 2,190). Values are kept to two significant
+figures (three with Shift) and shown in plain decimals. Nothing is retained but which slider is held.
 """
 from __future__ import annotations
 
@@ -28,6 +30,15 @@ ZERO_AT_LEFT = ("bending", "pull")
 
 #: A tool setting's slider spans this factor either side of its declared default (log scale).
 TOOL_RANGE = 10.0
+#: With Shift held, the knob moves this many times less than the mouse.
+FINE = 10.0
+
+
+def rounded(value: float, figures: int) -> float:
+    """``value`` to ``figures`` significant figures (a slider's value: 2200, not 2187.76)."""
+    if value <= 0 or not math.isfinite(value):
+        return value
+    return round(value, figures - 1 - math.floor(math.log10(value)))
 
 
 def tool_sliders(tool: str, scale: float = 1.0) -> list[tuple[str, str, float, float]]:
@@ -76,6 +87,8 @@ class SliderPanel:
         self.pending: float | None = None  # the held slider's value while dragging
         self._track: Box | None = None  # the held slider's track
         self._scale = 1.0  # the held sculpt's tool scale
+        self._knob = 0.0  # the held knob's position (0..1)
+        self._fine_from: tuple[float, float] | None = None  # (mouse x, knob) where Shift went down
 
     # --- values -----------------------------------------------------------------------------------
     @staticmethod
@@ -138,22 +151,32 @@ class SliderPanel:
         name = self.track_at(x, y, tracks)
         if name is None:
             return False
-        self.held, self._track, self._scale = name, tracks[name], _scale(obj)
+        self.held, self._track, self._scale, self._fine_from = name, tracks[name], _scale(obj), None
         self.drag(x)
         return True
 
-    def drag(self, x: float) -> None:
-        """The held slider follows the mouse along its track."""
-        if self.held is not None and self._track is not None:
-            x0, _, x1, _ = self._track
-            self.pending = self.from_fraction(self.held, (x - x0) / max(x1 - x0, 1.0), self._scale)
+    def drag(self, x: float, fine: bool = False) -> None:
+        """The held slider follows the mouse along its track; ``fine`` (Shift held) a tenth as far,
+        from where the knob was when Shift went down."""
+        if self.held is None or self._track is None:
+            return
+        x0, _, x1, _ = self._track
+        width = max(x1 - x0, 1.0)
+        if fine:
+            if self._fine_from is None:
+                self._fine_from = (x, self._knob)
+            f = self._fine_from[1] + (x - self._fine_from[0]) / width / FINE
+        else:
+            self._fine_from, f = None, (x - x0) / width
+        self._knob = float(np.clip(f, 0.0, 1.0))
+        self.pending = rounded(self.from_fraction(self.held, self._knob, self._scale), 3 if fine else 2)
 
     def release(self, obj: Any) -> bool:
         """Button up: the held slider's value becomes one undo step (True if one was held)."""
         if self.held is None:
             return False
         name, value = self.held, self.pending
-        self.held, self.pending, self._track = None, None, None
+        self.held, self.pending, self._track, self._fine_from = None, None, None, None
         if value is not None:
             self.apply(obj, name, value)
         return True

@@ -297,8 +297,9 @@ class Controller:
     def on_move(self, view: Any, cb: Any) -> None:
         from .view_focus import give_keyboard_to_view
         give_keyboard_to_view(view)  # (keys and ctrl+z reach it, whoever had them last)
-        pos = cb.getEvent().getPosition()
-        if any(ov.panel_drag(float(pos[0])) for ov in self.overlays.values()):
+        event = cb.getEvent()
+        pos = event.getPosition()
+        if any(ov.panel_drag(float(pos[0]), bool(event.wasShiftDown())) for ov in self.overlays.values()):
             cb.setHandled()  # a slider drag: neither a stroke nor a rotation
             return
         if view is not self.mouse_view:
