@@ -89,15 +89,23 @@ def frame(du: np.ndarray, dv: np.ndarray) -> np.ndarray:
     return np.column_stack([u, v, n])
 
 
-def coloured_mesh(mesh: np.ndarray, colours: np.ndarray, quads: list[int] | None = None) -> Any:
-    """The mesh as triangles with per-vertex colours, unlit, pulled a hair toward the viewer so it
-    covers the shaded face (``quads``: the grid's cells to draw, all when None)."""
+def coloured_mesh(mesh: np.ndarray, colours: np.ndarray, quads: list[int] | None = None, lit: bool = False) -> Any:
+    """The mesh as triangles with per-vertex colours, pulled a hair toward the viewer so it covers
+    the shaded face (``quads``: the grid's cells to draw, all when None). Unlit, the colours are
+    exact (a legend's); ``lit``, the view's light shades them on both sides as it does the face, so
+    the shape shows through (a bump under a uniform material map vanished unlit)."""
     from pivy import coin
     g, h = mesh.shape[:2]
     sep = coin.SoSeparator()
-    light = coin.SoLightModel()
-    light.model = coin.SoLightModel.BASE_COLOR
-    sep.addChild(light)
+    if lit:
+        hints = coin.SoShapeHints()  # smooth normals, lit on both sides
+        hints.vertexOrdering = coin.SoShapeHints.UNKNOWN_ORDERING
+        hints.creaseAngle = math.pi
+        sep.addChild(hints)
+    else:
+        light = coin.SoLightModel()
+        light.model = coin.SoLightModel.BASE_COLOR
+        sep.addChild(light)
     offset = coin.SoPolygonOffset()
     offset.factor = -1.0
     offset.units = -1.0

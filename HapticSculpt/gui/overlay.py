@@ -256,7 +256,8 @@ class Overlay:
         elif display != "shading":
             colours, rng = self._colours(s, mesh)
             scene.addChild(shapes.coloured_mesh(mesh, colours, self._cells(mesh.shape[:2], s.mesh_parameters_u,
-                                                                           s.mesh_parameters_v)))
+                                                                           s.mesh_parameters_v),
+                                                lit=display in MAPS))  # (a material map says nothing of the shape)
             legend = (self.display, rng)
             if display == "deviation" and self._target() is not None:
                 scene.addChild(self._scan_points(s, rng))
