@@ -16,7 +16,7 @@ TRACK = (100.0, 10.0, 320.0, 20.0)  # a 220-pixel track (the HUD's), view pixels
 class TestSliderValues(DocumentTestCase):
     def test_values_read_in_plain_decimals(self):
         for value, text in ((2190.0, "2190"), (100.0, "100"), (12.34, "12.3"), (0.0123, "0.0123"),
-                            (1e-4, "0.0001"), (0.1, "0.1"), (0.0, "0"), (1e5, "100000")):
+                            (1e-4, "0.0001"), (3.2e-17, "0"), (-0.5, "-0.5"), (0.1, "0.1"), (0.0, "0"), (1e5, "100000")):
             self.assertEqual(readable(value), text)
 
     def test_values_are_rounded_to_significant_figures(self):

@@ -453,12 +453,20 @@ def test_the_bending_map_is_painted_and_shown_like_the_other_maps(tmp_path):
         assert lo == hi == 10.0, "a new patch bends (api.FAIR_BENDING)"
         d.press_button("PaintBending", lambda s: s["painting"] == "bending", "the bending airbrush")
         d.wait(lambda s: any(o["display"] == "bending" for o in s["overlays"]), "the bending map shown")
+        # a uniform map's legend: one swatch and its value (both ends of a ramp read "10")
+        def map_hud(s: dict, item: str) -> dict | None:
+            return next((o["hud"] for o in s["overlays"] if o["display"] == "bending" and item in o["hud"]), None)
+
+        hud = map_hud(d.wait(lambda s: map_hud(s, "legend_bar"), "the map's legend"), "legend_bar")
+        assert "legend_hi" not in hud and hud["legend_bar"][3] - hud["legend_bar"][1] < 40, hud
+        d.shot("bending_uniform")
         before = undo(d.state())[0]
         d.drag([west, ((west[0] + centre[0]) // 2, (west[1] + centre[1]) // 2), east], seconds=0.1)
         s = d.wait(lambda s: undo(s)[0] == "Paint bending", f"one paint step (was {before})")
         lo, hi, n = sculpt(s)["bending_map"]
         assert n > 1 and lo == 10.0 and hi > 15.0, (lo, hi, n)  # (toward 3x its mean along the line)
         assert undo(s)[1] == before
+        d.wait(lambda s: map_hud(s, "legend_hi"), "the painted map's range in its legend")
         painted = d.shot("bending_painted")
         d.press_button("PaintBending", lambda s: s["painting"] is None, "the airbrush off")
         d.xdo("mousemove", str(centre[0]), str(centre[1]))

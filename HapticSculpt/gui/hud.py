@@ -41,11 +41,11 @@ BACK_Z, FRONT_Z = -0.5, 0.0  # backings behind the items they back (the camera l
 
 
 def readable(value: float) -> str:
-    """A slider's value in plain decimals to three significant figures: 2190, 0.0123, 0.0001 (never
-    2.19e+03)."""
+    """A slider's value in plain decimals to three significant figures, six decimals at most: 2190,
+    0.0123, 0.0001, 0 for 3e-17 (never 2.19e+03)."""
     if value == 0 or not math.isfinite(value):
         return f"{value:g}"
-    decimals = max(0, 2 - math.floor(math.log10(abs(value))))
+    decimals = min(6, max(0, 2 - math.floor(math.log10(abs(value)))))
     text = f"{value:.{decimals}f}"
     return text.rstrip("0").rstrip(".") if "." in text else text
 
@@ -199,8 +199,17 @@ class Hud:
             x1 = w - CUBE_CORNER - MARGIN
             top = h - MARGIN - PAD - head
             bottom = max(floor, top - 0.6 * h)
+        # A material map the same everywhere: one swatch and its value (its two ends read alike).
+        # Zebra: a bar as tall as its bands need (its backing was a tall, mostly empty box).
+        uniform = display not in UNITS and display != "zebra" and rng[1] - rng[0] <= 1e-6 * max(abs(rng[0]), 1.0)
+        if uniform:
+            bottom = max(bottom, top - 2 * FONT_SIZE)
+        elif display == "zebra":
+            bottom = max(bottom, top - max(8.0 * zebra_bands, 96.0))
         t = np.linspace(0.0, 1.0, 33)
-        if display == "curvature":  # two bars: u in green, v in blue, each from 0 to the top value
+        if uniform:
+            bars = [("", analysis.pseudo_colour(np.zeros(2), 0.0, 1.0)[0], TEXT)]
+        elif display == "curvature":  # two bars: u in green, v in blue, each from 0 to the top value
             bars = [("u", np.outer(t, U_COLOUR), U_LABEL), ("v", np.outer(t, V_COLOUR), V_LABEL)]
         elif display == "zebra":
             bands = np.arange(int(zebra_bands) + 1) % 2  # (one more: _bar draws n - 1 quads for n colours)
@@ -216,7 +225,9 @@ class Hud:
             if name:
                 self._text(name, bx + 4, top + 4, label, f"legend_{name}", w)
         units = UNITS.get(display, "")
-        if display != "zebra":
+        if uniform:
+            self._text(f"{readable(rng[0])} everywhere", x0 - 6, bottom, TEXT, "legend_lo", w, right=True)
+        elif display != "zebra":
             self._text(f"{rng[1]:.3g}{units}", x0 - 6, top - FONT_SIZE, TEXT, "legend_hi", w, right=True)
             self._text(f"{rng[0]:.3g}{units}", x0 - 6, bottom, TEXT, "legend_lo", w, right=True)
         if display == "deviation" and rng[1] > rng[0]:  # the band within the tolerance, labelled at its middle
