@@ -46,7 +46,7 @@ def test_new_patch_without_a_document_then_thicken_choosing_the_thickness(tmp_pa
         centre = d.to_screen(sculpt(s)["screen"][0])
         d.xdo("mousemove", str(centre[0]), str(centre[1]))
         d.wait(lambda s: s["mouse_point"] is not None, "the mouse over the patch")
-        # zebra stripes on the patch: they go with it when the Thickness hides it
+        # zebra stripes on the patch: they go onto the slab's top when the Thickness hides it
         d.press_button("Zebra", lambda s: any(o["display"] == "zebra" and o["surface_drawn"] for o in s["overlays"]),
                        "the zebra stripes")
         # nothing selected: Thicken takes the document's only sculpt
@@ -62,8 +62,10 @@ def test_new_patch_without_a_document_then_thicken_choosing_the_thickness(tmp_pa
         assert made["state"] == ["Up-to-date"] and made["visible"], made
         assert 0.85 * 5e4 < made["volume"] < 1.15 * 5e4, made  # 100 x 100 mm by 5 mm (a flat patch)
         assert undo(s)[0] == "Thicken", undo(s)[:3]
-        s = d.wait(lambda s: not any(o["surface_drawn"] for o in s["overlays"]), "the stripes hidden with the sculpt")
-        assert [o["display"] for o in s["overlays"]] == ["zebra"]  # (kept: they show again with the sculpt)
+        s = d.wait(lambda s: any(o["surface_drawn"] and o["offset"] == 5.0 for o in s["overlays"]),
+                   "the stripes on the slab's top, 5 mm up")
+        assert [o["display"] for o in s["overlays"]] == ["zebra"]
+        assert made["zmax"] > 4.9, made  # (the slab lies on the side the stripes went)
         top = d.shot("thick_made")
         d.xdo("mousemove", "640", "500", "key", "0")  # isometric: the slab's side shows
         shot_changed(d, "thick_made_isometric", top)

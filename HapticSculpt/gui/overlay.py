@@ -102,14 +102,31 @@ class Overlay:
         return self.needed or bool(self.visible() and (self.snapshot().constraints or self._curves_text()))
 
     def visible(self) -> bool:
-        """The surface shows: the sculpt itself, or a shown SculptedSolid it is a face of."""
+        """The surface shows: the sculpt itself, a shown SculptedSolid it is a face of, or a shown
+        Thickness made from it (drawn on the slab's face: :meth:`offset`)."""
         from ..app.sculpted_solid import solid_of
         vobj = getattr(self.obj, "ViewObject", None)
         if vobj is None or vobj.Visibility:
             return True
         solid = solid_of(self.obj)
         svobj = getattr(solid, "ViewObject", None) if solid is not None else None
-        return bool(svobj is not None and svobj.Visibility)
+        return bool(svobj is not None and svobj.Visibility) or self._thickness() is not None
+
+    def _thickness(self) -> Any:
+        """A shown Thickness made from this sculpt, which hides it, else None."""
+        from ..app.thickness import is_thickness
+        vobj = getattr(self.obj, "ViewObject", None)
+        if vobj is None or vobj.Visibility:
+            return None
+        return next((o for o in self.obj.InList if is_thickness(o)
+                     and getattr(getattr(o, "ViewObject", None), "Visibility", False)), None)
+
+    def offset(self) -> float:
+        """How far along the surface's normal the displays are drawn (mm): a shown Thickness's
+        value where it is positive, so they lie on the slab's face on that side (the sculpt's own
+        face is then inside the slab, where they could not be seen); else 0."""
+        thickness = self._thickness()
+        return max(float(thickness.Thickness.Value), 0.0) if thickness is not None else 0.0
 
     def _session(self) -> Any:
         live = getattr(self.obj.Proxy, "live", None)  # (None while its document is being read)
@@ -236,6 +253,9 @@ class Overlay:
         self._update_cursor()
         s = self.snapshot()
         mesh = np.array(s.mesh)
+        offset = self.offset()
+        if offset:
+            mesh = mesh + offset * analysis.vertex_normals(mesh)
         scene = coin.SoSeparator()
         unpickable = coin.SoPickStyle()  # the mouse finds the face under the displays and the jacks
         unpickable.style = coin.SoPickStyle.UNPICKABLE
@@ -352,6 +372,8 @@ class Overlay:
             points, texture = stripe_shading.sample(s.surface, size)
             self._sampled = (key, points, texture, size)
         _, points, texture, size = self._sampled
+        if self.offset():
+            points = points + self.offset() * analysis.vertex_normals(points)
         g, h = points.shape[:2]
         (u0, u1), (v0, v1) = s.surface.domain
         cells = self._cells((g, h), np.linspace(u0, u1, g), np.linspace(v0, v1, h))
