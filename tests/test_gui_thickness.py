@@ -101,5 +101,9 @@ def test_new_patch_without_a_document_then_thicken_choosing_the_thickness(tmp_pa
         assert thickness(s)["valid"] and thickness(s)["solids"] == 1 and thickness(s)["zmax"] > made["zmax"] + 2.0
         d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
         s = d.wait(lambda s: thickness(s)["state"] == ["Up-to-date"], "the slab up to date after the session")
+        # Displays off: the zebra and the combs off in one click (Show curvature cycled three more times)
+        d.press_button("Combs", lambda s: s["overlays"][0]["combs"], "the combs")
+        d.press_button("DisplaysOff", lambda s: s["overlays"][0]["display"] == "shading" and not s["overlays"][0]["combs"],
+                       "the displays off")
     finally:
         d.close()

@@ -47,7 +47,7 @@ GROUPS = {
                                    "HapticSculpt_ContinuityCheck",
                                    "HapticSculpt_CombDensity", "HapticSculpt_CombScale", "HapticSculpt_Zebra",
                                    "HapticSculpt_ZebraMode", "HapticSculpt_ZebraStripes",
-                                   "HapticSculpt_ZebraDirection", "HapticSculpt_SetTarget",
+                                   "HapticSculpt_ZebraDirection", "HapticSculpt_DisplaysOff", "HapticSculpt_SetTarget",
                                    "HapticSculpt_ShowDeviation", "HapticSculpt_FitToTarget", "HapticSculpt_PullToTarget"], 0),
 }
 #: The toolbars: few buttons, so that all show at 1280 px beside FreeCAD's own. Output is a toolbar
@@ -685,7 +685,7 @@ class ShowMap(_SculptCommand):
 
 class ShowCurvature(_SculptCommand):
     icon_name, menu = "ShowCurvature", "Show curvature"
-    tip = "Cycle curvature displays: u green / v blue (as in the paper), mean, Gaussian, off"
+    tip = "Cycle curvature displays: u green / v blue (as in the paper), mean, Gaussian, off (Displays off: at once)"
 
     def Activated(self) -> None:
         from .workbench import CURVATURE_CYCLE
@@ -748,6 +748,19 @@ class Zebra(_SculptCommand):
         ov = _ctl().overlay()
         if ov is not None:
             _ctl().set_display("shading" if ov.display == "zebra" else "zebra")
+
+
+class DisplaysOff(_SculptCommand):
+    icon_name, menu = "DisplaysOff", "Displays off"
+    tip = ("Plain shading: turn off the sculpt's display (map, curvature, zebra, deviation), its curvature combs "
+           "and its continuity check at once")
+
+    def Activated(self) -> None:
+        ov = _ctl().overlay()
+        if ov is not None:
+            ov.combs = ov.continuity = False
+            _ctl().set_display("shading")
+            ov.refresh()
 
 
 class ZebraMode(_SculptCommand):
@@ -834,7 +847,7 @@ COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_NewClampedPatch": N
             "HapticSculpt_ShowMap": ShowMap, "HapticSculpt_SetTarget": SetTarget,
             "HapticSculpt_ShowDeviation": ShowDeviation, "HapticSculpt_FitToTarget": FitToTarget,
             "HapticSculpt_PullToTarget": PullToTarget,
-            "HapticSculpt_ShowCurvature": ShowCurvature, "HapticSculpt_Combs": Combs, "HapticSculpt_ContinuityCheck": ContinuityCheck, "HapticSculpt_Zebra": Zebra,
+            "HapticSculpt_ShowCurvature": ShowCurvature, "HapticSculpt_Combs": Combs, "HapticSculpt_ContinuityCheck": ContinuityCheck, "HapticSculpt_Zebra": Zebra, "HapticSculpt_DisplaysOff": DisplaysOff,
             "HapticSculpt_ZebraMode": ZebraMode, "HapticSculpt_ZebraStripes": ZebraStripes,
             "HapticSculpt_ZebraDirection": ZebraDirection,
             "HapticSculpt_CombDensity": CombDensity, "HapticSculpt_CombScale": CombScale,

@@ -401,7 +401,7 @@ def write(*_):
                               "stripes": ov.stripes, "active_view": ov.view is getattr(Gui.ActiveDocument, "ActiveView", None),
                               "view": id(ov.view), "object": ov.obj.Name, "cursor": ov.cursor_shown,
                               "cursor_at": None if ov.cursor is None else [float(x) for x in ov.cursor[0]],
-                              "surface_drawn": ov.surface_drawn, "offset": ov.offset(), "continuity": ov.continuity,
+                              "surface_drawn": ov.surface_drawn, "offset": ov.offset(), "continuity": ov.continuity, "combs": ov.combs,
                               "neighbours_drawn": ov.neighbours_drawn,
                               "trimmed": any(v is not None for v in ov._trims.values()),
                               "continuity_worst": ov.continuity_worst,
