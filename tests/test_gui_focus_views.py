@@ -246,3 +246,44 @@ def test_a_session_follows_the_pointer_into_another_view_with_its_hud(tmp_path):
         d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
     finally:
         d.close()
+
+
+def test_a_session_sculpts_its_own_document_only(tmp_path):
+    """A mouse session on a patch in a second document; the pointer back in the first document's
+    view: the session's cursor and HUD stay in its own document's view, and a drag on the first
+    patch is FreeCAD's (a rotation), where it sculpted the hidden document's patch out of sight and
+    put its undo step in both documents."""
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        d.xdo("mousemove", "640", "500")
+        first_doc = d.new_patch()["active"]
+        d.xdo("key", "ctrl+n")
+        d.wait(lambda s: len(s["docs"]) == 2 and s["inputs"] == 2, "the second view to be attached")
+        s = d.press_button("NewPatch", lambda s: s["active"] != first_doc and s["docs"][s["active"]]["sculpts"],
+                           "a patch in the second document")
+        second_doc = s["active"]
+        d.press_button("Session", lambda s: sculpt(s)["session"], "a session on the second patch")
+        poles = s["docs"][second_doc]["sculpts"][0]["poles"]
+        undo_lists = {name: s["docs"][name]["undo"] for name in (first_doc, second_doc)}
+        d.xdo("key", "ctrl+Tab")  # the first document's view
+        d.wait(lambda s: s["active"] == first_doc, "ctrl+tab to the first document")
+        first_view = next(v["id"] for v in d.state()["views"] if v["doc"] == first_doc)
+        d.calibrate()
+        _, _, _, _, south = [d.to_screen(p) for p in sculpt(d.state())["screen"]]
+        d.xdo("mousemove", str(south[0]), str(south[1]))
+        d.wait(lambda s: s["mouse_point"] is not None, "the pointer over the first patch")
+        d.drag([south] + [(south[0], south[1] - 10 * k) for k in range(1, 12)], seconds=0.6)
+        d.wait_still(lambda s: [s["docs"][n]["undo"] for n in (first_doc, second_doc)], "the drag's aftermath")
+        s = d.state()
+        d.shot("session_in_another_document")
+        assert {n: s["docs"][n]["undo"] for n in (first_doc, second_doc)} == undo_lists
+        moved = np.abs(np.array(s["docs"][second_doc]["sculpts"][0]["poles"]) - np.array(poles)).max()
+        assert moved < 1e-6, f"the hidden document's patch was sculpted ({moved} mm)"
+        assert s["docs"][second_doc]["sculpts"][0]["session"]
+        assert not any(o["cursor"] or o["hud"] for o in s["overlays"] if o["view"] == first_view), \
+            "the session's cursor or HUD in another document's view"
+        d.xdo("key", "ctrl+Tab")
+        d.wait(lambda s: s["active"] == second_doc, "ctrl+tab back to the session's document")
+        d.press_button("Session", lambda s: not s["docs"][second_doc]["sculpts"][0]["session"], "the session to stop")
+    finally:
+        d.close()

@@ -113,6 +113,11 @@ def all_3d_views() -> list[tuple[Any, Any]]:
     return views
 
 
+def views_of(doc_name: str) -> list[Any]:
+    """The open 3D views of the document named ``doc_name``."""
+    return [view for doc, view in all_3d_views() if doc.Name == doc_name]
+
+
 class Controller:
     """One per GUI session of the workbench (see :func:`controller`)."""
 
@@ -172,8 +177,8 @@ class Controller:
         for doc, view in all_3d_views():
             if not any(i.view is view for i in self.inputs):
                 self.inputs.append(ViewInput(self, view))
-                if self.mouse is not None:
-                    self.mouse.attach_more([view])  # a mouse session follows the pointer into views opened later
+                if self.mouse is not None and self.session is not None and doc.Name == self.session.obj.Document.Name:
+                    self.mouse.attach_more([view])  # a mouse session follows the pointer into its document's new views
             if id(view) not in self._populated and not doc.Restoring:  # (a sculpt half read is no state)
                 self._populated.add(id(view))
                 for obj in [o for o in doc.Objects if is_sculpt(o)]:
@@ -259,7 +264,7 @@ class Controller:
         its first. (The mouse's alone drew a display set from the toolbar in the other document's
         view when the new document had not had the mouse yet.)"""
         import FreeCADGui as Gui
-        mine = [v for doc, v in all_3d_views() if doc == obj.Document]
+        mine = views_of(obj.Document.Name)
         if self.mouse_view is not None and any(v is self.mouse_view for v in mine):
             return self.mouse_view
         active = self.active_view()
@@ -375,6 +380,8 @@ class Controller:
         obj = self.session.obj if self.session is not None else None
         if obj is None or not _alive(obj):
             return
+        if view is not None and not any(v is view for v in views_of(obj.Document.Name)):
+            return  # (another document's view: the session's cursor and HUD stay in its own)
         if view is None:
             self.refresh(obj)
             return
@@ -550,13 +557,14 @@ class Controller:
             device, rate = self._attached_device(obj, devices)
         if device is None:
             device = MouseDevice(yields=self.panel_at)
-            device.attach_all([i.view for i in self.inputs] or [self.view()])
+            # (its document's views only: a drag in another document's view sculpted this one, unseen)
+            device.attach_all(views_of(obj.Document.Name))
         self.mouse = device if isinstance(device, MouseDevice) else None
         self.airbrush_for(obj)
         session = Session()
         session.set_airbrush(self.painting, factor=airbrush_factor(self.painting))  # before the first tick can grab
         self.session = session.start(obj, device, tool=obj.Proxy.live.snapshot().tool.name, haptic_rate=rate)
-        self._follow(self.view())
+        self._follow(self.view_of(obj))
         pull = obj.Proxy.live.snapshot().pull
         if pull["target"] and pull["enabled"]:
             import FreeCAD  # (it moves the surface from the first step, a stroke or none)
