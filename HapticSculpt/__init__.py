@@ -27,7 +27,7 @@ from .app.api import (
                       set_curvature_target,
                       set_material, set_regional,
                       set_tool,
-                      set_uniform,
+                      set_uniform, scale_map,
                       thicken,
                       to_cadquery,
 )
@@ -44,7 +44,7 @@ legacy_paths.install()
 __all__ = ["make_sculpt", "fair", "sculpt_solid", "set_boundary", "boundary_of", "seam_report_of", "run", "add_constraint", "add_curve_constraint",
            "curve_constraints_of", "remove_constraint", "hold_boundary", "held_boundary",
            "set_material", "material_of", "keep_shape", "set_regional",
-           "set_tool", "set_uniform", "set_curvature_target", "paint", "record_state", "replay_stroke",
+           "set_tool", "set_uniform", "scale_map", "set_curvature_target", "paint", "record_state", "replay_stroke",
            "set_target", "clear_target", "set_pull", "pull_of", "fit_to_target", "target_object", "deviation_of", "export_step", "thicken", "make_thickness",
            "to_cadquery", "ReplayDevice", "CursorSample", "CursorSource", "RunReport", "Session", "stop_all",
            "__version__"]

@@ -43,3 +43,25 @@ class TestSliderValues(DocumentTestCase):
         self.assertAlmostEqual(math.log10(fine / at_press), math.log10(coarse / at_press) / FINE, delta=0.01)
         panel.drag(middle + 60.0, fine=False)  # Shift up: the knob goes back under the mouse
         self.assertEqual(panel.pending, coarse)
+
+    def test_a_painted_map_is_scaled_by_its_slider_not_wiped(self):
+        """The slider shows a map's mean; its edit of a painted map is scale_map (set_uniform wiped
+        the painting)."""
+        import numpy as np
+        obj = hs.make_sculpt(self.doc)
+        hs.paint(obj, "stiffness", [(0.3, 0.5), (0.7, 0.5)])
+        painted = np.array(obj.Proxy.live.map_values("stiffness"))
+        self.assertGreater(painted.max(), 2 * painted.min())
+        undo = self.doc.UndoCount
+        hs.scale_map(obj, "stiffness", 4.0)
+        self.assertEqual(self.doc.UndoCount, undo + 1)
+        self.assertEqual(self.doc.UndoNames[0], "Set stiffness")
+        np.testing.assert_allclose(obj.Proxy.live.map_values("stiffness"), 4.0 * painted)
+        self.doc.undo()
+        np.testing.assert_allclose(obj.Proxy.live.map_values("stiffness"), painted)
+        for bad in (0.0, -1.0, float("nan"), float("inf")):
+            with self.assertRaises(ValueError):
+                hs.scale_map(obj, "stiffness", bad)
+        with self.assertRaises(ValueError):
+            hs.scale_map(obj, "colour", 2.0)
+        self.assertEqual(self.doc.UndoCount, undo)  # (undone; the refused calls left no step)

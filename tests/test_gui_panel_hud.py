@@ -241,3 +241,31 @@ def _linear(srgb: float) -> float:
 
 
 os.makedirs(SHOTS, exist_ok=True)
+
+
+def test_a_material_slider_scales_a_painted_map(tmp_path):
+    """Stiffness painted along a line, then its slider dragged: the map is scaled to the slider's
+    new mean, the painted line kept (the slider set one value everywhere and wiped it)."""
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        d.xdo("mousemove", "640", "500")
+        s = d.new_patch()
+        d.press_button("Panel", lambda s: "track3" in overlay(s)["hud"], "the slider panel")
+        calibrate(d)  # (on the overlay's frames: the panel draws them)
+        centre, east, west, _, _ = [d.to_screen(p) for p in sculpt(s)["screen"]]
+        d.press_button("PaintStiffness", lambda s: s["painting"] == "stiffness", "the airbrush")
+        d.drag([west, ((west[0] + centre[0]) // 2, (west[1] + centre[1]) // 2), east], seconds=0.3)
+        s = d.wait(lambda s: undo(s)[0] == "Paint stiffness", "the painted line")
+        lo, hi, n = sculpt(s)["stiffness_map"]
+        assert n > 1 and hi > 2 * lo, (lo, hi, n)
+        d.press_button("PaintStiffness", lambda s: s["painting"] is None, "the airbrush off")
+        mean = overlay(d.state())["sliders"][2][1]
+        drag_slider(d, 2)
+        s = d.wait(lambda s: undo(s)[0] == "Set stiffness" and not overlay(s)["sliders"][2][2], "the slider's step")
+        lo2, hi2, n2 = sculpt(s)["stiffness_map"]
+        factor = overlay(s)["sliders"][2][1] / mean
+        assert abs(factor - 1) > 0.5, factor  # (the drag moved the mean)
+        assert n2 == n and abs(lo2 / lo - factor) < 0.01 * factor and abs(hi2 / hi - factor) < 0.01 * factor, \
+            ((lo, hi, n), (lo2, hi2, n2), factor)
+    finally:
+        d.close()

@@ -340,6 +340,21 @@ def set_uniform(obj: Any, map: str, value: float) -> None:
     obj.Proxy.live.edit(lambda s: getattr(s, map + "_map").set_uniform(value), f"Set {map}")
 
 
+def scale_map(obj: Any, map: str, factor: float) -> None:
+    """Multiplies material map ``map`` by ``factor`` (> 0) everywhere: what is painted on it keeps
+    its pattern (the slider panel's edit of a painted map: :func:`set_uniform` would wipe it). One
+    undo step ("Set <map>"); a running session takes it at once."""
+    obj = _sculpt(obj, solids=True)
+    sculpt_state.map_property(map)  # validates the name
+    factor = _finite(factor, "factor", positive=True)
+
+    def change(s: core.DynamicSurface) -> None:
+        m = getattr(s, map + "_map")
+        m.set_values(np.array(m.values) * factor)
+
+    obj.Proxy.live.edit(change, f"Set {map}")
+
+
 def fair_weights(mesh: np.ndarray, region: Any = None) -> np.ndarray:
     """Per mesh point weights in [0, 1] for :func:`fair`: all ones without a region, else
     (1 - (r / radius)^2)^2 at distance r < radius from the centre (smooth to zero at the rim)."""

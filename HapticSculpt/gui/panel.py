@@ -109,13 +109,19 @@ class SliderPanel:
     @staticmethod
     def apply(obj: Any, name: str, value: float) -> None:
         """Sets slider ``name`` to ``value`` as one undo step through the scripting call (echoed to
-        the Python console and a recorded macro); a running session takes it at once."""
+        the Python console and a recorded macro); a running session takes it at once. A material
+        slider shows its map's mean: a painted map is scaled to the new mean, a uniform one set."""
         from .echo import ref, run_echoed
         if name.startswith("tool."):
             _, tool, setting = name.split(".")
             run_echoed(f"HapticSculpt.set_tool({ref(obj)}, {tool!r}, {setting}={float(value)!r})")
-        elif name in MAPS:
-            run_echoed(f"HapticSculpt.set_uniform({ref(obj)}, {name!r}, {float(value)!r})")
+        elif name in MAPS:  # (a painted map is scaled to the new mean: its pattern kept)
+            values = obj.Proxy.live.map_values(name)
+            mean = float(np.mean(values))
+            if value > 0 and mean > 0 and float(np.ptp(values)) > 0:
+                run_echoed(f"HapticSculpt.scale_map({ref(obj)}, {name!r}, {float(value) / mean!r})")
+            else:
+                run_echoed(f"HapticSculpt.set_uniform({ref(obj)}, {name!r}, {float(value)!r})")
         elif [c for c in obj.Proxy.live.snapshot().constraints if c["kind"] == "curvature"]:
             run_echoed(f"HapticSculpt.set_curvature_target({ref(obj)}, {name[-1]}={float(value)!r})")
         else:  # (the targets belong to curvature constraints: nothing to set yet)
