@@ -267,5 +267,15 @@ def test_a_material_slider_scales_a_painted_map(tmp_path):
         assert abs(factor - 1) > 0.5, factor  # (the drag moved the mean)
         assert n2 == n and abs(lo2 / lo - factor) < 0.01 * factor and abs(hi2 / hi - factor) < 0.01 * factor, \
             ((lo, hi, n), (lo2, hi2, n2), factor)
+        # a drag from the panel's backing (a slider's text, off its track) in a mouse session is the
+        # panel's: no stroke (it went through and sculpted the patch)
+        d.press_button("Session", lambda s: sculpt(s)["session"], "a mouse session")
+        x0, y0, x1, y1 = overlay(d.state())["hud"]["slider1"]
+        start = d.to_screen([(x0 + x1) / 2, (y0 + y1) / 2])
+        before = undo(d.state())
+        d.drag([start] + [(start[0] + 25 * k, start[1] + 25 * k) for k in range(1, 12)], seconds=0.6)
+        assert d.wait_still(undo, "the drag's aftermath") == before
+        assert sculpt(d.state())["strokes"] == 0
+        d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
     finally:
         d.close()

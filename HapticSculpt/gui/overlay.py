@@ -326,6 +326,14 @@ class Overlay:
         return {name: boxes[f"track{k + 1}"] for k, (name, _, _, _) in enumerate(sliders(self.obj))
                 if f"track{k + 1}" in boxes}
 
+    def panel_covers(self, x: float, y: float) -> bool:
+        """True if view pixel (x, y) lies on the shown slider panel, its tracks or the backing
+        between them (a press there is the panel's, never a stroke or a dab)."""
+        if not self.panel_visible or self.hud is None:
+            return False
+        box = self.hud.boxes().get("back_sliders")
+        return box is not None and box[0] <= x <= box[2] and box[1] <= y <= box[3]
+
     def panel_press(self, x: float, y: float) -> bool:
         """Button down at view pixel (x, y): True if it took a slider (shown at once)."""
         if not self.panel.press(x, y, self.tracks(), self.obj):

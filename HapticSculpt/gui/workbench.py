@@ -340,17 +340,20 @@ class Controller:
             cb.setHandled()
 
     def panel_at(self, view: Any, pixel: tuple[int, int]) -> bool:
-        """True if a slider of a panel shown in ``view`` is under ``pixel`` (the mouse device leaves
-        a press there to the panel: it is not a stroke)."""
-        return any(ov.panel.track_at(pixel[0], pixel[1], ov.tracks()) is not None
+        """True if a panel shown in ``view`` is under ``pixel``, a slider or the backing between
+        them (the mouse device leaves a press there to the panel: it is not a stroke; a press on
+        the backing went through and sculpted the patch behind it)."""
+        return any(ov.panel.track_at(pixel[0], pixel[1], ov.tracks()) is not None or ov.panel_covers(*pixel)
                    for (vid, _), ov in self.overlays.items() if vid == id(view))
 
     def _panel_button(self, view: Any, event: Any) -> bool:
-        """Button 1 on a slider panel: a press on a track takes it, the release commits the held one."""
+        """Button 1 on a slider panel: a press on a track takes it, one on the backing between the
+        tracks does nothing (neither a dab nor FreeCAD's selection), the release commits the held one."""
         from pivy import coin
         x, y = (float(c) for c in event.getPosition())
         if event.getState() == coin.SoButtonEvent.DOWN:
-            return any(ov.panel_press(x, y) for (vid, _), ov in self.overlays.items() if vid == id(view))
+            mine = [ov for (vid, _), ov in self.overlays.items() if vid == id(view)]
+            return any(ov.panel_press(x, y) for ov in mine) or any(ov.panel_covers(x, y) for ov in mine)
         return any([ov.panel_release() for ov in self.overlays.values()])
 
     def on_key(self, view: Any, cb: Any) -> None:
