@@ -33,6 +33,16 @@ def thickness(s: dict) -> dict:
 
 
 @pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def view_direction(s: dict) -> np.ndarray:
+    """The active view's direction, from its camera's orientation (Inventor: the camera looks
+    down its -z axis)."""
+    camera = next(v for v in s["views"] if v["active"])["camera"]
+    x, y, z, angle = (float(t) for t in camera.split("orientation")[1].split()[:4])
+    axis = np.array([x, y, z]) / (np.linalg.norm([x, y, z]) or 1.0)
+    v = np.array([0.0, 0.0, -1.0])  # Rodrigues' rotation of -z about the axis
+    return v * np.cos(angle) + np.cross(axis, v) * np.sin(angle) + axis * axis.dot(v) * (1 - np.cos(angle))
+
+
 def test_new_patch_without_a_document_then_thicken_choosing_the_thickness(tmp_path):
     os.makedirs(SHOTS, exist_ok=True)
     d = Desktop(str(tmp_path), "CAD")
@@ -41,6 +51,9 @@ def test_new_patch_without_a_document_then_thicken_choosing_the_thickness(tmp_pa
         d.click_button("NewPatch")  # (once: it is active with no document, as FreeCAD's Part primitives are)
         s = d.wait(lambda s: s["active"] and doc(s)["sculpts"] and sculpt(s)["screen"], "a new document with a patch")
         assert len(s["docs"]) == 1 and undo(s)[0] == "Create sculpt"
+        # seen from above and aside (FreeCAD 0.20 opened the new document from the top, where a
+        # drag moved the patch in its own plane, unseen)
+        s = d.wait(lambda s: -0.9 < view_direction(s)[2] < -0.3, "an isometric view of the first patch")
         d.shot("thick_new_patch")
         d.calibrate()
         centre = d.to_screen(sculpt(s)["screen"][0])
@@ -66,9 +79,9 @@ def test_new_patch_without_a_document_then_thicken_choosing_the_thickness(tmp_pa
                    "the stripes on the slab's top, 5 mm up")
         assert [o["display"] for o in s["overlays"]] == ["zebra"]
         assert made["zmax"] > 4.9, made  # (the slab lies on the side the stripes went)
-        top = d.shot("thick_made")
-        d.xdo("mousemove", "640", "500", "key", "0")  # isometric: the slab's side shows
-        shot_changed(d, "thick_made_isometric", top)
+        made_shot = d.shot("thick_made")  # (isometric: the slab's side shows)
+        d.xdo("mousemove", "640", "500", "key", "2")  # from the top
+        shot_changed(d, "thick_made_top", made_shot)
         item = d.wait(lambda s: "Thickness" in s["tree"], "the Thickness in the tree")["tree"]["Thickness"]
         d.xdo("mousemove", str(item[0]), str(item[1]), "click", "--repeat", "2", "--delay", "80", "1")
         d.wait(lambda s: s["task_dialog"], "the panel to edit the thickness")

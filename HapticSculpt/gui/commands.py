@@ -110,6 +110,7 @@ class NewPatch:
         from .echo import run_echoed
         if FreeCAD.ActiveDocument is None:
             run_echoed("App.newDocument()", modules=())
+        first = not FreeCAD.ActiveDocument.Objects
         edges = "" if self.EDGES == "free" else f", edges={self.EDGES!r}"
         spot = free_spot(FreeCAD.ActiveDocument)
         at = f", centre={spot!r}" if any(spot) else ""
@@ -117,6 +118,10 @@ class NewPatch:
         run_echoed(f"HapticSculpt.make_sculpt(App.getDocument({FreeCAD.ActiveDocument.Name!r}), material='clay'"
                    f"{edges}{at})")
         FreeCAD.ActiveDocument.recompute()
+        if first and getattr(Gui.ActiveDocument, "ActiveView", None) is not None:
+            # seen from above and aside, as a drag lifts it: a new document opened in the top view on
+            # 0.20, where a drag moved the patch in its own plane, unseen
+            run_echoed("Gui.ActiveDocument.ActiveView.viewIsometric()", modules=())
         Gui.SendMsgToActiveView("ViewFit")
 
 

@@ -227,9 +227,10 @@ class Hud:
         units = UNITS.get(display, "")
         if uniform:
             self._text(f"{readable(rng[0])} everywhere", x0 - 6, bottom, TEXT, "legend_lo", w, right=True)
-        elif display != "zebra":
-            self._text(f"{rng[1]:.3g}{units}", x0 - 6, top - FONT_SIZE, TEXT, "legend_hi", w, right=True)
-            self._text(f"{rng[0]:.3g}{units}", x0 - 6, bottom, TEXT, "legend_lo", w, right=True)
+        elif display != "zebra":  # (a material map's values as the sliders give them: 100000, not 1e+05)
+            show = (lambda v: f"{v:.3g}") if display in UNITS else readable
+            self._text(f"{show(rng[1])}{units}", x0 - 6, top - FONT_SIZE, TEXT, "legend_hi", w, right=True)
+            self._text(f"{show(rng[0])}{units}", x0 - 6, bottom, TEXT, "legend_lo", w, right=True)
         if display == "deviation" and rng[1] > rng[0]:  # the band within the tolerance, labelled at its middle
             middle = bottom + (top - bottom) * (0.0 - rng[0]) / (rng[1] - rng[0])
             self._text(f"\u00b1{tolerance:.3g}{units}", x0 - 6, middle - FONT_SIZE / 2, TEXT, "legend_band", w, right=True)
