@@ -121,7 +121,7 @@ class NewPatch:
         if first and getattr(Gui.ActiveDocument, "ActiveView", None) is not None:
             # seen from above and aside, as a drag lifts it: a new document opened in the top view on
             # 0.20, where a drag moved the patch in its own plane, unseen
-            run_echoed("Gui.ActiveDocument.ActiveView.viewIsometric()", modules=())
+            Gui.ActiveDocument.ActiveView.viewIsometric()  # (view state, as ViewFit: not in a macro)
         Gui.SendMsgToActiveView("ViewFit")
 
 
