@@ -11,7 +11,7 @@ import time
 
 import numpy as np
 import pytest
-from test_gui_real_input import NEEDS, SHOTS, Desktop, patch_with_keyed_constraints, sculpt, undo
+from test_gui_real_input import NEEDS, SHOTS, Desktop, patch_with_keyed_constraints, sculpt, undo, view_direction
 
 SLIDERS = [("mass", "Set mass"), ("damping", "Set damping"), ("stiffness", "Set stiffness"),
            ("bending", "Set bending"), ("pull", "Set pull"), ("curvature_u", "Set curvature"),
@@ -30,10 +30,16 @@ def camera(s: dict) -> str:
     return next(v for v in s["views"] if v["active"])["camera"]
 
 
+#: Each standard view's direction, as a test on the active view's (iso: from above and aside).
+VIEW_DIRECTIONS = {"iso": lambda v: -0.9 < v[2] < -0.3 and abs(v[0]) > 0.2 and abs(v[1]) > 0.2,
+                   "front": lambda v: v[1] > 0.99, "top": lambda v: v[2] < -0.99}
+
+
 def set_view(d: Desktop, name: str) -> None:
-    before = camera(d.state())
+    """FreeCAD's key for the view ``name``, then waits for the view to look that way (it may do so
+    already: a first patch is shown isometric)."""
     d.xdo("key", VIEW_KEYS[name])
-    d.wait(lambda s: camera(s) != before, f"the {name} view")
+    d.wait(lambda s: VIEW_DIRECTIONS[name](view_direction(s)), f"the {name} view")
 
 
 def calibrate(d: Desktop) -> None:

@@ -360,6 +360,16 @@ def patch_with_keyed_constraints(d: Desktop) -> tuple[dict, list[tuple[int, int]
     return d.state(), points
 
 
+def view_direction(s: dict) -> np.ndarray:
+    """The active view's direction, from its camera's orientation (Inventor: the camera looks
+    down its -z axis)."""
+    camera = next(v for v in s["views"] if v["active"])["camera"]
+    x, y, z, angle = (float(t) for t in camera.split("orientation")[1].split()[:4])
+    axis = np.array([x, y, z]) / (np.linalg.norm([x, y, z]) or 1.0)
+    v = np.array([0.0, 0.0, -1.0])  # Rodrigues' rotation of -z about the axis
+    return v * np.cos(angle) + np.cross(axis, v) * np.sin(angle) + axis * axis.dot(v) * (1 - np.cos(angle))
+
+
 def sculpt(s: dict) -> dict:
     return s["docs"][s["active"]]["sculpts"][0]
 

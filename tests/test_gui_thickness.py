@@ -11,7 +11,7 @@ import time
 import numpy as np
 
 import pytest
-from test_gui_real_input import NEEDS, SHOTS, Desktop, sculpt, undo
+from test_gui_real_input import NEEDS, SHOTS, Desktop, sculpt, undo, view_direction
 
 
 def doc(s: dict) -> dict:
@@ -33,16 +33,6 @@ def thickness(s: dict) -> dict:
 
 
 @pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
-def view_direction(s: dict) -> np.ndarray:
-    """The active view's direction, from its camera's orientation (Inventor: the camera looks
-    down its -z axis)."""
-    camera = next(v for v in s["views"] if v["active"])["camera"]
-    x, y, z, angle = (float(t) for t in camera.split("orientation")[1].split()[:4])
-    axis = np.array([x, y, z]) / (np.linalg.norm([x, y, z]) or 1.0)
-    v = np.array([0.0, 0.0, -1.0])  # Rodrigues' rotation of -z about the axis
-    return v * np.cos(angle) + np.cross(axis, v) * np.sin(angle) + axis * axis.dot(v) * (1 - np.cos(angle))
-
-
 def test_new_patch_without_a_document_then_thicken_choosing_the_thickness(tmp_path):
     os.makedirs(SHOTS, exist_ok=True)
     d = Desktop(str(tmp_path), "CAD")
