@@ -271,7 +271,7 @@ class Overlay:
         self._place_lift()
         scene.addChild(self._lift)  # the displays and the jacks lie on the surface: in front of the face
         if display == "zebra" and glsl:
-            scene.addChild(self._stripes(s))
+            scene.addChild(self._stripes(s, offset))
             legend = (self.display, (0.0, 1.0))
         elif display != "shading":
             colours, rng = self._colours(s, mesh)
@@ -372,7 +372,7 @@ class Overlay:
         d /= np.linalg.norm(d) or 1.0
         self._lift.translation.setValue(*(-self._lift_by * d))
 
-    def _stripes(self, s: core.DynamicSurface) -> Any:
+    def _stripes(self, s: core.DynamicSurface, offset: float) -> Any:
         """Zebra stripes per pixel on the exact surface (sampled again only when the poles moved)."""
         size = stripe_shading.TEXTURE // (2 if self._session() is not None else 1)
         key = np.asarray(s.poles).tobytes()
@@ -380,8 +380,8 @@ class Overlay:
             points, texture = stripe_shading.sample(s.surface, size)
             self._sampled = (key, points, texture, size)
         _, points, texture, size = self._sampled
-        if self.offset():
-            points = points + self.offset() * analysis.vertex_normals(points)
+        if offset:  # (the frame's: see offset())
+            points = points + offset * analysis.vertex_normals(points)
         g, h = points.shape[:2]
         (u0, u1), (v0, v1) = s.surface.domain
         cells = self._cells((g, h), np.linspace(u0, u1, g), np.linspace(v0, v1, h))
