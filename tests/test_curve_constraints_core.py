@@ -96,3 +96,13 @@ def test_a_curve_a_micrometre_off_the_surface_moves_it_no_more():
     record, moved, _ = cc.make(s, line, "G0", None, 1, [], [])
     assert np.abs(moved - p.reshape(-1, 3)).max() < 1e-3
     assert cc.misses(s.surface, record, moved)[0] <= 1e-6 * s.size
+
+
+def test_samples_follow_the_curve_parameter_domain_cells():
+    """The conditions take at least 2 (p + q + 1) samples per knot cell the curve crosses."""
+    s = core.patch((24, 24), mesh=(40, 40))
+    record, _, _ = cc.make(s, [(-45.0, -45.0, 0.0), (45.0, 45.0, 0.0)], "G0", None, 1, [], [])
+    knots = np.asarray(s.surface.knots_u)
+    cells = len({(a, b) for a, b in zip(cc._basis(knots, 3, record.uv[:, 0])[0],
+                                        cc._basis(knots, 3, record.uv[:, 1])[0])})
+    assert cells >= 19 and len(record.uv) >= 14 * cells

@@ -14,7 +14,6 @@ from test_freecad_layer import stroke
 from test_freecad_sculpted_solid import SolidChecks, face_named, pull
 
 import HapticSculpt as hs
-from HapticSculpt.app import curve_constraint
 
 V = FreeCAD.Vector
 
@@ -261,13 +260,3 @@ class TestCurveConstraints(SolidChecks):
         top_face = max(obj.Shape.Faces, key=lambda f: f.CenterOfMass.z)
         self.assertLessEqual(curve_distance(top_face, line), 1e-6 * size)
 
-
-def test_samples_follow_the_curve_parameter_domain_cells():
-    """The conditions take at least 2 (p + q + 1) samples per knot cell the curve crosses."""
-    from HapticSculpt import core
-    s = core.patch((24, 24), mesh=(40, 40))
-    record, _, _ = curve_constraint.make(s, [(-45.0, -45.0, 0.0), (45.0, 45.0, 0.0)], "G0", None, 1, [], [])
-    knots = np.asarray(s.surface.knots_u)
-    cells = len({(a, b) for a, b in zip(curve_constraint._basis(knots, 3, record.uv[:, 0])[0],
-                                        curve_constraint._basis(knots, 3, record.uv[:, 1])[0])})
-    assert cells >= 19 and len(record.uv) >= 14 * cells
