@@ -22,9 +22,16 @@ class ThicknessPanel:
     def __init__(self, sculpt: Any = None, feature: Any = None) -> None:
         self.sculpt, self.feature = sculpt, feature
         self.form = Gui.PySideUic.loadUi(UI)
-        self.form.setWindowTitle("Thickness" if feature is None else f"Thickness of {feature.Label}")
+        self.form.setWindowTitle(self._title())
         value = DEFAULT if feature is None else float(feature.Thickness.Value)
         self.form.thickness.setProperty("rawValue", value)
+
+    def _title(self) -> str:
+        """What is thickened, by name: "Thicken Sculpt", "Edit Thickness of Sculpt"."""
+        if self.feature is None:
+            return "Thicken" if self.sculpt is None else f"Thicken {self.sculpt.Label}"
+        source = getattr(self.feature, "Source", None)
+        return f"Edit {self.feature.Label}" + ("" if source is None else f" of {source.Label}")
 
     def open(self) -> None:
         """Shown: the value is selected, so typing replaces it (as in FreeCAD's own dialogs). Again
