@@ -845,6 +845,41 @@ def test_a_clay_stroke_stays_where_it_was_left(tmp_path):
 
 
 @pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+@pytest.mark.parametrize("view,key,up", [("top", "2", 1.0), ("bottom", "5", -1.0)])
+def test_a_drag_up_in_a_view_onto_the_patch_lifts_it_toward_the_eye(tmp_path, view, key, up):
+    """A new clamped patch seen from the top (or the bottom), a session, a drag up the screen: the
+    patch rises toward the eye. (In the plane facing the screen, which is the patch's own from
+    there, the grab slid along the patch, unseen: a top view's drag lifted nothing.)"""
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        d.xdo("mousemove", "640", "500")
+        d.xdo("key", "ctrl+n")
+        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
+        d.press_button("NewClampedPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new clamped patch")
+        d.xdo("key", key)
+        d.wait(lambda s: view_direction(s)[2] * up < -0.99, f"the {view} view")
+        s = d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
+        d.calibrate()
+        centre = d.to_screen(sculpt(s)["screen"][0])
+        flat = np.array(sculpt(s)["poles"]).reshape(-1, 3)
+        path = [(centre[0], centre[1] - 10 * k) for k in range(1, 13)]
+        d.drag([centre] + path + path[-1:] * 4, seconds=1.0)
+        s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke's undo step")
+        poles = np.array(sculpt(s)["poles"]).reshape(-1, 3)
+        lift = float((poles[:, 2] * up).max())
+        slide = float(np.abs(poles[:, :2] - flat[:, :2]).max())
+        assert lift > 3.0, f"the drag up lifted the patch {lift:.2f} mm toward the eye (slid {slide:.2f} mm)"
+        assert float((poles[:, 2] * up).min()) > -0.5, "the patch went away from the eye"
+        assert slide < lift, f"the patch slid {slide:.2f} mm, rose {lift:.2f} mm"
+        d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
+        d.xdo("mousemove", "640", "500", "key", "0")  # isometric: the bump shows
+        d.wait(lambda s: abs(view_direction(s)[2]) < 0.9, "the isometric view")
+        d.shot(f"{view}_view_drag_lifts")
+    finally:
+        d.close()
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
 def test_the_airbrush_paints_its_own_sculpt_only_and_only_on_it(tmp_path):
     """The airbrush turned on for one patch: a click on the background beside it (to give the view
     the keyboard) paints nothing, where it painted the patch's nearest edge; a session on a second

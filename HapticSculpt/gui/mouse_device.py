@@ -1,6 +1,7 @@
 """The mouse as a session's device: the 3D cursor follows the pointer in FreeCAD's 3D views."""
 from __future__ import annotations
 
+import math
 from typing import Any, Callable, Sequence
 
 from ..core import native as _core
@@ -9,6 +10,12 @@ from ..core import native as _core
 #: A press grabs once the pointer has moved this many pixels with the button held: a click (to
 #: give the view the keyboard, say) is no stroke.
 GRAB_PIXELS = 4
+#: A view looks onto the surface when its direction is within this many degrees of the surface's
+#: normal at the grab: a drag in the plane facing the screen would then slide the grab along the
+#: surface, unseen, so the drag lifts it instead (up: toward the eye).
+FACING_DEGREES = 30.0
+#: How far apart (pixels) the three picks are that give the surface's normal under a press.
+NORMAL_PIXELS = 4
 
 
 class MouseDevice:
@@ -24,6 +31,7 @@ class MouseDevice:
         self._buttons = 0
         self._position = (0.0, 0.0, 0.0)
         self._grab_plane: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None
+        self._lift: _Lift | None = None  # a grab in a view that looks onto the surface
         self._pressed: tuple[Any, int, int] | None = None  # view and pixel of a press not yet a grab
         self._pointer: tuple[Any, tuple[int, int]] | None = None  # view and pixel of the last move
 
@@ -56,15 +64,12 @@ class MouseDevice:
         """Puts the cursor under ``pixel`` of ``view``: on the surface there if any, else on the
         focal plane; during a grab, on the plane through the grab point that faces the screen."""
         x, y = int(pixel[0]), int(pixel[1])
-        if self._buttons and self._grab_plane is not None:
+        if self._buttons and self._lift is not None:
+            p = self._lift.at(view, x, y)
+        elif self._buttons and self._grab_plane is not None:
             p = _on_plane(view, x, y, *self._grab_plane)
         else:
-            info = view.getObjectInfo((x, y))
-            if info and all(k in info for k in ("x", "y", "z")):
-                p = (float(info["x"]), float(info["y"]), float(info["z"]))
-            else:
-                v = view.getPoint(x, y)
-                p = (float(v.x), float(v.y), float(v.z))
+            p = _picked(view, x, y) or _vector(view.getPoint(x, y))
         self._position, self._pointer = p, (view, (x, y))
         self.native.push(list(p), buttons=self._buttons)
         return p
@@ -79,15 +84,25 @@ class MouseDevice:
         except Exception:  # noqa: BLE001 - its view was closed: the cursor stays
             self._pointer = None
 
-    def press(self, held: bool, view: Any = None) -> None:
+    def press(self, held: bool, view: Any = None, pixel: Sequence[int] | None = None) -> None:
         """Button 1 (grab) held or released at the current cursor. A grab in ``view`` then moves the
         cursor in the plane through the grab point that faces the screen: the pointer dragged up in
         a view from above and aside lifts the surface. (The surface under the pointer, as before
         the grab, is the surface being pulled: a cursor put on it slid along it, and a face of a
-        solid, with the solid all around under the pointer, barely rose.)"""
+        solid, with the solid all around under the pointer, barely rose.) Where the view looks onto
+        the surface under ``pixel`` (within FACING_DEGREES of its normal, as from the top onto a
+        flat patch), that plane is the surface's own, so the drag up lifts along the normal toward
+        the eye instead, and a drag sideways moves along the surface."""
         self._buttons = 1 if held else 0
         d = view.getViewDirection() if held and view is not None else None
         self._grab_plane = (self._position, (float(d.x), float(d.y), float(d.z))) if d is not None else None
+        self._lift = None
+        if d is not None and pixel is not None:
+            n = _surface_normal(view, int(pixel[0]), int(pixel[1]))
+            along = 0.0 if n is None else n[0] * d.x + n[1] * d.y + n[2] * d.z
+            if abs(along) >= math.cos(math.radians(FACING_DEGREES)):
+                toward_eye = tuple(-c if along > 0 else c for c in n)
+                self._lift = _Lift(view, int(pixel[0]), int(pixel[1]), self._position, toward_eye)
         self.native.push(list(self._position), buttons=self._buttons)
 
     def _on_move(self, view: Any, cb: Any) -> None:
@@ -95,7 +110,7 @@ class MouseDevice:
         if self._pressed is not None and self._pressed[0] is view and \
                 max(abs(int(pos[0]) - self._pressed[1]), abs(int(pos[1]) - self._pressed[2])) >= GRAB_PIXELS:
             self.move_to(view, self._pressed[1:])
-            self.press(True, view)  # the grab starts where the button went down
+            self.press(True, view, self._pressed[1:])  # the grab starts where the button went down
             self._pressed = None
         self.move_to(view, (pos[0], pos[1]))
         if self._buttons or self._pressed is not None:
@@ -137,3 +152,70 @@ def _on_plane(view: Any, x: int, y: int, point: Sequence[float], normal: Sequenc
         return q
     t = sum((p - o) * n for p, o, n in zip(point, origin, normal)) / along
     return tuple(o + t * r for o, r in zip(origin, ray))
+
+
+def _picked(view: Any, x: int, y: int) -> tuple[float, float, float] | None:
+    """The point of a shape under pixel (x, y) of ``view``, if any."""
+    info = view.getObjectInfo((x, y))
+    if info and all(k in info for k in ("x", "y", "z")):
+        return float(info["x"]), float(info["y"]), float(info["z"])
+    return None
+
+
+def _surface_normal(view: Any, x: int, y: int) -> tuple[float, float, float] | None:
+    """The unit normal of the shape under pixel (x, y), from it and two picks beside it (either
+    side, to find the shape near its border); None where no three picks span a plane."""
+    o = _picked(view, x, y)
+    if o is None:
+        return None
+    sides = []
+    for offsets in (((NORMAL_PIXELS, 0), (-NORMAL_PIXELS, 0)), ((0, NORMAL_PIXELS), (0, -NORMAL_PIXELS))):
+        for dx, dy in offsets:
+            p = _picked(view, x + dx, y + dy)
+            if p is not None:
+                sides.append(tuple(pi - oi for pi, oi in zip(p, o)))
+                break
+        else:
+            return None
+    (ax, ay, az), (bx, by, bz) = sides
+    n = (ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx)
+    length = math.sqrt(sum(c * c for c in n))
+    scale = math.sqrt(sum(c * c for c in sides[0])) * math.sqrt(sum(c * c for c in sides[1]))
+    if length <= 1e-6 * scale:  # (two picks in a line: no plane)
+        return None
+    return n[0] / length, n[1] / length, n[2] / length
+
+
+class _Lift:
+    """A grab in a view that looks onto the surface: the pointer's move from the press, measured on
+    the view's focal plane, moves the grab point as far, its upward part along ``toward_eye`` (the
+    surface's normal, turned to the eye) and its sideways part along the surface."""
+
+    def __init__(self, view: Any, x: int, y: int, grab: Sequence[float], toward_eye: Sequence[float]) -> None:
+        self.grab, self.normal = tuple(grab), tuple(toward_eye)
+        self.start = _vector(view.getPoint(x, y))
+        self.right = _unit(_minus(_vector(view.getPoint(x + 1, y)), self.start))
+        self.up = _unit(_minus(_vector(view.getPoint(x, y + 1)), self.start))
+        # the screen's sideways axis laid onto the surface (its plane through the grab)
+        r = self.right
+        along = sum(a * b for a, b in zip(r, self.normal))
+        self.sideways = _unit(tuple(a - along * b for a, b in zip(r, self.normal)))
+
+    def at(self, view: Any, x: int, y: int) -> tuple[float, float, float]:
+        move = _minus(_vector(view.getPoint(x, y)), self.start)
+        side = sum(a * b for a, b in zip(move, self.right))
+        up = sum(a * b for a, b in zip(move, self.up))
+        return tuple(g + side * s + up * n for g, s, n in zip(self.grab, self.sideways, self.normal))
+
+
+def _vector(v: Any) -> tuple[float, float, float]:
+    return float(v.x), float(v.y), float(v.z)
+
+
+def _minus(a: Sequence[float], b: Sequence[float]) -> tuple[float, float, float]:
+    return a[0] - b[0], a[1] - b[1], a[2] - b[2]
+
+
+def _unit(v: Sequence[float]) -> tuple[float, float, float]:
+    length = math.sqrt(sum(c * c for c in v)) or 1.0
+    return v[0] / length, v[1] / length, v[2] / length
