@@ -1,7 +1,8 @@
 """Export STEP as a designer uses it, with real X input (tests/test_gui_real_input.py's Desktop):
 with nothing selected it takes the document's only sculpt, its task panel offers
-<home>/<label>.step in FreeCAD's file chooser (its save dialog filtered to STEP), OK writes it
-through one echoed HapticSculpt.export_step call, and an independent reader (cadquery's OCP) reads
+<folder>/<label>.step in FreeCAD's file chooser (its save dialog filtered to STEP; the folder:
+the document's, else the one FreeCAD's file dialogs last used, else home), OK writes it through
+one echoed HapticSculpt.export_step call, and an independent reader (cadquery's OCP) reads
 the surface back."""
 from __future__ import annotations
 
@@ -121,6 +122,11 @@ try:
     res["thickness"] = thick.Name
     FreeCAD.closeDocument(thick_doc.Name)
     FreeCAD.setActiveDocument(doc.Name)
+    # an unsaved document: the folder FreeCAD's file dialogs last used (else home)
+    params = FreeCAD.ParamGet(export_panel.LAST_FOLDER[0])
+    params.SetString(export_panel.LAST_FOLDER[1], os.path.join(TMP, "last"))
+    os.makedirs(os.path.join(TMP, "last"))
+    res["unsaved_default"] = export_panel.ExportStepPanel([solid]).path()
     doc.saveAs(os.path.join(TMP, "parts.FCStd"))
     panel = export_panel.ExportStepPanel([solid])
     res["default"] = panel.path()
@@ -130,6 +136,7 @@ try:
     panel.form.file.setProperty("fileName", os.path.join(TMP, "part"))
     res["accepted"] = panel.accept()
     res["written"] = panel.path()
+    res["last_folder"] = params.GetString(export_panel.LAST_FOLDER[1])
     shape = Part.read(panel.path())
     res["solids"] = len(shape.Solids)
     res["volume"] = [shape.Volume, solid.Shape.Volume]
@@ -167,9 +174,11 @@ def test_export_step_chooses_the_only_sculpted_solid_and_refuses_a_bad_file_name
     assert out["selected"] == [out["patch"]] and out["active_selected"]
     assert out["part"] == ["Box"]
     assert out["thickened"] == [out["thickness"]]
+    assert out["unsaved_default"] == str(tmp_path / "last" / "SculptedSolid.step")
     assert out["default"] == str(tmp_path / "SculptedSolid.step")  # (the saved document's folder, its label)
     assert out["refused"] is False  # (said in the report view; the panel stays open)
     assert out["accepted"] is True and out["written"] == str(tmp_path / "part.step")
+    assert out["last_folder"] == str(tmp_path)  # (the next export starts where this one went)
     assert out["solids"] == 1 and out["volume"][0] == pytest.approx(out["volume"][1], rel=1e-6)
     assert out["undo_same"]  # exporting is no edit
     assert out["running"] and out["stopped"]

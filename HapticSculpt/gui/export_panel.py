@@ -41,10 +41,21 @@ def exportable(selection: list[Any], doc: Any) -> list[Any]:
     return found if len(found) == 1 else []
 
 
+#: Where FreeCAD's own file dialogs keep the folder they last used (Gui::FileDialog's working directory).
+LAST_FOLDER = ("User parameter:BaseApp/Preferences/General", "FileOpenSavePath")
+
+
+def last_folder() -> str:
+    """The folder FreeCAD's file dialogs last used, if it still exists; else the home folder."""
+    folder = FreeCAD.ParamGet(LAST_FOLDER[0]).GetString(LAST_FOLDER[1], "")
+    return folder if folder and os.path.isdir(folder) else os.path.expanduser("~")
+
+
 def default_path(objs: list[Any]) -> str:
-    """<the document's folder, else the home folder>/<the object's label, or the document's>.step."""
+    """<the document's folder, else the folder FreeCAD's file dialogs last used, else the home
+    folder>/<the object's label, or the document's>.step."""
     doc = objs[0].Document
-    folder = os.path.dirname(doc.FileName) if doc.FileName else os.path.expanduser("~")
+    folder = os.path.dirname(doc.FileName) if doc.FileName else last_folder()
     label = objs[0].Label if len(objs) == 1 else doc.Label
     return os.path.join(folder, (re.sub(r'[\\/:*?"<>|]+', "_", label).strip() or "sculpt") + ".step")
 
@@ -80,6 +91,8 @@ class ExportStepPanel:
             return False
         FreeCAD.Console.PrintMessage(f"HapticSculpt: exported {', '.join(o.Label for o in self.objs)} to "
                                      f"{self.path()}\n")
+        # (remembered as FreeCAD's own dialogs remember it: the next export or save starts there)
+        FreeCAD.ParamGet(LAST_FOLDER[0]).SetString(LAST_FOLDER[1], os.path.dirname(self.path()))
         Gui.Control.closeDialog()
         return True
 
