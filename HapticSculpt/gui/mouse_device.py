@@ -14,18 +14,20 @@ GRAB_PIXELS = 4
 #: normal at the grab: a drag in the plane facing the screen would then slide the grab along the
 #: surface, unseen, so the drag lifts it instead (up: toward the eye).
 FACING_DEGREES = 30.0
-#: How far apart (pixels) the three picks are that give the surface's normal under a press.
-NORMAL_PIXELS = 4
 
 
 class MouseDevice:
     """The 3D cursor follows the mouse in a FreeCAD 3D view: onto the surface under the pointer, or
     onto the view's focal plane elsewhere; the left button, held and moved, grabs. Only usable
     with the GUI up. ``yields(view, pixel)``: True where a press belongs to something else (the
-    slider panel): the device neither grabs nor takes that press, nor its release."""
+    slider panel): the device neither grabs nor takes that press, nor its release. ``normal_at(point)``:
+    the sculpted surface's unit normal nearest ``point`` (None: unknown), which tells a view that
+    looks onto the surface (see :meth:`press`)."""
 
-    def __init__(self, name: str = "mouse", yields: Callable[[Any, tuple[int, int]], bool] | None = None) -> None:
+    def __init__(self, name: str = "mouse", yields: Callable[[Any, tuple[int, int]], bool] | None = None,
+                 normal_at: Callable[[Sequence[float]], Sequence[float] | None] | None = None) -> None:
         self.yields = yields
+        self.normal_at = normal_at
         self.native = _core.ExternalDevice(name)
         self._callbacks: list[Any] = []
         self._buttons = 0
@@ -90,15 +92,17 @@ class MouseDevice:
         a view from above and aside lifts the surface. (The surface under the pointer, as before
         the grab, is the surface being pulled: a cursor put on it slid along it, and a face of a
         solid, with the solid all around under the pointer, barely rose.) Where the view looks onto
-        the surface under ``pixel`` (within FACING_DEGREES of its normal, as from the top onto a
-        flat patch), that plane is the surface's own, so the drag up lifts along the normal toward
-        the eye instead, and a drag sideways moves along the surface."""
+        the sculpted surface at the grab (within FACING_DEGREES of its normal there, as from the
+        top onto a flat patch), that plane is the surface's own, so the drag up from ``pixel``
+        lifts along the normal toward the eye instead, and a drag sideways moves along the surface.
+        (The sculpted surface's normal, not the one of the face under the pointer: a slab's side,
+        seen from the front, faces the eye where the surface does not.)"""
         self._buttons = 1 if held else 0
         d = view.getViewDirection() if held and view is not None else None
         self._grab_plane = (self._position, (float(d.x), float(d.y), float(d.z))) if d is not None else None
         self._lift = None
-        if d is not None and pixel is not None:
-            n = _surface_normal(view, int(pixel[0]), int(pixel[1]))
+        if d is not None and pixel is not None and self.normal_at is not None:
+            n = self.normal_at(self._position)
             along = 0.0 if n is None else n[0] * d.x + n[1] * d.y + n[2] * d.z
             if abs(along) >= math.cos(math.radians(FACING_DEGREES)):
                 toward_eye = tuple(-c if along > 0 else c for c in n)
@@ -160,30 +164,6 @@ def _picked(view: Any, x: int, y: int) -> tuple[float, float, float] | None:
     if info and all(k in info for k in ("x", "y", "z")):
         return float(info["x"]), float(info["y"]), float(info["z"])
     return None
-
-
-def _surface_normal(view: Any, x: int, y: int) -> tuple[float, float, float] | None:
-    """The unit normal of the shape under pixel (x, y), from it and two picks beside it (either
-    side, to find the shape near its border); None where no three picks span a plane."""
-    o = _picked(view, x, y)
-    if o is None:
-        return None
-    sides = []
-    for offsets in (((NORMAL_PIXELS, 0), (-NORMAL_PIXELS, 0)), ((0, NORMAL_PIXELS), (0, -NORMAL_PIXELS))):
-        for dx, dy in offsets:
-            p = _picked(view, x + dx, y + dy)
-            if p is not None:
-                sides.append(tuple(pi - oi for pi, oi in zip(p, o)))
-                break
-        else:
-            return None
-    (ax, ay, az), (bx, by, bz) = sides
-    n = (ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx)
-    length = math.sqrt(sum(c * c for c in n))
-    scale = math.sqrt(sum(c * c for c in sides[0])) * math.sqrt(sum(c * c for c in sides[1]))
-    if length <= 1e-6 * scale:  # (two picks in a line: no plane)
-        return None
-    return n[0] / length, n[1] / length, n[2] / length
 
 
 class _Lift:

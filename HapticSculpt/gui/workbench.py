@@ -559,7 +559,7 @@ class Controller:
         if device is None:
             device, rate = self._attached_device(obj, devices)
         if device is None:
-            device = MouseDevice(yields=self.panel_at)
+            device = MouseDevice(yields=self.panel_at, normal_at=lambda p: surface_normal(obj, p))
             # (its document's views only: a drag in another document's view sculpted this one, unseen)
             device.attach_all(views_of(obj.Document.Name))
         self.mouse = device if isinstance(device, MouseDevice) else None
@@ -669,6 +669,18 @@ def hidden_by(sculpt: Any) -> str:
     """The text ' behind X' naming the shown objects made from ``sculpt`` (a Thickness hides it), or ''."""
     shown = [o.Label for o in sculpt.InList if getattr(getattr(o, "ViewObject", None), "Visibility", False)]
     return f" behind {', '.join(shown)}" if shown else ""
+
+
+def surface_normal(sculpt: Any, point: Any) -> tuple[float, float, float] | None:
+    """The unit normal of ``sculpt``'s live surface at its mesh point nearest ``point`` (central
+    differences over its neighbours), or None where the mesh gives none there."""
+    from ..app.analysis import vertex_normals
+    s = sculpt.Proxy.live.snapshot()
+    mesh = np.asarray(s.mesh, float)
+    i, j = divmod(int(s.nearest_mesh_index([float(c) for c in point])), mesh.shape[1])
+    around = mesh[max(i - 1, 0):i + 2, max(j - 1, 0):j + 2]
+    n = vertex_normals(around)[min(i, 1), min(j, 1)]
+    return tuple(float(c) for c in n) if np.linalg.norm(n) > 0.5 else None
 
 
 def _alive(obj: Any) -> bool:
