@@ -102,3 +102,36 @@ def test_a_name_typed_in_the_tree_keeps_its_letters_while_the_pointer_crosses_th
         assert sculpt(s)["constraints"][0][0] == "point"
     finally:
         d.close()
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD's GUI")
+def test_keys_with_the_pointer_over_the_tree_leave_the_sculpt_alone(tmp_path):
+    """P over the patch pins a point; the pointer then moves onto the model tree, no click: the view
+    still has the keyboard, but P, N and M there neither take the pin away, nor add a normal where
+    the pointer last was, nor show a map. Back over the view, P works again."""
+    d = tree_shown_desktop(str(tmp_path))
+    try:
+        s = d.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
+        d.calibrate()
+        centre, east, _, _, _ = [d.to_screen(p) for p in sculpt(s)["screen"]]
+        d.xdo("mousemove", str(east[0]), str(east[1]))
+        d.wait(lambda s: s["mouse_point"] is not None, "the pointer over the patch")
+        d.xdo("key", "p")
+        s = d.wait(lambda s: len(sculpt(s)["constraints"]) == 1, "P: a point constraint")
+        before, displays, view_focus = undo(s), [ov["display"] for ov in s["overlays"]], s["focus"]
+        item = d.wait(lambda s: sculpt(s)["label"] in s["tree"], "the sculpt in the tree")["tree"][sculpt(s)["label"]]
+        d.xdo("mousemove", str(item[0] + 60), str(item[1] + 120))  # (below the items: the tree's empty part)
+        assert d.state()["focus"] == view_focus, "the view lost the keyboard: the keys would prove nothing"
+        d.xdo("key", "--delay", "150", "p", "n", "m")
+        # nothing may happen, so there is nothing to wait for but what the keys would have done by
+        # now: a key typed next over the view is handled after them, in order
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.wait(lambda s: s["mouse_point"] is not None, "the pointer over the patch again")
+        d.xdo("key", "c")
+        s = d.wait(lambda s: len(sculpt(s)["constraints"]) == 2, "C over the view: a curvature constraint")
+        assert [c[0] for c in sculpt(s)["constraints"]] == ["point", "curvature"], sculpt(s)["constraints"]
+        assert undo(s)[1:] == before, undo(s)
+        assert [ov["display"] for ov in s["overlays"]] == displays
+        d.shot("focus_keys_over_tree")
+    finally:
+        d.close()

@@ -5,8 +5,10 @@ it was last given: after the Python console was used, P typed a "p" there and ct
 console's text. While the workbench is active, a mouse move over a 3D view gives that view the
 keyboard, as a click in it would, unless a task dialog is open (its fields keep what is typed),
 another window is active (a dialog) or a field is being typed in (a name in the tree, a value in
-the property editor: its letters P, N, C and M went to the view as constraints). The widgets are
-FreeCAD's own, reached through its main window object: no Qt module is imported.
+the property editor: its letters P, N, C and M went to the view as constraints). The view keeps the
+keyboard when the pointer leaves it (FreeCAD's own keys still work there), so the workbench's keys
+act only while the pointer is over the view: over the model tree, P took away a pin out of sight.
+The widgets are FreeCAD's own, reached through its main window object: no Qt module is imported.
 """
 from __future__ import annotations
 
@@ -30,3 +32,12 @@ def give_keyboard_to_view(view) -> None:
     widget = view.graphicsView()
     if widget is not None and not widget.hasFocus():
         widget.setFocus()
+
+
+def pointer_over(view) -> bool:
+    """Whether the pointer is inside ``view`` (or over a panel FreeCAD lays over it). From where
+    the view finds the pointer, not from the widget's under-mouse flag, which FreeCAD 1.1's view
+    (Qt6) never set."""
+    x, y = view.getCursorPos()
+    w, h = view.getSize()
+    return 0 <= x < w and 0 <= y < h

@@ -366,6 +366,9 @@ class Controller:
             return
         if event.wasCtrlDown() or event.wasAltDown():
             return  # ctrl+N and the like belong to FreeCAD
+        from .view_focus import pointer_over
+        if not pointer_over(view):
+            return  # (the view kept the keyboard, the pointer went on to the tree: not the view's key)
         self.mouse_view = view
         try:
             if key in KEYS:
