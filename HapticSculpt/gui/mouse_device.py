@@ -12,8 +12,9 @@ from ..core import native as _core
 GRAB_PIXELS = 4
 #: A view looks onto the surface when its direction is within this many degrees of the surface's
 #: normal at the grab: a drag in the plane facing the screen would then slide the grab along the
-#: surface, unseen, so the drag lifts it instead (up: toward the eye).
-FACING_DEGREES = 30.0
+#: surface, unseen, so the drag lifts it toward the eye instead. (An isometric view of a flat patch
+#: is 55 degrees off its normal: its drags stay in the plane facing the screen, which lifts there.)
+FACING_DEGREES = 45.0
 
 
 class MouseDevice:
@@ -93,10 +94,11 @@ class MouseDevice:
         the grab, is the surface being pulled: a cursor put on it slid along it, and a face of a
         solid, with the solid all around under the pointer, barely rose.) Where the view looks onto
         the sculpted surface at the grab (within FACING_DEGREES of its normal there, as from the
-        top onto a flat patch), that plane is the surface's own, so the drag up from ``pixel``
-        lifts along the normal toward the eye instead, and a drag sideways moves along the surface.
-        (The sculpted surface's normal, not the one of the face under the pointer: a slab's side,
-        seen from the front, faces the eye where the surface does not.)"""
+        top onto a flat patch, or onto a bump's side), that plane slides the grab along the surface,
+        so the drag up from ``pixel`` lifts it straight toward the eye instead, as the designer
+        looking down expects, and a drag sideways moves it sideways on the screen. (The sculpted
+        surface's normal, not the one of the face under the pointer: a slab's side, seen from the
+        front, faces the eye where the surface does not.)"""
         self._buttons = 1 if held else 0
         d = view.getViewDirection() if held and view is not None else None
         self._grab_plane = (self._position, (float(d.x), float(d.y), float(d.z))) if d is not None else None
@@ -105,8 +107,8 @@ class MouseDevice:
             n = self.normal_at(self._position)
             along = 0.0 if n is None else n[0] * d.x + n[1] * d.y + n[2] * d.z
             if abs(along) >= math.cos(math.radians(FACING_DEGREES)):
-                toward_eye = tuple(-c if along > 0 else c for c in n)
-                self._lift = _Lift(view, int(pixel[0]), int(pixel[1]), self._position, toward_eye)
+                self._lift = _Lift(view, int(pixel[0]), int(pixel[1]), self._position,
+                                   (-float(d.x), -float(d.y), -float(d.z)))
         self.native.push(list(self._position), buttons=self._buttons)
 
     def _on_move(self, view: Any, cb: Any) -> None:
@@ -168,24 +170,20 @@ def _picked(view: Any, x: int, y: int) -> tuple[float, float, float] | None:
 
 class _Lift:
     """A grab in a view that looks onto the surface: the pointer's move from the press, measured on
-    the view's focal plane, moves the grab point as far, its upward part along ``toward_eye`` (the
-    surface's normal, turned to the eye) and its sideways part along the surface."""
+    the view's focal plane, moves the grab point as far, its upward part ``toward_eye`` (against
+    the view direction) and its sideways part sideways on the screen."""
 
     def __init__(self, view: Any, x: int, y: int, grab: Sequence[float], toward_eye: Sequence[float]) -> None:
-        self.grab, self.normal = tuple(grab), tuple(toward_eye)
+        self.grab, self.toward_eye = tuple(grab), tuple(toward_eye)
         self.start = _vector(view.getPoint(x, y))
         self.right = _unit(_minus(_vector(view.getPoint(x + 1, y)), self.start))
         self.up = _unit(_minus(_vector(view.getPoint(x, y + 1)), self.start))
-        # the screen's sideways axis laid onto the surface (its plane through the grab)
-        r = self.right
-        along = sum(a * b for a, b in zip(r, self.normal))
-        self.sideways = _unit(tuple(a - along * b for a, b in zip(r, self.normal)))
 
     def at(self, view: Any, x: int, y: int) -> tuple[float, float, float]:
         move = _minus(_vector(view.getPoint(x, y)), self.start)
         side = sum(a * b for a, b in zip(move, self.right))
         up = sum(a * b for a, b in zip(move, self.up))
-        return tuple(g + side * s + up * n for g, s, n in zip(self.grab, self.sideways, self.normal))
+        return tuple(g + side * r + up * e for g, r, e in zip(self.grab, self.right, self.toward_eye))
 
 
 def _vector(v: Any) -> tuple[float, float, float]:
