@@ -137,6 +137,12 @@ try:
     res["accepted"] = panel.accept()
     res["written"] = panel.path()
     res["last_folder"] = params.GetString(export_panel.LAST_FOLDER[1])
+    again = export_panel.ExportStepPanel([solid])  # the same file again: OK asks first, then replaces it
+    again.form.file.setProperty("fileName", panel.path())
+    written = os.path.getmtime(panel.path())
+    os.utime(panel.path(), (written - 100, written - 100))
+    res["replace_first"] = [again.accept(), str(again.form.message.text()), os.path.getmtime(panel.path()) == written - 100]
+    res["replace_second"] = [again.accept(), os.path.getmtime(panel.path()) > written - 100]
     shape = Part.read(panel.path())
     res["solids"] = len(shape.Solids)
     res["volume"] = [shape.Volume, solid.Shape.Volume]
@@ -179,6 +185,8 @@ def test_export_step_chooses_the_only_sculpted_solid_and_refuses_a_bad_file_name
     assert out["refused"] is False  # (said in the report view; the panel stays open)
     assert out["accepted"] is True and out["written"] == str(tmp_path / "part.step")
     assert out["last_folder"] == str(tmp_path)  # (the next export starts where this one went)
+    assert out["replace_first"] == [False, "part.step exists: OK again replaces it", True]  # (nothing written)
+    assert out["replace_second"] == [True, True]
     assert out["solids"] == 1 and out["volume"][0] == pytest.approx(out["volume"][1], rel=1e-6)
     assert out["undo_same"]  # exporting is no edit
     assert out["running"] and out["stopped"]

@@ -74,6 +74,7 @@ class ExportStepPanel:
         self.form = Gui.PySideUic.loadUi(UI)
         self.form.objects.setText("Export " + ", ".join(o.Label for o in objs))
         self.form.file.setProperty("fileName", default_path(objs))
+        self._replace: str | None = None  # a file that exists and OK was pressed for once: the next OK replaces it
 
     def path(self) -> str:
         """The file name the chooser holds, with .step added if it has no STEP suffix."""
@@ -83,11 +84,19 @@ class ExportStepPanel:
         return _OK | _CANCEL
 
     def accept(self) -> bool:
+        """Exports, unless the file exists and was not offered for replacing yet: the panel then
+        says so and stays open, and OK again replaces it (no file is overwritten unasked)."""
         from .echo import ref, run_echoed
+        path = self.path()
+        if os.path.exists(path) and self._replace != path:
+            self._replace = path
+            self.form.message.setText(f"{os.path.basename(path)} exists: OK again replaces it")
+            return False
         try:
-            run_echoed(f"HapticSculpt.export_step([{', '.join(ref(o) for o in self.objs)}], {self.path()!r})")
+            run_echoed(f"HapticSculpt.export_step([{', '.join(ref(o) for o in self.objs)}], {path!r})")
         except Exception as exc:  # noqa: BLE001 - said in the report view; the panel stays open to fix the name
             FreeCAD.Console.PrintError(f"HapticSculpt: Export STEP: {exc}\n")
+            self.form.message.setText(str(exc))
             return False
         FreeCAD.Console.PrintMessage(f"HapticSculpt: exported {', '.join(o.Label for o in self.objs)} to "
                                      f"{self.path()}\n")
