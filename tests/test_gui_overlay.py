@@ -65,22 +65,13 @@ try:
     Gui.runCommand("HapticSculpt_PointConstraint")
     ctl.mouse_point = mesh[g // 4, 3 * h // 4]
     Gui.runCommand("HapticSculpt_NormalConstraint")
+    # (the keys themselves, real ones with the pointer in the view: test_gui_real_input, test_gui_focus_keys)
     from pivy import coin
-    class FakeCallback:
-        def __init__(self, key):
-            self.event = coin.SoKeyboardEvent()
-            self.event.setKey(key)
-            self.event.setState(coin.SoButtonEvent.DOWN)
-            self.handled = False
-        def getEvent(self):
-            return self.event
-        def setHandled(self):
-            self.handled = True
     ctl.mouse_point = mesh[3 * g // 4, 3 * h // 4]
-    ctl.on_key(view, FakeCallback(coin.SoKeyboardEvent.C))
+    Gui.runCommand("HapticSculpt_CurvatureConstraint")
     ctl.mouse_point = mesh[3 * g // 4, h // 4]
-    ctl.on_key(view, FakeCallback(coin.SoKeyboardEvent.P))
-    ctl.on_key(view, FakeCallback(coin.SoKeyboardEvent.P))  # again: removes it
+    Gui.runCommand("HapticSculpt_PointConstraint")
+    Gui.runCommand("HapticSculpt_PointConstraint")  # again: removes it
     out["constraints"] = sorted(c["kind"] for c in surface.constraints)
     class FakeMouse:
         def __init__(self, event):
@@ -238,9 +229,9 @@ try:
     out["undo_after_panel"] = [doc.UndoNames[0], doc.UndoCount - undo_before]
     Gui.runCommand("HapticSculpt_Combs")
     Gui.runCommand("HapticSculpt_Panel")
-    ctl.on_key(view, FakeCallback(coin.SoKeyboardEvent.M))
+    ctl.toggle_map()  # (what M does: the real key in test_gui_real_input)
     out["m_key"] = ov.display
-    ctl.on_key(view, FakeCallback(coin.SoKeyboardEvent.M))
+    ctl.toggle_map()
     out["m_key_back"] = ov.display
     out["timer_after_off"] = ov._timer is not None
     Gui.activateWorkbench("PartWorkbench")
