@@ -163,8 +163,8 @@ test: test-cpp test-asan test-tsan test-python test-addon demo test-other-debian
 # ASan and TSan builds are the slowest part), so that make test fits in an hour.
 ROOT_PACKAGES := $(APT_PACKAGES) make ca-certificates
 IN_ROOT = tools/debian-root $(1) run env HS_STRESS_SEEDS=$(STRESS_SEEDS_$(1)) make BUILD=build/$(1) DEMO_OUT=build/$(1)/demo
-# The stress test's seeds in each root: the host runs 0..9999, each root 2,000 of its own (the same
-# core, built by another compiler: more seeds covered in less time than 10,000 three times).
+# The stress test's seeds in each root: the host runs 0..3999, each root 2,000 of its own (the same
+# core, built by another compiler: more seeds covered in less time than the same ones three times).
 STRESS_SEEDS_bookworm := 10000:2000
 STRESS_SEEDS_trixie   := 12000:2000
 STRESS_SEEDS_forky    := 14000:2000
@@ -214,7 +214,8 @@ fuzz: deps
 # Campaigns run their scenes on Dask distributed (bench/campaign.py): a local cluster over all cores
 # unless CAMPAIGN says otherwise ("--workers 4", "--scheduler tcp://HOST:8786", "--workers 0": serial).
 CAMPAIGN ?=
-# The long stability campaign (make test runs seeds 0..9999; this goes on from there). Resumable.
+# The long stability campaign (make test runs seeds 0..3999 and 10000..15999; this goes on from
+# 10000 with its own log). Resumable.
 STRESS_SCENES ?= 100000
 stress: build
 	$(PY) bench/stress_campaign.py --scenes $(STRESS_SCENES) $(CAMPAIGN)

@@ -84,7 +84,7 @@ def summarise(log: str, first: int, scenes: int) -> dict:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scenes", type=int, default=100_000)
-    ap.add_argument("--first", type=int, default=10_000, help="first seed (make test covers 0..9999)")
+    ap.add_argument("--first", type=int, default=10_000, help="first seed (make test covers 0..3999 on the host)")
     ap.add_argument("--log", default=os.path.join(ROOT, "build", "stress", "campaign.jsonl"))
     ap.add_argument("--out", default=os.path.join(ROOT, "bench", "results", "stress_campaign.json"))
     campaign.add_arguments(ap)
