@@ -98,10 +98,9 @@ class ExportStepPanel:
             FreeCAD.Console.PrintError(f"HapticSculpt: Export STEP: {exc}\n")
             self.form.message.setText(str(exc))
             return False
-        FreeCAD.Console.PrintMessage(f"HapticSculpt: exported {', '.join(o.Label for o in self.objs)} to "
-                                     f"{self.path()}\n")
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: exported {', '.join(o.Label for o in self.objs)} to {path}\n")
         # (remembered as FreeCAD's own dialogs remember it: the next export or save starts there)
-        FreeCAD.ParamGet(LAST_FOLDER[0]).SetString(LAST_FOLDER[1], os.path.dirname(self.path()))
+        FreeCAD.ParamGet(LAST_FOLDER[0]).SetString(LAST_FOLDER[1], os.path.dirname(path))
         Gui.Control.closeDialog()
         return True
 
