@@ -291,3 +291,59 @@ class TestStop(DocumentTestCase):
         self.doc.redo()
         np.testing.assert_array_equal(read_state(obj).arrays["Poles"], kept.arrays["Poles"])
         self.assertEqual(obj.Strokes, 1)
+
+
+class TestDroppedStroke(DocumentTestCase):
+    """Session.drop_stroke (Esc or Undo during a drag in the GUI): the stroke held is not committed
+    and the surface goes back to the document's state; the strokes around it are kept."""
+
+    @staticmethod
+    def kept_then_held() -> hs.ReplayDevice:
+        """A stroke up (0-0.4 s), released, then one held 0.6-3 s (long: the drop lands in it)."""
+        return hs.ReplayDevice(t=[0.0, 0.4, 0.5, 0.6, 1.0, 3.0, 3.1],
+                               xyz=[[0, 0, 0], [0, 0, 20], [0, 0, 20], [10, 10, 0], [10, 10, 25], [10, 10, 25],
+                                    [10, 10, 25]], buttons=[1, 1, 0, 1, 1, 1, 0])
+
+    def held_after_the_first(self, session, obj) -> np.ndarray:
+        """Polls until the first stroke is committed and the second grabs; the document's poles then."""
+        end = time.monotonic() + 20
+        while obj.Strokes < 1 or not session.status()["grab"]:
+            self.assertLess(time.monotonic(), end, "no first stroke, or no second grab")
+            session.poll()
+            time.sleep(0.005)
+        self.assertLess(session.status()["elapsed"], 2.5, "the machine was too slow to drop in the held stroke")
+        return np.array(obj.Poles)
+
+    def test_a_dropped_stroke_is_not_committed_and_the_surface_goes_back(self):
+        obj = hs.make_sculpt(self.doc, material="clay")
+        session = hs.Session().start(obj, self.kept_then_held(), stop_when_finished=False)
+        kept = self.held_after_the_first(session, obj)
+        steps = list(self.doc.UndoNames)
+        session.drop_stroke()
+        end = time.monotonic() + 20
+        while session.status()["elapsed"] < 3.3:  # (the release at 3.1 s: the dropped stroke's end)
+            self.assertLess(time.monotonic(), end)
+            session.poll()
+            time.sleep(0.005)
+        end = time.monotonic() + 5
+        # (its end dropped: the document's state, taken back at rest, settles by a few hundredths of a mm)
+        while np.abs(session.newest_poles().ravel() - kept).max() > 0.1:
+            self.assertLess(time.monotonic(), end, "the surface did not go back")
+            session.poll()
+            time.sleep(0.005)
+        session.stop()
+        self.assertEqual(list(self.doc.UndoNames), steps)
+        self.assertEqual((obj.Strokes, session.status()["strokes"]), (1, 2))
+        np.testing.assert_allclose(np.array(obj.Poles), kept, atol=0.1)
+
+    def test_a_stop_while_a_dropped_stroke_is_held_keeps_the_document_as_it_was(self):
+        obj = hs.make_sculpt(self.doc, material="clay")
+        session = hs.Session().start(obj, self.kept_then_held())
+        kept = self.held_after_the_first(session, obj)
+        steps = list(self.doc.UndoNames)
+        session.drop_stroke()
+        session.stop()  # (the button still held: no release, the drop pending)
+        self.assertEqual(list(self.doc.UndoNames), steps)
+        self.assertEqual(obj.Strokes, 1)
+        np.testing.assert_array_equal(np.array(obj.Poles), kept)
+        np.testing.assert_array_equal(np.asarray(obj.Proxy.surface.poles).ravel(), kept)

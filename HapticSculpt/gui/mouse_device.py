@@ -37,6 +37,7 @@ class MouseDevice:
         self._lift: _Lift | None = None  # a grab in a view that looks onto the surface
         self._pressed: tuple[Any, int, int] | None = None  # view and pixel of a press not yet a grab
         self._pointer: tuple[Any, tuple[int, int]] | None = None  # view and pixel of the last move
+        self._dropped = False  # a grab let go by cancel(): the button's release is still to come
 
     def attach(self, view: Any) -> None:
         """Follows the mouse in ``view`` (a FreeCADGui 3D view) until :meth:`detach`."""
@@ -87,6 +88,22 @@ class MouseDevice:
         except Exception:  # noqa: BLE001 - its view was closed: the cursor stays
             self._pointer = None
 
+    @property
+    def grabbing(self) -> bool:
+        """True while the left button holds a grab (a press not yet moved is no grab)."""
+        return bool(self._buttons)
+
+    def cancel(self) -> bool:
+        """Lets go of the grab the button holds (Esc, Undo): the cursor hovers again and the rest of
+        the drag, up to the release, is the pointer's alone. True if there was a grab."""
+        grabbed = bool(self._buttons)
+        if grabbed or self._pressed is not None:
+            self._dropped = True
+        self._pressed = None
+        if grabbed:
+            self.press(False)
+        return grabbed
+
     def press(self, held: bool, view: Any = None, pixel: Sequence[int] | None = None) -> None:
         """Button 1 (grab) held or released at the current cursor. A grab in ``view`` then moves the
         cursor in the plane through the grab point that faces the screen: the pointer dragged up in
@@ -119,8 +136,8 @@ class MouseDevice:
             self.press(True, view, self._pressed[1:])  # the grab starts where the button went down
             self._pressed = None
         self.move_to(view, (pos[0], pos[1]))
-        if self._buttons or self._pressed is not None:
-            cb.setHandled()  # a grab: not a selection box or a rotation
+        if self._buttons or self._pressed is not None or self._dropped:
+            cb.setHandled()  # a grab (or a cancelled one's drag): not a selection box or a rotation
 
     def _on_button(self, view: Any, cb: Any) -> None:
         from pivy import coin
@@ -130,8 +147,13 @@ class MouseDevice:
             down = event.getState() == coin.SoButtonEvent.DOWN
             if down and self.yields is not None and self.yields(view, (pos[0], pos[1])):
                 return
+            if not down and self._dropped and not self._buttons and self._pressed is None:
+                self._dropped = False
+                cb.setHandled()  # (the release of a cancelled grab: no click for the selection)
+                return
             if not down and not self._buttons and self._pressed is None:
                 return  # (the release of a press it did not take)
+            self._dropped = False
             self.move_to(view, (pos[0], pos[1]))
             if event.getState() == coin.SoButtonEvent.DOWN:
                 self._pressed = (view, int(pos[0]), int(pos[1]))  # a grab once it moves (GRAB_PIXELS)

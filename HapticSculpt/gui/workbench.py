@@ -361,6 +361,10 @@ class Controller:
         event = cb.getEvent()
         if event.getState() != coin.SoButtonEvent.DOWN:
             return
+        if (event.getKey() == coin.SoKeyboardEvent.ESCAPE or (event.getKey() == coin.SoKeyboardEvent.Z and
+                                                             event.wasCtrlDown())) and self.drop_held():
+            cb.setHandled()  # (ctrl+z reaches the view only while FreeCAD has nothing to undo: see _UndoObserver)
+            return
         key = event.getPrintableCharacter().lower() if hasattr(event, "getPrintableCharacter") else ""
         if key not in KEYS and key != "m":
             return
@@ -379,6 +383,36 @@ class Controller:
             import FreeCAD
             FreeCAD.Console.PrintWarning(f"HapticSculpt: {exc}\n")
         cb.setHandled()
+
+    def holds_stroke(self, doc: Any = None) -> bool:
+        """True while the left button holds a stroke (of ``doc``'s sculpt, if given): a mouse
+        session's grab, or an airbrush stroke without a session."""
+        if self.mouse is not None and self.mouse.grabbing and self.session is not None and self.session.running:
+            obj = self.session.obj
+        elif self._paint_stroke is not None:
+            obj = self._paint_stroke
+        else:
+            return False
+        return doc is None or (_alive(obj) and obj.Document == doc)
+
+    def drop_held(self) -> bool:
+        """Drops the stroke the left button holds (Esc, or Undo, during a drag): a mouse session's
+        grab lets go and the surface goes back to the document's state; an airbrush stroke's dabs
+        are taken back. Nothing of it is committed or echoed, and the rest of the drag does nothing.
+        (The drag went on from whatever Undo left, and its release committed it.) True if there was one."""
+        if not self.holds_stroke():
+            return False
+        if self._paint_stroke is not None:
+            obj, self._paint_stroke, self._paint_path = self._paint_stroke, None, []
+            if _alive(obj):
+                obj.Proxy.live.revert_map(self.painting)
+                self.refresh(obj)
+        else:
+            self.session.drop_stroke()  # (before the grab lets go: its end is the one dropped)
+            self.mouse.cancel()
+        import FreeCAD
+        FreeCAD.Console.PrintMessage("HapticSculpt: the stroke in hand was dropped; the surface is as before it\n")
+        return True
 
     def _follow(self, view: Any) -> None:
         """The pointer came into ``view``: a running session's sculpt is drawn each frame there, with
@@ -656,13 +690,36 @@ class Controller:
 
 class _UndoObserver:
     """Undo and Redo show at once: the overlays redraw from the restored state (a running session
-    takes it up through its own observer)."""
+    takes it up through its own observer). Undo during a drag (ctrl+z with the button held) takes
+    back the stroke in hand, and only that: FreeCAD's Undo has by then taken back the step before
+    it, which is done again at once. (Undo took back the previous stroke and the drag carried on
+    from there.)"""
 
     def __init__(self, ctl: Controller) -> None:
         self.ctl = ctl
+        self._redo: Any = None  # the one-shot sensor doing the step again, while it is pending
 
     def slotUndoDocument(self, doc: Any) -> None:
+        if self.ctl.holds_stroke(doc) and self.ctl.drop_held():
+            self._redo_soon(doc)
         self.ctl.refresh_all()
+
+    def _redo_soon(self, doc: Any) -> None:
+        """Redoes ``doc``'s undone step once FreeCAD's Undo has finished (not inside its signal)."""
+        from pivy import coin
+
+        def redo(*_: Any) -> None:
+            import FreeCADGui as Gui
+            self._redo = None
+            if not _alive_document(doc) or doc.RedoCount == 0:
+                return
+            if Gui.ActiveDocument is not None and Gui.ActiveDocument.Document == doc:
+                # (echoed as FreeCAD echoes the Undo: a macro plays both, or neither, as its Gui lines)
+                Gui.doCommandGui("Gui.runCommand('Std_Redo',0)")
+            else:
+                doc.redo()
+        self._redo = coin.SoOneShotSensor(redo, None)
+        self._redo.schedule()
 
     def slotRedoDocument(self, doc: Any) -> None:
         self.ctl.refresh_all()
@@ -690,6 +747,14 @@ def _alive(obj: Any) -> bool:
     try:
         return obj.Document is not None and obj.Document.getObject(obj.Name) is obj
     except Exception:  # noqa: BLE001 - a deleted object raises on any access
+        return False
+
+
+def _alive_document(doc: Any) -> bool:
+    import FreeCAD
+    try:
+        return FreeCAD.listDocuments().get(doc.Name) == doc
+    except Exception:  # noqa: BLE001 - a closed document raises on any access
         return False
 
 

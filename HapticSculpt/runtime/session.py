@@ -81,6 +81,10 @@ class Session:
         self._latest_maps: dict[str, np.ndarray] = {}  # the newest snapshot of each map sprayed this run
         self._next_edit = 1
         self._committed = False
+        self._strokes_taken = 0  # stroke and spray ends taken from the runtime this run
+        #: the stroke end to drop (its ordinal among those taken), set by drop_stroke while it is held
+        self._drop: int | None = None
+        self._dropped_in_stop = False
         self._edits: dict[int, tuple[str, sculpt_state.SculptState | None, int]] = {}  # posted, not yet applied
         #: the state a macro replayed in console mode holds after the lines echoed so far (None: not
         #: known, an edit's own call failed on it; the document's state stands in then)
@@ -136,6 +140,7 @@ class Session:
         self._latest_poles, self._latest_maps, self._edits, self.applied_edits = None, {}, {}, []
         self._previewed = False
         self._committed = False  # a stroke, spray or edit this run (else its end commits nothing)
+        self._strokes_taken, self._drop, self._dropped_in_stop = 0, None, False
         self._console, self._last_commit = obj.Proxy.live.stored(), None
         runtime.set_airbrush(**self._airbrush)
         runtime.start()
@@ -198,10 +203,21 @@ class Session:
             obj.Proxy.live.detach(runtime.surface)
             if commit:
                 self._commit_strokes(runtime, obj, final=sculpt_state.capture(obj.Proxy.live.surface))
-                self._commit_final(obj)
+                if self._drop is not None or self._dropped_in_stop:
+                    obj.Proxy.live.document_changed()  # (a dropped stroke's motion is no change)
+                else:
+                    self._commit_final(obj)
             obj.Proxy.live.reset_shape()
         self._last_runtime = runtime  # logs stay readable (recording, force errors)
         return status
+
+    def drop_stroke(self) -> None:
+        """The stroke held now is dropped: call it before the device releases its grab. Its end is
+        not committed, no line is echoed for it, and the surface goes back to the document's state
+        (Esc, or Undo, during a drag: nothing of the stroke in hand is kept)."""
+        if self._runtime is None:
+            raise RuntimeError("session: not running")
+        self._drop = int(self._runtime.status()["strokes"])
 
     # --- the live surface's link (see live_surface.SessionLink) -------------------------------------
     def post_edit(self, prepared: Any, state: sculpt_state.SculptState | None, title: str, restore: bool,
@@ -380,7 +396,18 @@ class Session:
         live = obj.Proxy.live
         events = []
         while (event := runtime.take_stroke()) is not None:
+            if event["edit"] is None:
+                self._strokes_taken += 1
+                if self._strokes_taken - 1 == self._drop:
+                    self._drop = None
+                    if final is not None:  # (stopping: the stop puts the document's state back)
+                        self._dropped_in_stop = True
+                    else:
+                        live.restore_into_session()
+                    continue
             events.append(event)
+        if self._dropped_in_stop:
+            final = None  # (the surface at the stop holds the dropped stroke)
         last = max((k for k, e in enumerate(events) if e["edit"] is None or self._edits.get(e["edit"], ("", None))[1]
                     is not None), default=-1)
         for k, event in enumerate(events):
