@@ -912,6 +912,19 @@ def test_esc_or_ctrl_z_during_a_drag_drops_the_stroke_in_hand_only(tmp_path):
         assert undo(s) == ["Sculpt stroke"] + steps, undo(s)
         assert np.abs(np.array(sculpt(s)["poles"]) - kept).max() < 0.3, "Stop kept another surface"
         d.shot("dropped_drags_kept_stroke")
+        # the airbrush outside a session: Esc in a paint drag takes its dabs back, no step
+        steps, plain = undo(s), sculpt(s)["stiffness_values"]
+        d.press_button("PaintStiffness", lambda s: s["painting"] == "stiffness", "the airbrush")
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.wait(lambda s: s["mouse_point"] is not None, "the mouse over the patch", shot=False)
+        d.xdo("mousedown", "1")
+        for k in range(1, 8):
+            d.xdo("mousemove", str(centre[0] + 8 * k), str(centre[1]))
+        d.wait(lambda s: s["paint_dabs"] > 1, "the held paint drag's dabs")
+        d.xdo("key", "Escape")
+        d.xdo("mousemove", str(centre[0] + 80), str(centre[1]), "mouseup", "1")
+        s = d.wait_still(lambda s: (undo(s), sculpt(s)["stiffness_values"]), "the paint drag dropped")
+        assert s == (steps, plain), f"Esc kept the paint drag: {s[0][:2]}"
     finally:
         d.close()
 

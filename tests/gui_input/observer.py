@@ -391,6 +391,7 @@ def write(*_):
         import HapticSculpt.gui.workbench as hg
         ctl = hg.controller()
         state["painting"] = ctl.painting
+        state["paint_dabs"] = len(ctl._paint_path) if ctl._paint_stroke is not None else 0  # (a held paint drag's)
         state["session"] = ctl.session is not None
         state["inputs"] = len(ctl.inputs)
         state["mouse_point"] = None if ctl.mouse_point is None else [float(x) for x in ctl.mouse_point]
