@@ -861,6 +861,12 @@ def test_esc_or_ctrl_z_during_a_drag_drops_the_stroke_in_hand_only(tmp_path):
         d.calibrate()
         centre, east = (d.to_screen(p) for p in sculpt(s)["screen"][:2])
         steps = undo(s)
+        # a hover in the session lights nothing: FreeCAD's preselection washed out the surface
+        for k in range(8):
+            d.xdo("mousemove", str(east[0] - 10 * k), str(east[1] + 5 * k))
+        d.wait(lambda s: s["mouse_point"] is not None and abs(s["mouse_point"][0] - s["mouse_point"][1]) > 0 and
+               any(o["cursor_at"] for o in s["overlays"]), "the session's cursor over the patch", shot=False)
+        assert d.wait_still(lambda s: str(s["preselection"]), "the hover's preselection") == "None"
 
         def lifted(s: dict) -> float:  # (what the session draws, mm)
             return float(np.array(sculpt(s)["drawn_poles"]).reshape(-1, 3)[:, 2].max())
@@ -916,7 +922,7 @@ def test_esc_or_ctrl_z_during_a_drag_drops_the_stroke_in_hand_only(tmp_path):
         steps, plain = undo(s), sculpt(s)["stiffness_values"]
         d.press_button("PaintStiffness", lambda s: s["painting"] == "stiffness", "the airbrush")
         d.xdo("mousemove", str(centre[0]), str(centre[1]))
-        d.wait(lambda s: s["mouse_point"] is not None, "the mouse over the patch", shot=False)
+        d.wait(lambda s: s["preselection"], "the hover's preselection outside a session", shot=False)
         d.xdo("mousedown", "1")
         for k in range(1, 8):
             d.xdo("mousemove", str(centre[0] + 8 * k), str(centre[1]))

@@ -88,8 +88,10 @@ def test_new_patch_without_a_document_then_thicken_choosing_the_thickness(tmp_pa
         d.xdo("mousemove", "640", "500", "key", "1")  # front view: the slab's top rises up the screen
         d.calibrate()
         centre = d.to_screen(sculpt(d.state())["screen"][0])
+        before = [o["cursor_at"] for o in d.state()["overlays"]]
         d.xdo("mousemove", str(centre[0]), str(centre[1]))
-        d.wait(lambda s: s["preselection"], "the mouse over the slab")
+        # (the session's cursor following the pointer: a session's hover lights no preselection)
+        d.wait(lambda s: [o["cursor_at"] for o in s["overlays"]] != before, "the session's cursor over the slab")
         d.xdo("mousedown", "1")
         try:
             for k in range(1, 13):

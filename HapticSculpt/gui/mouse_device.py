@@ -38,6 +38,7 @@ class MouseDevice:
         self._pressed: tuple[Any, int, int] | None = None  # view and pixel of a press not yet a grab
         self._pointer: tuple[Any, tuple[int, int]] | None = None  # view and pixel of the last move
         self._dropped = False  # a grab let go by cancel(): the button's release is still to come
+        self._navigating: set[int] = set()  # the other buttons held (the navigation style's)
 
     def attach(self, view: Any) -> None:
         """Follows the mouse in ``view`` (a FreeCADGui 3D view) until :meth:`detach`."""
@@ -136,12 +137,22 @@ class MouseDevice:
             self.press(True, view, self._pressed[1:])  # the grab starts where the button went down
             self._pressed = None
         self.move_to(view, (pos[0], pos[1]))
-        if self._buttons or self._pressed is not None or self._dropped:
-            cb.setHandled()  # a grab (or a cancelled one's drag): not a selection box or a rotation
+        event = cb.getEvent()
+        if self._buttons or self._pressed is not None or self._dropped or not (
+                self._navigating or event.wasShiftDown() or event.wasCtrlDown() or event.wasAltDown()):
+            # A grab (or a cancelled one's drag): not a selection box or a rotation. A hover: no
+            # preselection, whose highlight washed out the surface being sculpted under the pointer.
+            # (A move with another button or a modifier held is the navigation style's.)
+            cb.setHandled()
 
     def _on_button(self, view: Any, cb: Any) -> None:
         from pivy import coin
         event = cb.getEvent()
+        if event.getButton() != coin.SoMouseButtonEvent.BUTTON1:
+            if event.getState() == coin.SoButtonEvent.DOWN:
+                self._navigating.add(event.getButton())
+            else:
+                self._navigating.discard(event.getButton())
         if event.getButton() == coin.SoMouseButtonEvent.BUTTON1:
             pos = event.getPosition()
             down = event.getState() == coin.SoButtonEvent.DOWN

@@ -599,6 +599,8 @@ class Controller:
             device = MouseDevice(yields=self.panel_at, normal_at=lambda p: surface_normal(obj, p))
             # (its document's views only: a drag in another document's view sculpted this one, unseen)
             device.attach_all(views_of(obj.Document.Name))
+            import FreeCADGui as Gui  # (the device keeps hovers from the selection: none left lit)
+            Gui.Selection.clearPreselection()
         self.mouse = device if isinstance(device, MouseDevice) else None
         self.airbrush_for(obj)
         session = Session()
