@@ -900,7 +900,6 @@ def test_esc_or_ctrl_z_during_a_drag_drops_the_stroke_in_hand_only(tmp_path):
         s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the kept stroke's undo step")
         kept = np.array(sculpt(s)["poles"])
         assert np.abs(kept - flat).max() > 2.0, "the kept stroke did not pull"
-        d.wait_still(lambda s: round(lifted(s), 3), "the kept stroke at rest")
         held_drag(centre, "ctrl+z", kept)
         s = d.wait_still(lambda s: (undo(s), s["docs"][s["active"]]["redo"], round(lifted(s), 3)),
                          "the surface after ctrl+z in the drag")
@@ -931,6 +930,85 @@ def test_esc_or_ctrl_z_during_a_drag_drops_the_stroke_in_hand_only(tmp_path):
         d.xdo("mousemove", str(centre[0] + 80), str(centre[1]), "mouseup", "1")
         s = d.wait_still(lambda s: (undo(s), sculpt(s)["stiffness_values"]), "the paint drag dropped")
         assert s == (steps, plain), f"Esc kept the paint drag: {s[0][:2]}"
+    finally:
+        d.close()
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_a_mouse_session_keeps_to_its_sculpt_its_drags_and_what_it_shows(tmp_path):
+    """A mouse session on a clamped patch, in the order a designer met each trouble: a middle-button
+    pan then a hover lights no preselection (the pan's stayed lit over the surface); a drag whose
+    release a dialog took (ctrl+w's question) is dropped at the next press (the grab followed the
+    hover, and the next click committed it); a paint drag dropped with Esc leaves the map shown as
+    the document's (the dropped dabs stayed on show); a press on another patch selects it and
+    pulls nothing (the session's patch was pulled at its nearest edge)."""
+    d = Desktop(str(tmp_path), "CAD")
+    try:
+        d.xdo("mousemove", "640", "500")
+        d.xdo("key", "ctrl+n")
+        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
+        d.press_button("NewClampedPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new clamped patch")
+        s = d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
+        d.calibrate()
+        centre, east, west = (d.to_screen(p) for p in sculpt(s)["screen"][:3])
+        steps, flat = undo(s), np.array(sculpt(s)["poles"])
+
+        def hover_over(at: tuple[int, int]) -> None:
+            for k in range(6):
+                d.xdo("mousemove", str(at[0] - 6 * k), str(at[1] + 4 * k))
+            d.wait(lambda s: any(o["cursor_at"] for o in s["overlays"]), "the session's cursor", shot=False)
+
+        d.xdo("mousemove", str(centre[0]), str(centre[1]), "mousedown", "2")
+        for k in range(1, 6):
+            d.xdo("mousemove", str(centre[0] + 10 * k), str(centre[1]))
+        d.xdo("mouseup", "2")
+        hover_over(centre)
+        assert d.wait_still(lambda s: str(s["preselection"]), "the preselection after a pan") == "None"
+        s = d.state()
+        centre, east, west = (d.to_screen(p) for p in sculpt(s)["screen"][:3])  # (panned)
+
+        d.xdo("mousemove", str(centre[0]), str(centre[1]), "mousedown", "1")
+        for k in range(1, 11):
+            d.xdo("mousemove", str(centre[0]), str(centre[1] - 8 * k))
+        d.wait(lambda s: np.abs(np.array(sculpt(s)["drawn_poles"]) - flat).max() > 2.0, "the held drag's lift")
+        d.xdo("key", "ctrl+w")
+        d.wait(lambda s: s["message_buttons"].get("Cancel"), "ctrl+w's question")
+        d.wait_window("Unsaved document")  # (up and with the keyboard)
+        d.xdo("mouseup", "1")  # (to the question)
+        d.xdo("key", "Escape")  # (Cancel; on FreeCAD 1.1, Qt 6 lets no click reach it after a release it did not take)
+        d.wait(lambda s: not s["message_buttons"], "the question gone")
+        hover_over(centre)
+        d.xdo("click", "1")
+        s = d.wait_still(lambda s: (undo(s), round(float(np.abs(np.array(sculpt(s)["drawn_poles"]) - flat).max()), 2)),
+                         "the surface after the press that found the grab held")
+        assert s[0] == steps, f"the lost release's drag was committed: {s[0][:2]}"
+        assert s[1] < 0.3, f"the session shows {s[1]} mm off the patch before the drag"
+
+        d.press_button("PaintStiffness", lambda s: s["painting"] == "stiffness", "the airbrush")
+        d.drag([west, centre, east], seconds=0.4)
+        s = d.wait(lambda s: undo(s)[0] == "Paint stiffness", "the kept paint stroke")
+        d.xdo("mousemove", str(east[0]), str(east[1]), "mousedown", "1")
+        for k in range(1, 9):
+            d.xdo("mousemove", str(east[0] - 12 * k), str(east[1] + 4 * k))
+        d.wait(lambda s: sculpt(s)["shown_stiffness"][1] > sculpt(s)["stiffness_map"][1] * 1.02, "the held spray shown")
+        d.xdo("key", "Escape")
+        d.xdo("mouseup", "1")
+        s = d.wait_still(lambda s: (undo(s)[0], sculpt(s)["shown_stiffness"], sculpt(s)["stiffness_map"]),
+                         "the map after the dropped spray")
+        assert s[0] == "Paint stiffness" and np.allclose(s[1], s[2]), f"shown {s[1]}, the document's {s[2]}"
+        d.press_button("PaintStiffness", lambda s: s["painting"] is None, "the airbrush off")
+
+        s = d.press_button("NewPatch", lambda s: len(s["docs"][s["active"]]["sculpts"]) == 2, "a second patch")
+        d.xdo("mousemove", "640", "400", "key", "--delay", "150", "v", "f")  # fit all
+        other = d.wait(lambda s: s["docs"][s["active"]]["sculpts"][1]["screen"], "the second patch on screen")
+        other = d.to_screen(other["docs"][other["active"]]["sculpts"][1]["screen"][0])
+        steps, kept = undo(d.state()), np.array(sculpt(d.state())["poles"])
+        d.drag([other] + [(other[0], other[1] - 10 * k) for k in range(1, 9)], seconds=0.6)
+        d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sculpt001"], "the other patch selected")
+        s = d.wait_still(lambda s: (undo(s), sculpt(s)["strokes"]), "the press on the other patch")
+        assert s[0] == steps and np.array_equal(np.array(sculpt(d.state())["poles"]), kept), s[0][:2]
+        assert sculpt(d.state())["session"], "the session stopped"
+        d.shot("session_keeps_to_its_sculpt")
     finally:
         d.close()
 

@@ -23,12 +23,17 @@ class MouseDevice:
     with the GUI up. ``yields(view, pixel)``: True where a press belongs to something else (the
     slider panel): the device neither grabs nor takes that press, nor its release. ``normal_at(point)``:
     the sculpted surface's unit normal nearest ``point`` (None: unknown), which tells a view that
-    looks onto the surface (see :meth:`press`)."""
+    looks onto the surface (see :meth:`press`). ``lost_release()``: called on a press that comes
+    while a grab is still held, its release having gone elsewhere (a dialog opened by a key during
+    the drag took it, and the grab went on with the hover): it drops the stroke (without it, the
+    grab ends there as if released)."""
 
     def __init__(self, name: str = "mouse", yields: Callable[[Any, tuple[int, int]], bool] | None = None,
-                 normal_at: Callable[[Sequence[float]], Sequence[float] | None] | None = None) -> None:
+                 normal_at: Callable[[Sequence[float]], Sequence[float] | None] | None = None,
+                 lost_release: Callable[[], None] | None = None) -> None:
         self.yields = yields
         self.normal_at = normal_at
+        self.lost_release = lost_release
         self.native = _core.ExternalDevice(name)
         self._callbacks: list[Any] = []
         self._buttons = 0
@@ -142,8 +147,10 @@ class MouseDevice:
                 self._navigating or event.wasShiftDown() or event.wasCtrlDown() or event.wasAltDown()):
             # A grab (or a cancelled one's drag): not a selection box or a rotation. A hover: no
             # preselection, whose highlight washed out the surface being sculpted under the pointer.
-            # (A move with another button or a modifier held is the navigation style's.)
+            # (A move with another button or a modifier held is the navigation style's: the
+            # preselection it lit, a pan's, goes at the next hover.)
             cb.setHandled()
+            _unlight()
 
     def _on_button(self, view: Any, cb: Any) -> None:
         from pivy import coin
@@ -156,6 +163,11 @@ class MouseDevice:
         if event.getButton() == coin.SoMouseButtonEvent.BUTTON1:
             pos = event.getPosition()
             down = event.getState() == coin.SoButtonEvent.DOWN
+            if down and self._buttons:  # (its release went elsewhere)
+                if self.lost_release is not None:
+                    self.lost_release()
+                if self._buttons:
+                    self.press(False)
             if down and self.yields is not None and self.yields(view, (pos[0], pos[1])):
                 return
             if not down and self._dropped and not self._buttons and self._pressed is None:
@@ -172,6 +184,13 @@ class MouseDevice:
                 self._pressed = None
                 self.press(False)
             cb.setHandled()
+
+
+def _unlight() -> None:
+    """Takes away FreeCAD's preselection highlight, if any."""
+    import FreeCADGui as Gui
+    if Gui.Selection.getPreselection().ObjectName:
+        Gui.Selection.clearPreselection()
 
 
 def _on_plane(view: Any, x: int, y: int, point: Sequence[float], normal: Sequence[float]) -> tuple[float, float, float]:

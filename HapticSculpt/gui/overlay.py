@@ -439,7 +439,7 @@ class Overlay:
         parts = [f"tool: {s.tool.name}", "clay" if s.plasticity[0] else "elastic"]
         session = self._session()
         if session is not None:
-            parts.append(f"sculpting with the {session.device_name or 'mouse'}")
+            parts.append(f"sculpting {self.obj.Label} with the {session.device_name or 'mouse'}")
             if session.device_name not in ("", "mouse") and session.rate_and_priority:
                 parts.append(session.rate_and_priority)
         if self.display == "zebra":

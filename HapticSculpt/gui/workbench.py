@@ -346,6 +346,25 @@ class Controller:
         return any(ov.panel.track_at(pixel[0], pixel[1], ov.tracks()) is not None or ov.panel_covers(*pixel)
                    for (vid, _), ov in self.overlays.items() if vid == id(view))
 
+    def _mouse_yields(self, view: Any, pixel: tuple[int, int]) -> bool:
+        """A mouse session's press that is not a grab: one on a slider panel (:meth:`panel_at`), or
+        on another sculpt than the session's, which FreeCAD then selects (the drag pulled the
+        session's sculpt at its nearest edge, unseen where the designer looked)."""
+        if self.panel_at(view, pixel):
+            return True
+        import FreeCAD
+
+        from ..app.sculpted_solid import sculpt_for
+        session_obj = self.session.obj if self.session is not None else None
+        info = view.getObjectInfo((int(pixel[0]), int(pixel[1])))
+        doc = FreeCAD.getDocument(info["Document"]) if info and info.get("Document") else None
+        other = sculpt_for(doc.getObject(info["Object"])) if doc is not None and info.get("Object") else None
+        if other is None or session_obj is None or other == session_obj:
+            return False
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: the session sculpts {session_obj.Label}, not {other.Label}: "
+                                     f"Start/stop sculpting twice, with {other.Label} selected, sculpts it\n")
+        return True
+
     def _panel_button(self, view: Any, event: Any) -> bool:
         """Button 1 on a slider panel: a press on a track takes it, one on the backing between the
         tracks does nothing (neither a dab nor FreeCAD's selection), the release commits the held one."""
@@ -395,7 +414,7 @@ class Controller:
             return False
         return doc is None or (_alive(obj) and obj.Document == doc)
 
-    def drop_held(self) -> bool:
+    def drop_held(self, why: str = "") -> bool:
         """Drops the stroke the left button holds (Esc, or Undo, during a drag): a mouse session's
         grab lets go and the surface goes back to the document's state; an airbrush stroke's dabs
         are taken back. Nothing of it is committed or echoed, and the rest of the drag does nothing.
@@ -411,7 +430,8 @@ class Controller:
             self.session.drop_stroke()  # (before the grab lets go: its end is the one dropped)
             self.mouse.cancel()
         import FreeCAD
-        FreeCAD.Console.PrintMessage("HapticSculpt: the stroke in hand was dropped; the surface is as before it\n")
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: {why + ': ' if why else ''}the stroke in hand was dropped; the "
+                                     "surface is as before it\n")
         return True
 
     def _follow(self, view: Any) -> None:
@@ -596,7 +616,8 @@ class Controller:
         if device is None:
             device, rate = self._attached_device(obj, devices)
         if device is None:
-            device = MouseDevice(yields=self.panel_at, normal_at=lambda p: surface_normal(obj, p))
+            device = MouseDevice(yields=self._mouse_yields, normal_at=lambda p: surface_normal(obj, p),
+                                 lost_release=lambda: self.drop_held("the drag's release went elsewhere (a dialog?)"))
             # (its document's views only: a drag in another document's view sculpted this one, unseen)
             device.attach_all(views_of(obj.Document.Name))
             import FreeCADGui as Gui  # (the device keeps hovers from the selection: none left lit)

@@ -141,6 +141,7 @@ class Session:
         self._previewed = False
         self._committed = False  # a stroke, spray or edit this run (else its end commits nothing)
         self._strokes_taken, self._drop, self._dropped_in_stop = 0, None, False
+        self._restores: set[int] = set()  # posted edits that restore the document's state
         self._console, self._last_commit = obj.Proxy.live.stored(), None
         runtime.set_airbrush(**self._airbrush)
         runtime.start()
@@ -240,6 +241,8 @@ class Session:
             del self._edits[edit_id]
             raise
         self._edits[edit_id] = (title, state, int(posted))
+        if restore:
+            self._restores.add(edit_id)
 
     def latest_poles(self) -> np.ndarray | None:
         """The newest pole snapshot ((nu*nv, 3)) the GUI received, None before the first."""
@@ -415,6 +418,9 @@ class Session:
                 title, state, posted = self._edits.pop(event["edit"], ("", None, 0))
                 self.applied_edits.append({"title": title or "restore", "posted_step": posted,
                                            "applied_step": int(event["step"]), "time": float(event["time"])})
+                if event["edit"] in self._restores:
+                    self._restores.discard(event["edit"])
+                    self._latest_maps.clear()  # (a spray shown before it is gone: the maps are the document's)
                 if state is None:
                     continue  # an Undo or Redo the session took up: the document holds that state already
                 strokes = 0

@@ -29,7 +29,7 @@ def _sculpts(doc):
                     "constraints": [[c["kind"], c["index"]] for c in settings.get("constraints", [])],
                     "plasticity": settings.get("plasticity"), "tool": settings.get("tool", {}).get("name"),
                     "stiffness_map": [min(o.StiffnessMap), max(o.StiffnessMap), len(o.StiffnessMap)],
-                    "stiffness_values": list(o.StiffnessMap),
+                    "stiffness_values": list(o.StiffnessMap), "shown_stiffness": _shown_map(o, "stiffness"),
                     "bending_map": [min(o.BendingMap), max(o.BendingMap), len(o.BendingMap)]
                     if hasattr(o, "BendingMap") else [], "edges": _held_edges(o),
                     "session": o.Proxy.live.session is not None if getattr(o.Proxy, "live", None) else False,
@@ -61,6 +61,15 @@ def _held_edges(o):
         return HapticSculpt.held_boundary(o)
     except Exception:  # noqa: BLE001 - a face sculpted in its solid, or a state being read
         return {}
+
+
+def _shown_map(o, name):
+    """[min, max, count] of the map the displays show (a running session's spray included)."""
+    try:
+        values = o.Proxy.live.map_values(name)
+        return [float(values.min()), float(values.max()), int(values.size)]
+    except Exception:  # noqa: BLE001 - a stored state being read
+        return []
 
 
 def _drawn_poles(o):
