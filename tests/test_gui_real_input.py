@@ -867,6 +867,7 @@ def test_esc_or_ctrl_z_during_a_drag_drops_the_stroke_in_hand_only(tmp_path):
         d.wait(lambda s: s["mouse_point"] is not None and abs(s["mouse_point"][0] - s["mouse_point"][1]) > 0 and
                any(o["cursor_at"] for o in s["overlays"]), "the session's cursor over the patch", shot=False)
         assert d.wait_still(lambda s: str(s["preselection"]), "the hover's preselection") == "None"
+        assert not any("edges free" in (o["status_text"] or "") for o in d.state()["overlays"]), "a clamped patch's HUD"
 
         def lifted(s: dict) -> float:  # (what the session draws, mm)
             return float(np.array(sculpt(s)["drawn_poles"]).reshape(-1, 3)[:, 2].max())
@@ -1077,6 +1078,8 @@ def test_the_airbrush_paints_its_own_sculpt_only_and_only_on_it(tmp_path):
         d.wait(lambda s: [o for o, _ in s["selection"]] == [name], "the second patch selected")
         s = d.press_button("Session", lambda s: s["session"], "the session on the second patch")
         assert s["painting"] is None, "the first patch's airbrush stayed on for the second"
+        d.wait(lambda s: any("edges free" in (o["status_text"] or "") for o in s["overlays"]), "the HUD: edges free")
+        d.shot("free_patch_session_hud")
         d.drag([centre] + [(centre[0], centre[1] - 10 * k) for k in range(1, 13)], seconds=0.8)
         s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke's undo step")
         lifted = next(x for x in s["docs"][s["active"]]["sculpts"] if x["name"] == name)

@@ -442,6 +442,9 @@ class Overlay:
             parts.append(f"sculpting {self.obj.Label} with the {session.device_name or 'mouse'}")
             if session.device_name not in ("", "mouse") and session.rate_and_priority:
                 parts.append(session.rate_and_priority)
+            if not s.held_poles and not any(c["kind"] == "point" for c in s.constraints):
+                # (a free sheet pulled at a corner swung up whole, flat: it looked broken on a first try)
+                parts.append("edges free: a pull lifts it whole, P pins a point")
         if self.display == "zebra":
             turn = (f"stripes at {self.stripe_angle:g} deg" if self.stripe_mode == "reflection"
                     else "to ({:.2g}, {:.2g}, {:.2g})".format(*self.stripe_direction))
