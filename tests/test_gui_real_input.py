@@ -290,6 +290,12 @@ class Desktop:
         self.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
         return self.press_button("NewPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new patch")
 
+    def new_clamped_patch(self) -> dict:
+        """ctrl+n (a new document, its view attached), then the New clamped patch button; the state."""
+        self.xdo("key", "ctrl+n")
+        self.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
+        return self.press_button("NewClampedPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new clamped patch")
+
     def press_button(self, button: str, condition, what: str) -> dict:
         """Clicks a command's button (or drop-down entry) until ``condition`` holds (FreeCAD enables a
         command's button on its next update after the command becomes usable: a click before that
@@ -817,9 +823,7 @@ def test_a_clay_stroke_stays_where_it_was_left(tmp_path):
     d = Desktop(str(tmp_path), "CAD")
     try:
         d.xdo("mousemove", "640", "500")
-        d.xdo("key", "ctrl+n")
-        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
-        s = d.press_button("NewClampedPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new clamped patch")
+        s = d.new_clamped_patch()
         assert sculpt(s)["plasticity"][0], "the GUI's patch is not clay"
         s = d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
         d.calibrate()
@@ -854,9 +858,7 @@ def test_esc_or_ctrl_z_during_a_drag_drops_the_stroke_in_hand_only(tmp_path):
     d = Desktop(str(tmp_path), "CAD")
     try:
         d.xdo("mousemove", "640", "500")
-        d.xdo("key", "ctrl+n")
-        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
-        d.press_button("NewClampedPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new clamped patch")
+        d.new_clamped_patch()
         s = d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
         d.calibrate()
         centre, east = (d.to_screen(p) for p in sculpt(s)["screen"][:2])
@@ -946,9 +948,7 @@ def test_a_mouse_session_keeps_to_its_sculpt_its_drags_and_what_it_shows(tmp_pat
     d = Desktop(str(tmp_path), "CAD")
     try:
         d.xdo("mousemove", "640", "500")
-        d.xdo("key", "ctrl+n")
-        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
-        d.press_button("NewClampedPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new clamped patch")
+        d.new_clamped_patch()
         s = d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
         d.calibrate()
         centre, east, west = (d.to_screen(p) for p in sculpt(s)["screen"][:3])
@@ -1023,9 +1023,7 @@ def test_a_drag_up_in_a_view_onto_the_patch_lifts_it_toward_the_eye(tmp_path, vi
     d = Desktop(str(tmp_path), "CAD")
     try:
         d.xdo("mousemove", "640", "500")
-        d.xdo("key", "ctrl+n")
-        d.wait(lambda s: s["views"] and s["inputs"] == 1, "the new view to be attached")
-        d.press_button("NewClampedPatch", lambda s: s["active"] and sculpt(s)["screen"], "a new clamped patch")
+        d.new_clamped_patch()
         d.xdo("key", key)
         d.wait(lambda s: view_direction(s)[2] * up < -0.99, f"the {view} view")
         s = d.press_button("Session", lambda s: sculpt(s)["session"], "the session")

@@ -286,16 +286,9 @@ class Controller:
     def point_at(self, view: Any, x: int, y: int) -> np.ndarray:
         """The surface point under pixel (x, y), else the point on the view's focal plane; notes
         which sculpt is under the mouse."""
-        import FreeCAD
-
-        from ..app.sculpted_solid import sculpt_for
-        info = view.getObjectInfo((x, y))
-        self.mouse_object = None
-        if info and all(k in info for k in ("x", "y", "z")):
-            doc = FreeCAD.getDocument(info["Document"]) if info.get("Document") else None
-            obj = doc.getObject(info["Object"]) if doc is not None and info.get("Object") else None
-            self.mouse_object = sculpt_for(obj)
-            return np.array([info["x"], info["y"], info["z"]], float)
+        at, self.mouse_object = _sculpt_at(view, x, y)
+        if at is not None:
+            return at
         p = view.getPoint(x, y)
         return np.array([p.x, p.y, p.z], float)
 
@@ -353,12 +346,8 @@ class Controller:
         if self.panel_at(view, pixel):
             return True
         import FreeCAD
-
-        from ..app.sculpted_solid import sculpt_for
         session_obj = self.session.obj if self.session is not None else None
-        info = view.getObjectInfo((int(pixel[0]), int(pixel[1])))
-        doc = FreeCAD.getDocument(info["Document"]) if info and info.get("Document") else None
-        other = sculpt_for(doc.getObject(info["Object"])) if doc is not None and info.get("Object") else None
+        _, other = _sculpt_at(view, int(pixel[0]), int(pixel[1]))
         if other is None or session_obj is None or other == session_obj:
             return False
         FreeCAD.Console.PrintMessage(f"HapticSculpt: the session sculpts {session_obj.Label}, not {other.Label}: "
@@ -771,6 +760,20 @@ def _alive(obj: Any) -> bool:
         return obj.Document is not None and obj.Document.getObject(obj.Name) is obj
     except Exception:  # noqa: BLE001 - a deleted object raises on any access
         return False
+
+
+def _sculpt_at(view: Any, x: int, y: int) -> tuple[np.ndarray | None, Any]:
+    """The shape point under pixel (x, y) of ``view`` (None: none) and the sculpt it belongs to
+    (itself, or the sculpt an object built from it comes from; None: no sculpt's)."""
+    import FreeCAD
+
+    from ..app.sculpted_solid import sculpt_for
+    info = view.getObjectInfo((x, y))
+    if not info or not all(k in info for k in ("x", "y", "z")):
+        return None, None
+    doc = FreeCAD.getDocument(info["Document"]) if info.get("Document") else None
+    obj = doc.getObject(info["Object"]) if doc is not None and info.get("Object") else None
+    return np.array([info["x"], info["y"], info["z"]], float), sculpt_for(obj)
 
 
 def _alive_document(doc: Any) -> bool:
