@@ -264,6 +264,7 @@ bench: build wheel
 	$(PY) bench/solids.py
 	$(PY) bench/scan_fit.py
 	$(PY) bench/scan_pull.py
+	$(PY) bench/stroke_reach.py
 
 # Peers run in their own virtual environment (optional benchmark dependencies, not test ones).
 BENCH_VENV := $(BUILD)/bench-venv
