@@ -284,20 +284,25 @@ class Session(_SculptCommand):
     menu = "Start/stop sculpting"
     tip = ("Start sculpting the selected sculpt (or the only one) with the first attached force device (Falcon, "
            "Touch/Phantom, Force Dimension), else a SpaceMouse, else the mouse (its left button grabs); run again to "
-           "stop")
+           "stop, or with another sculpt selected (or in another document) to sculpt that one instead")
 
     def IsActive(self) -> bool:
         return _ctl().session is not None or _has_sculpt()
 
     def Activated(self) -> None:
         ctl = _ctl()
+        target = None
         if ctl.session is not None:
+            target = ctl.session_switch_target()
+            left = ctl.session.obj.Label if target is not None else ""
             ctl.stop_session()
-        else:
-            try:
-                ctl.start_session()
-            except RuntimeError as exc:
-                FreeCAD.Console.PrintWarning(f"HapticSculpt: {exc}\n")
+            if target is None:
+                return
+            FreeCAD.Console.PrintMessage(f"HapticSculpt: stopped sculpting {left}; sculpting {target.Label} now\n")
+        try:
+            ctl.start_session(obj=target)
+        except RuntimeError as exc:
+            FreeCAD.Console.PrintWarning(f"HapticSculpt: {exc}\n")
 
 
 class Material(_SculptCommand):

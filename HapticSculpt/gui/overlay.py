@@ -24,9 +24,10 @@ import numpy as np
 from .. import core
 from ..app import analysis, continuity_check, curve_constraint
 from . import coin_shapes as shapes
+from . import kept_displays
 from . import stripes as stripe_shading
 from .hud import Hud
-from .panel import SliderPanel, sliders
+from .panel import SliderPanel, rounded, sliders
 
 MAPS = ("mass", "damping", "stiffness", "bending", "pull")
 DISPLAYS = ("shading", *MAPS, "curvature", "mean", "gauss", "zebra", "deviation")
@@ -87,6 +88,11 @@ class Overlay:
         self._lift_by = 0.0
         self._camera_sensor = coin.SoNodeSensor(lambda *_: self._place_lift(), None)
         view.getSceneGraph().addChild(self._root)
+        self._defaults = kept_displays.settings_of(self)
+        choices = {"display": DISPLAYS, "stripe_mode": stripe_shading.MODES}
+        for name, value in kept_displays.kept(obj).items():  # (as the file was saved)
+            if value in choices.get(name, (value,)):
+                setattr(self, name, value)
 
     # --- life cycle -------------------------------------------------------------------------------
     @property
@@ -205,7 +211,10 @@ class Overlay:
             graph.removeChild(self._root)
 
     def refresh(self) -> None:
-        """Starts or stops the timer to match what is on, and draws once."""
+        """Starts or stops the timer to match what is on, and draws once; keeps what it shows with
+        the document."""
+        if self._object_alive():
+            kept_displays.keep(self.obj, kept_displays.settings_of(self), self._defaults)
         if self.needed:
             self.start()
             self.frame()
@@ -445,6 +454,8 @@ class Overlay:
             if not s.held_poles and not any(c["kind"] == "point" for c in s.constraints):
                 # (a free sheet pulled at a corner swung up whole, flat: it looked broken on a first try)
                 parts.append("edges free: a pull lifts it whole, P pins a point")
+            if session.last_stroke is not None:
+                parts.append(stroke_text(session.last_stroke, float(np.mean(s.stiffness_map.values))))
         if self.display == "zebra":
             turn = (f"stripes at {self.stripe_angle:g} deg" if self.stripe_mode == "reflection"
                     else "to ({:.2g}, {:.2g}, {:.2g})".format(*self.stripe_direction))
@@ -635,6 +646,25 @@ class Overlay:
         if self.contact is not None and grab:
             sep.addChild(shapes.lines(np.array([[pos, self.contact]]), (1.0, 0.85, 0.0), 2.0))
         return sep
+
+
+#: A stroke that moved the surface less than this share of the cursor's pull barely followed it.
+BARELY_FOLLOWED = 0.05
+#: A mean stiffness above this (ten times a new sculpt's 100) is what holds a stroke back.
+STIFF = 1000.0
+
+
+def stroke_text(last: dict[str, float], stiffness: float) -> str:
+    """The HUD's line for a session's last stroke: how far it moved the surface, and, where that
+    was a small part of the pull, why (a stroke on a very stiff sculpt changed nothing one could
+    see, and nothing said so: the stiffness slider spans five decades)."""
+    moved, pulled = last["moved_mm"], last["pulled_mm"]
+    text = f"last stroke moved it {moved:.2g} mm"
+    if pulled >= 1.0 and moved < BARELY_FOLLOWED * pulled:
+        text += f" of a {pulled:.2g} mm pull"
+        text += (f": stiffness {rounded(stiffness, 2):g} holds it, lower it in the slider panel" if stiffness > STIFF else
+                 ": held there, or heavy or damped (slider panel)")
+    return text
 
 
 def continuity_text(worst: dict[str, Any]) -> str:

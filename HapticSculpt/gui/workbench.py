@@ -129,6 +129,8 @@ class Controller:
         self.mouse_view: Any = None  # the view the mouse was last seen in
         self.mouse_object: Any = None  # the sculpt under the mouse there, if any
         self.session: Any = None
+        self._yielded_to: str | None = None  # the other sculpt a session's press last yielded to (said once)
+        self._set_aside: list[tuple[Any, list[str]]] = []  # the selection a session cleared: (object, subelements)
         self.mouse: Any = None
         self._scan: Any = None
         self._observer: Any = None
@@ -201,7 +203,8 @@ class Controller:
 
     # --- what commands act on ---------------------------------------------------------------------
     def active_sculpt(self) -> Any:
-        """The selected sculpt, else the one under the mouse, else the active document's only one."""
+        """The selected sculpt, else the session's (in the active document), else the one under the
+        mouse, else the active document's only one."""
         import FreeCAD
         import FreeCADGui as Gui
 
@@ -211,6 +214,9 @@ class Controller:
         if sel:
             return sel[0]
         doc = FreeCAD.ActiveDocument
+        running = self.session.obj if self.session is not None else None
+        if running is not None and _alive(running) and running.Document == doc:
+            return running  # (its selection was cleared at the start: the green tint hid the shading)
         if self.mouse_object is not None and _alive(self.mouse_object) and self.mouse_object.Document == doc:
             return self.mouse_object  # (another document's, last under the mouse: a session started there, unseen)
         sculpts = [o for o in doc.Objects if is_sculpt(o)] if doc is not None else []
@@ -350,8 +356,10 @@ class Controller:
         _, other = _sculpt_at(view, int(pixel[0]), int(pixel[1]))
         if other is None or session_obj is None or other == session_obj:
             return False
-        FreeCAD.Console.PrintMessage(f"HapticSculpt: the session sculpts {session_obj.Label}, not {other.Label}: "
-                                     f"Start/stop sculpting twice, with {other.Label} selected, sculpts it\n")
+        if self._yielded_to != other.Name:  # (once, not at every press on it)
+            self._yielded_to = other.Name
+            FreeCAD.Console.PrintMessage(f"HapticSculpt: the session sculpts {session_obj.Label}, not {other.Label}: "
+                                         f"Start/stop sculpting, with {other.Label} selected, moves it there\n")
         return True
 
     def _panel_button(self, view: Any, event: Any) -> bool:
@@ -592,13 +600,16 @@ class Controller:
         call += "".join(f", {k}={v!r}" for k, v in kept.items()) if current.name != tool else ""
         run_echoed(f"HapticSculpt.set_tool({ref(obj)}, {call})")
 
-    def start_session(self, device: Any = None) -> Any:
-        """Starts sculpting the active sculpt with `device`, else the first attached force device, else
-        a SpaceMouse, else the mouse (devices.pick)."""
+    def start_session(self, device: Any = None, obj: Any = None) -> Any:
+        """Starts sculpting `obj` (by default the active sculpt) with `device`, else the first attached
+        force device, else a SpaceMouse, else the mouse (devices.pick). The selection is set aside until
+        the stop: its highlight tinted the whole surface, and commands act on the session's sculpt."""
+        import FreeCADGui as Gui
+
         from ..runtime import devices
         from ..runtime.session import Session
         from .mouse_device import MouseDevice
-        obj = self.active_sculpt()
+        obj = obj or self.active_sculpt()
         if obj is None:
             raise RuntimeError("select the sculpt to sculpt (or create a patch first)")
         rate = None  # (the core's default)
@@ -609,8 +620,12 @@ class Controller:
                                  lost_release=lambda: self.drop_held("the drag's release went elsewhere (a dialog?)"))
             # (its document's views only: a drag in another document's view sculpted this one, unseen)
             device.attach_all(views_of(obj.Document.Name))
-            import FreeCADGui as Gui  # (the device keeps hovers from the selection: none left lit)
-            Gui.Selection.clearPreselection()
+            Gui.Selection.clearPreselection()  # (the device keeps hovers from the selection: none left lit)
+        # (what was selected is set aside and given back at the stop: a sketch picked with the
+        # sculpt for Follow curve is picked still when the designer comes back to make it G1)
+        self._set_aside = [(o.Object, list(o.SubElementNames)) for o in Gui.Selection.getSelectionEx()]
+        Gui.Selection.clearSelection()
+        self._yielded_to = None
         self.mouse = device if isinstance(device, MouseDevice) else None
         self.airbrush_for(obj)
         session = Session()
@@ -641,6 +656,39 @@ class Controller:
             FreeCAD.Console.PrintWarning(f"HapticSculpt: {e}; sculpting with the mouse\n")
             return None, None
 
+    def _give_back_selection(self) -> None:
+        """The selection set aside at the session's start, where nothing was selected since (what
+        of it still exists)."""
+        import FreeCADGui as Gui
+        aside, self._set_aside = self._set_aside, []
+        if Gui.Selection.getSelection():
+            return
+        for picked, subs in aside:
+            if _alive(picked):
+                for sub in subs or [""]:
+                    Gui.Selection.addSelection(picked, sub)
+
+    def session_switch_target(self) -> Any:
+        """The sculpt Start/stop sculpting moves a running session to, None where it stops it: a
+        selected sculpt that is not the session's, else, with the session in another document than
+        the active one, the active document's only sculpt (the command's tooltip promises either)."""
+        import FreeCAD
+        import FreeCADGui as Gui
+
+        from ..app.sculpt_feature import is_sculpt
+        from ..app.sculpted_solid import sculpt_for
+        running = self.session.obj if self.session is not None else None
+        if running is None or not _alive(running):
+            return None
+        sel = [sculpt_for(o) for o in Gui.Selection.getSelection() if sculpt_for(o) is not None]
+        if sel:
+            return sel[0] if sel[0] != running else None
+        doc = FreeCAD.ActiveDocument
+        if doc is None or running.Document == doc:
+            return None
+        sculpts = [o for o in doc.Objects if is_sculpt(o)]
+        return sculpts[0] if len(sculpts) == 1 else None
+
     def stop_session(self) -> None:
         if self.session is not None:
             obj = self.session.obj
@@ -650,6 +698,7 @@ class Controller:
                 for ov in self.overlays_of(obj):
                     ov.drop_cursor()
                 self.refresh(obj)
+            self._give_back_selection()
         if self.mouse is not None:
             self.mouse.detach()
             self.mouse = None

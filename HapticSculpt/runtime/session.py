@@ -89,7 +89,6 @@ class Session:
         #: the state a macro replayed in console mode holds after the lines echoed so far (None: not
         #: known, an edit's own call failed on it; the document's state stands in then)
         self._console: sculpt_state.SculptState | None = None
-        #: the last commit: (undo steps after it, title, strokes, console state before it, in this stop())
         #: the last commit: undo steps after it, its title and strokes, the console's state before it,
         #: whether the listener was told of it, whether it was made by stop()
         self._last_commit: tuple[int, str, int, sculpt_state.SculptState, bool, bool] | None = None
@@ -97,6 +96,12 @@ class Session:
         #: was posted and when it applied (it applies between two steps, so these differ by 0 to 2),
         #: and the simulated time it applied at (s since the start)
         self.applied_edits: list[dict[str, Any]] = []
+        self._grab_from: np.ndarray | None = None  # the cursor where the held grab began (GUI frames)
+        self._pulled = 0.0  # mm: how far the cursor went from there, in this grab or the last
+        #: the last stroke committed: how far it moved the surface (largest pole displacement, mm)
+        #: and how far the cursor went from where it grabbed (mm, as the GUI's frames saw it; 0 in
+        #: console mode), so that the HUD can say when the material barely followed
+        self.last_stroke: dict[str, float] | None = None
 
     # --- life cycle -------------------------------------------------------------------------------
     def start(self, obj: Any, device: Any, tool: str = "rope", haptic_rate: float | None = None,
@@ -434,6 +439,10 @@ class Session:
                 live.write(final if final is not None and k == last else _with_event(state, event))
                 if strokes:
                     obj.Strokes = obj.Strokes + strokes
+                    after, was = obj.Proxy.live.stored().arrays["Poles"], before.arrays["Poles"]
+                    if not event["painted"] and after.shape == was.shape:
+                        moved = np.linalg.norm((after - was).reshape(-1, 3), axis=1)
+                        self.last_stroke = {"moved_mm": float(moved.max(initial=0.0)), "pulled_mm": self._pulled}
                 told = bool(strokes) or _differs(before, obj.Proxy.live.stored())  # (else the edit's own call gives it)
                 if told:
                     _tell_commit(obj, before, title, strokes)
@@ -520,6 +529,13 @@ class Session:
         # (A spray moves no pole: nothing to preview.)
         status = runtime.status()
         held = bool(status["grab"]) and not status["spraying"]
+        if held and "cursor" in status:
+            cursor = np.asarray(status["cursor"], dtype=float)
+            if self._grab_from is None:
+                self._grab_from, self._pulled = cursor, 0.0
+            self._pulled = max(self._pulled, float(np.linalg.norm(cursor - self._grab_from)))
+        elif not held:
+            self._grab_from = None
         poles = runtime.take_poles()
         if poles is not None and _alive(obj):
             self._latest_poles = poles
