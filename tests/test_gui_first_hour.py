@@ -67,6 +67,11 @@ def test_a_stiff_sculpt_says_why_a_stroke_barely_moved_and_a_session_owns_the_se
         assert "holds it" not in text and "held there" not in text, text
         moved = float(text.split("last stroke moved it ")[1].split(" mm")[0])
         assert moved > 5.0, text
+        # ctrl+z takes the stroke back, and the HUD no longer speaks of it
+        d.xdo("mousemove", str(centre[0]), str(centre[1]))
+        d.shortcut("ctrl+z", "Std_Undo")
+        d.wait(lambda s: undo(s)[0] == "Set stiffness" and "last stroke" not in overlay(s)["status_text"],
+               "ctrl+z: the stroke and the HUD's line for it gone")
         # the selection set aside at the start comes back at the stop
         d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
         d.wait(lambda s: sculpt(s)["selected"], "the patch selected again")

@@ -4,6 +4,8 @@ from __future__ import annotations
 import json
 from typing import Any
 
+import numpy as np
+
 import FreeCAD
 import FreeCADGui as Gui
 
@@ -293,12 +295,14 @@ class Session(_SculptCommand):
         ctl = _ctl()
         target = None
         if ctl.session is not None:
-            target = ctl.session_switch_target()
-            left = ctl.session.obj.Label if target is not None else ""
-            ctl.stop_session()
+            target, left = ctl.session_switch_target(), ctl.session.obj
             if target is None:
+                ctl.stop_session()
                 return
-            FreeCAD.Console.PrintMessage(f"HapticSculpt: stopped sculpting {left}; sculpting {target.Label} now\n")
+            names = [o.Label if left.Document == target.Document else f"{o.Label} ({o.Document.Label})"
+                     for o in (left, target)]  # (two documents may each have a Sculpt)
+            ctl.stop_session()
+            FreeCAD.Console.PrintMessage(f"HapticSculpt: stopped sculpting {names[0]}; sculpting {names[1]} now\n")
         try:
             ctl.start_session(obj=target)
         except RuntimeError as exc:
@@ -335,7 +339,12 @@ class Fair(_SculptCommand):
 
     def Activated(self) -> None:
         from .echo import ref, run_echoed
-        run_echoed(f"HapticSculpt.fair({ref(_ctl().active_sculpt())})")
+        obj = _ctl().active_sculpt()
+        before = obj.Proxy.live.stored().arrays["Poles"]
+        run_echoed(f"HapticSculpt.fair({ref(obj)})")
+        moved = float(np.abs(obj.Proxy.live.stored().arrays["Poles"] - before).max(initial=0.0))
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label} faired: poles moved up to {moved:.2g} mm"
+                                     + (" (it was fair already)" if moved < 1e-6 else "") + "\n")
 
 
 class HoldEdges(_SculptCommand):

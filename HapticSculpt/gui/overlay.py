@@ -455,7 +455,7 @@ class Overlay:
                 # (a free sheet pulled at a corner swung up whole, flat: it looked broken on a first try)
                 parts.append("edges free: a pull lifts it whole, P pins a point")
             if session.last_stroke is not None:
-                parts.append(stroke_text(session.last_stroke, float(np.mean(s.stiffness_map.values))))
+                parts.append(stroke_text(session.last_stroke))
         if self.display == "zebra":
             turn = (f"stripes at {self.stripe_angle:g} deg" if self.stripe_mode == "reflection"
                     else "to ({:.2g}, {:.2g}, {:.2g})".format(*self.stripe_direction))
@@ -654,16 +654,21 @@ BARELY_FOLLOWED = 0.05
 STIFF = 1000.0
 
 
-def stroke_text(last: dict[str, float], stiffness: float) -> str:
-    """The HUD's line for a session's last stroke: how far it moved the surface, and, where that
-    was a small part of the pull, why (a stroke on a very stiff sculpt changed nothing one could
-    see, and nothing said so: the stiffness slider spans five decades)."""
-    moved, pulled = last["moved_mm"], last["pulled_mm"]
+def stroke_text(last: dict[str, float]) -> str:
+    """The HUD's line for a session's last stroke (Session.last_stroke): how far it moved the
+    surface, and, where that was a small part of the pull, why, as things stood at the stroke (a
+    stroke on a very stiff sculpt changed nothing one could see, and nothing said so: the
+    stiffness slider spans five decades; held edges pin rows of poles)."""
+    moved, pulled, stiffness = last["moved_mm"], last["pulled_mm"], last["stiffness"]
     text = f"last stroke moved it {moved:.2g} mm"
     if pulled >= 1.0 and moved < BARELY_FOLLOWED * pulled:
         text += f" of a {pulled:.2g} mm pull"
-        text += (f": stiffness {rounded(stiffness, 2):g} holds it, lower it in the slider panel" if stiffness > STIFF else
-                 ": held there, or heavy or damped (slider panel)")
+        if stiffness > STIFF:
+            text += f": stiffness {rounded(stiffness, 2):g} holds it, lower it in the slider panel"
+        elif last["held"]:
+            text += ": held poles pin it there (Hold edges, P), or it is heavy or damped"
+        else:
+            text += ": the material is heavy or damped (slider panel)"
     return text
 
 

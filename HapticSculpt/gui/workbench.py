@@ -131,6 +131,7 @@ class Controller:
         self.session: Any = None
         self._yielded_to: str | None = None  # the other sculpt a session's press last yielded to (said once)
         self._set_aside: list[tuple[Any, list[str]]] = []  # the selection a session cleared: (object, subelements)
+        self._greeted = False  # the report view's first line said (once a run)
         self.mouse: Any = None
         self._scan: Any = None
         self._observer: Any = None
@@ -159,7 +160,9 @@ class Controller:
         if self._observer is None:
             self._observer = _UndoObserver(self)
             FreeCAD.addDocumentObserver(self._observer)
-        FreeCAD.Console.PrintMessage(HELLO)
+        if not self._greeted:  # (once a run: each return to the workbench repeated it)
+            self._greeted = True
+            FreeCAD.Console.PrintMessage(HELLO)
 
     def sync_views(self) -> None:
         """Attaches to views that opened and forgets closed ones; stops a session whose sculpt was
@@ -727,7 +730,13 @@ class Controller:
                 ov.refresh()
 
     def shutdown(self) -> None:
-        """Leaving the workbench: stop the session, remove every overlay, drop the callbacks."""
+        """Leaving the workbench: stop the session (said in the report view: the HUD and the cursor
+        went with no word), remove every overlay, drop the callbacks."""
+        if self.session is not None and self.session.obj is not None and _alive(self.session.obj):
+            import FreeCAD
+            FreeCAD.Console.PrintMessage(f"HapticSculpt: the sculpting session on {self.session.obj.Label} stopped: "
+                                         "you left the workbench (its strokes are kept; Start/stop sculpting "
+                                         "starts it again once you are back)\n")
         self.stop_session()
         self.painting = None
         if self._scan is not None:

@@ -98,9 +98,10 @@ class Session:
         self.applied_edits: list[dict[str, Any]] = []
         self._grab_from: np.ndarray | None = None  # the cursor where the held grab began (GUI frames)
         self._pulled = 0.0  # mm: how far the cursor went from there, in this grab or the last
-        #: the last stroke committed: how far it moved the surface (largest pole displacement, mm)
-        #: and how far the cursor went from where it grabbed (mm, as the GUI's frames saw it; 0 in
-        #: console mode), so that the HUD can say when the material barely followed
+        #: the last stroke committed: how far it moved the surface (largest pole displacement, mm),
+        #: how far the cursor went from where it grabbed (mm, as the GUI's frames saw it; 0 in
+        #: console mode), the mean stiffness and the held poles then, so that the HUD can say why
+        #: when the material barely followed; None again after an Undo or Redo
         self.last_stroke: dict[str, float] | None = None
 
     # --- life cycle -------------------------------------------------------------------------------
@@ -426,6 +427,7 @@ class Session:
                 if event["edit"] in self._restores:
                     self._restores.discard(event["edit"])
                     self._latest_maps.clear()  # (a spray shown before it is gone: the maps are the document's)
+                    self.last_stroke = None  # (an Undo or Redo: the HUD spoke of a stroke no longer in hand)
                 if state is None:
                     continue  # an Undo or Redo the session took up: the document holds that state already
                 strokes = 0
@@ -439,10 +441,13 @@ class Session:
                 live.write(final if final is not None and k == last else _with_event(state, event))
                 if strokes:
                     obj.Strokes = obj.Strokes + strokes
-                    after, was = obj.Proxy.live.stored().arrays["Poles"], before.arrays["Poles"]
+                    now = obj.Proxy.live.stored()
+                    after, was = now.arrays["Poles"], before.arrays["Poles"]
                     if not event["painted"] and after.shape == was.shape:
                         moved = np.linalg.norm((after - was).reshape(-1, 3), axis=1)
-                        self.last_stroke = {"moved_mm": float(moved.max(initial=0.0)), "pulled_mm": self._pulled}
+                        self.last_stroke = {"moved_mm": float(moved.max(initial=0.0)), "pulled_mm": self._pulled,
+                                            "stiffness": float(np.mean(now.arrays["StiffnessMap"])),
+                                            "held": float(len(now.settings.get("held_poles", [])))}
                 told = bool(strokes) or _differs(before, obj.Proxy.live.stored())  # (else the edit's own call gives it)
                 if told:
                     _tell_commit(obj, before, title, strokes)
