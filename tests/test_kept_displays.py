@@ -92,3 +92,12 @@ def test_the_last_strokes_line_says_why_it_barely_moved():
     assert line(12.0, 23.0, 95000.0) == "last stroke moved it 12 mm"
     # a pull the frames did not see (console mode, or a grab between two frames) gives no reason
     assert line(0.01, 0.0, 95000.0) == "last stroke moved it 0.01 mm"
+
+
+def test_a_status_part_longer_than_the_hud_wraps_between_its_words():
+    from HapticSculpt.gui.hud import _wrap
+    reason = "last stroke moved it 0.032 mm of a 17 mm pull: stiffness 100000 holds it, lower it in the slider panel"
+    lines = _wrap("tool: rope  |  clay  |  " + reason, 60)
+    assert all(len(line) <= 60 for line in lines), lines
+    assert lines[0] == "tool: rope  |  clay" and " ".join(lines[1:]) == reason
+    assert _wrap("a  |  b", 60) == ["a  |  b"]

@@ -13,6 +13,7 @@ so its white text reads on any background (white zebra stripes too).
 from __future__ import annotations
 
 import math
+import textwrap
 from typing import Any
 
 import numpy as np
@@ -284,11 +285,12 @@ class Hud:
 
 
 def _wrap(text: str, width: int) -> list[str]:
-    """The status line in lines of at most ``width`` characters, broken between its parts."""
+    """The status line in lines of at most ``width`` characters, broken between its parts, and a
+    part longer than a line between its words (a last stroke's reason ran off a narrow view)."""
     lines: list[str] = []
     for part in text.split("  |  "):
         if lines and len(lines[-1]) + 5 + len(part) <= width:
             lines[-1] += "  |  " + part
         else:
-            lines.append(part)
+            lines.extend(textwrap.wrap(part, max(width, 10)) or [part])
     return lines
