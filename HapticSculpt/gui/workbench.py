@@ -209,21 +209,16 @@ class Controller:
         """The selected sculpt, else the session's (in the active document), else the one under the
         mouse, else the active document's only one."""
         import FreeCAD
-        import FreeCADGui as Gui
-
-        from ..app.sculpt_feature import is_sculpt
-        from ..app.sculpted_solid import sculpt_for
-        sel = [sculpt_for(o) for o in Gui.Selection.getSelection() if sculpt_for(o) is not None]
-        if sel:
-            return sel[0]
+        picked = _selected_sculpt()
+        if picked is not None:
+            return picked
         doc = FreeCAD.ActiveDocument
         running = self.session.obj if self.session is not None else None
         if running is not None and _alive(running) and running.Document == doc:
             return running  # (its selection was cleared at the start: the green tint hid the shading)
         if self.mouse_object is not None and _alive(self.mouse_object) and self.mouse_object.Document == doc:
             return self.mouse_object  # (another document's, last under the mouse: a session started there, unseen)
-        sculpts = [o for o in doc.Objects if is_sculpt(o)] if doc is not None else []
-        return sculpts[0] if len(sculpts) == 1 else None
+        return _only_sculpt(doc)
 
     def overlay(self, obj: Any | None = None, view: Any = None) -> Overlay | None:
         obj = obj or self.active_sculpt()
@@ -676,21 +671,14 @@ class Controller:
         selected sculpt that is not the session's, else, with the session in another document than
         the active one, the active document's only sculpt (the command's tooltip promises either)."""
         import FreeCAD
-        import FreeCADGui as Gui
-
-        from ..app.sculpt_feature import is_sculpt
-        from ..app.sculpted_solid import sculpt_for
         running = self.session.obj if self.session is not None else None
         if running is None or not _alive(running):
             return None
-        sel = [sculpt_for(o) for o in Gui.Selection.getSelection() if sculpt_for(o) is not None]
-        if sel:
-            return sel[0] if sel[0] != running else None
+        picked = _selected_sculpt()
+        if picked is not None:
+            return picked if picked != running else None
         doc = FreeCAD.ActiveDocument
-        if doc is None or running.Document == doc:
-            return None
-        sculpts = [o for o in doc.Objects if is_sculpt(o)]
-        return sculpts[0] if len(sculpts) == 1 else None
+        return None if doc is None or running.Document == doc else _only_sculpt(doc)
 
     def stop_session(self) -> None:
         if self.session is not None:
@@ -811,6 +799,21 @@ def surface_normal(sculpt: Any, point: Any) -> tuple[float, float, float] | None
     around = mesh[max(i - 1, 0):i + 2, max(j - 1, 0):j + 2]
     n = vertex_normals(around)[min(i, 1), min(j, 1)]
     return tuple(float(c) for c in n) if np.linalg.norm(n) > 0.5 else None
+
+
+def _selected_sculpt() -> Any:
+    """The first selected sculpt (a sculpted solid stands for its sculpt), or None."""
+    import FreeCADGui as Gui
+
+    from ..app.sculpted_solid import sculpt_for
+    return next((sculpt_for(o) for o in Gui.Selection.getSelection() if sculpt_for(o) is not None), None)
+
+
+def _only_sculpt(doc: Any) -> Any:
+    """``doc``'s sculpt where it has exactly one, else None."""
+    from ..app.sculpt_feature import is_sculpt
+    sculpts = [o for o in doc.Objects if is_sculpt(o)] if doc is not None else []
+    return sculpts[0] if len(sculpts) == 1 else None
 
 
 def _alive(obj: Any) -> bool:
