@@ -101,7 +101,7 @@ os._exit(0)
 """
 
 
-@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs Xvfb and the FreeCAD GUI (make deps installs both)")
 def test_deleting_a_sculpted_solid_mid_session_deletes_its_face_sculpt_and_stops_the_session(tmp_path):
     """The hidden sculpt of a deleted SculptedSolid went on being sculpted (the HUD said so, drags
     echoed strokes on it): it goes with the solid, in the same undo step."""
@@ -155,7 +155,7 @@ os._exit(0)
 """
 
 
-@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs Xvfb and the FreeCAD GUI (make deps installs both)")
 def test_the_scan_the_deviation_display_hid_shows_again_when_its_sculpt_or_target_goes(tmp_path):
     """The deviation display hides the target's mesh (it draws the points in colour); deleting the
     sculpt, or undoing Set target, left the scan hidden with nothing drawn in its place."""
@@ -218,7 +218,7 @@ os._exit(0)
 """
 
 
-@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs Xvfb and the FreeCAD GUI (make deps installs both)")
 def test_a_document_closed_and_opened_again_draws_without_a_traceback(tmp_path):
     """Opening a saved document beside another raised in the sculpt's view provider 4 times (a
     sculpt still being read was asked for its session, by the closed document's overlay of the same
@@ -266,7 +266,7 @@ os._exit(0)
 """
 
 
-@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs Xvfb and the FreeCAD GUI (make deps installs both)")
 def test_a_display_set_in_a_new_document_is_drawn_in_its_view(tmp_path):
     """A display turned on for a new document's sculpt was drawn in the other document's view, the
     one the mouse was in last."""

@@ -172,7 +172,7 @@ os._exit(0)
 """
 
 
-@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and FreeCAD")
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs Xvfb and FreeCAD")
 def test_export_step_chooses_the_only_sculpted_solid_and_refuses_a_bad_file_name(tmp_path):
     out = run_freecad_gui(f"TMP = {str(tmp_path)!r}\n" + PANEL_SCRIPT, str(tmp_path))
     assert out["only_solid"] == ["SculptedSolid"] and out["active_solid"]  # (not its own hidden sculpt)

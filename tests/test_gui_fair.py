@@ -55,7 +55,7 @@ os._exit(0)
 """
 
 
-@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs Xvfb and the FreeCAD GUI (make deps installs both)")
 def test_fair_command_is_one_undo_step_shown_at_once(tmp_path):
     os.makedirs(SCREENSHOTS, exist_ok=True)
     before = os.path.join(SCREENSHOTS, "gui_fair_before.png")
@@ -102,7 +102,7 @@ os._exit(0)
 """
 
 
-@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs Xvfb and the FreeCAD GUI (make deps installs both)")
 def test_new_patch_offers_free_or_held_edges(tmp_path):
     """The create toolbar's New patch drop-down: New sculpt patch makes a free sheet, New clamped
     patch one with every edge held G1; each one undo step, both bending by default. The first lies

@@ -254,7 +254,7 @@ def colour_fraction(img: np.ndarray, test) -> float:
     return float(np.mean(test(img[..., 0], img[..., 1], img[..., 2])))
 
 
-@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs Xvfb and the FreeCAD GUI (make deps installs both)")
 def test_overlay_commands_keys_and_pictures(tmp_path):
     os.makedirs(SHOTS, exist_ok=True)
     recording = os.path.join(ROOT, "tests", "fixtures", "hid", "spacemouse_wireless.hid")

@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 import pytest
-from freecad_support import ROOT, SCREENSHOTS, make_addon_home, run_freecadcmd
+from freecad_support import NO_SPLASH, ROOT, SCREENSHOTS, VirtualDisplay, make_addon_home, run_freecadcmd
 
 SHOTS = SCREENSHOTS
 RECORD_BUTTON = (536, 552)  # the Record button of FreeCAD's macro recording dialog
@@ -26,7 +26,7 @@ NEEDS = [shutil.which(t) for t in ("Xvfb", "xdotool", "import", "freecad")]
 
 USER_CFG = """<?xml version="1.0" encoding="UTF-8" standalone="no" ?>
 <FCParameters><FCParamGroup Name="Root"><FCParamGroup Name="BaseApp"><FCParamGroup Name="Preferences">
-<FCParamGroup Name="General"><FCText Name="AutoloadModule">HapticSculptWorkbench</FCText></FCParamGroup>
+<FCParamGroup Name="General"><FCText Name="AutoloadModule">HapticSculptWorkbench</FCText>""" + NO_SPLASH + """</FCParamGroup>
 <FCParamGroup Name="View"><FCBool Name="UseNavigationAnimations" Value="0"/>
 <FCText Name="NavigationStyle">{style}</FCText></FCParamGroup>
 </FCParamGroup></FCParamGroup></FCParamGroup></FCParameters>
@@ -40,14 +40,12 @@ class Desktop:
         self.tmp = tmp
         home = os.path.join(tmp, "home")
         if not os.path.isdir(home):  # (a restart keeps the home, as a user's does)
-            make_addon_home(home)
-            with open(os.path.join(home, "user.cfg"), "w") as f:
+            with open(os.path.join(make_addon_home(home), "user.cfg"), "w") as f:
                 f.write(USER_CFG.format(style=STYLES[style]))
         self.home = home
         self.state_file = os.path.join(tmp, "state.json")
-        self.xvfb = subprocess.Popen(["Xvfb", "-displayfd", "1", "-screen", "0", screen + "x24", "-nolisten", "tcp"],
-                                     stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
-        self.display = ":" + self.xvfb.stdout.readline().decode().strip()
+        self.xvfb = VirtualDisplay(screen)
+        self.display = self.xvfb.name
         # (XDG_CONFIG_HOME: Qt keeps the window's layout, toolbars too, in ~/.config/FreeCAD/FreeCAD.conf,
         # which FREECAD_USER_HOME does not move: every FreeCAD on the machine would start with the
         # layout the last one left)
@@ -115,10 +113,10 @@ class Desktop:
         self.xdo("windowfocus", "--sync", found[-1])
 
     def close(self) -> None:
-        for p in (self.freecad, self.xvfb):
-            if p.poll() is None:
-                p.kill()
-            p.wait()
+        if self.freecad.poll() is None:
+            self.freecad.kill()
+        self.freecad.wait()
+        self.xvfb.close()
         self.log.close()
 
     def xdo(self, *args: str) -> str:

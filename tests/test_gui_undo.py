@@ -54,7 +54,7 @@ os._exit(0)
 """
 
 
-@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs Xvfb and the FreeCAD GUI (make deps installs both)")
 def test_every_editing_command_is_one_exact_undo_step(tmp_path):
     out = run_freecad_gui(GUI_SCRIPT, str(tmp_path))
     names = {"HapticSculpt_Material": "Material: ", "HapticSculpt_ToolMagnet": "Tool: magnet",
@@ -116,7 +116,7 @@ os._exit(0)
 """
 
 
-@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs Xvfb and the FreeCAD GUI (make deps installs both)")
 def test_gui_edits_reach_a_running_session_and_undo_restores_it_in_place(tmp_path):
     out = run_freecad_gui(EDIT_SCRIPT, str(tmp_path))
     assert out["pulled"] and out["applied"] and out["still_running"], out

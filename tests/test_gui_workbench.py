@@ -85,7 +85,7 @@ os._exit(0)
 """
 
 
-@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs xvfb-run and the FreeCAD GUI (make deps installs both)")
+@pytest.mark.skipif(not GUI_AVAILABLE, reason="needs Xvfb and the FreeCAD GUI (make deps installs both)")
 def test_workbench_loads_and_commands_run(tmp_path):
     os.makedirs(SCREENSHOTS, exist_ok=True)
     png = os.path.join(SCREENSHOTS, "gui_workbench.png")
