@@ -83,14 +83,27 @@ def _drawn_poles(o):
         return []
 
 
-def _solids(doc):
+def _shape_facts(doc):
+    """{name: (shape, valid, volume)} of every object with a shape, each checked once a write (the
+    check is the observer's dearest part)."""
+    out = {}
+    for o in doc.Objects:
+        shape = getattr(o, "Shape", None)
+        if shape is None or not hasattr(shape, "Solids"):
+            continue
+        null = shape.isNull()
+        out[o.Name] = (shape, not null and shape.isValid(), 0.0 if null else shape.Volume)
+    return out
+
+
+def _solids(doc, facts):
     out = []
     for o in doc.Objects:
         if getattr(getattr(o, "Proxy", None), "Type", None) != "HapticSculpt::SculptedSolid":
             continue
-        shape = o.Shape
-        out.append({"name": o.Name, "valid": shape.isValid(), "solids": len(shape.Solids),
-                    "closed": all(sh.isClosed() for sh in shape.Shells), "volume": shape.Volume,
+        shape, valid, volume = facts[o.Name]
+        out.append({"name": o.Name, "valid": valid, "solids": len(shape.Solids),
+                    "closed": all(sh.isClosed() for sh in shape.Shells), "volume": volume,
                     "faces": len(shape.Faces), "wires": sorted(len(f.Wires) for f in shape.Faces),
                     "seams": json.loads(o.SeamReport or "[]"), "error": o.RebuildError,
                     "sculpt_faces": list(o.SculptFaces), "mirror_mm": _mirror_distance(o),
@@ -98,16 +111,16 @@ def _solids(doc):
     return out
 
 
-def _features(doc):
+def _features(doc, facts):
     """Every object with a shape: its type, recompute state and what its shape is (and a Thickness's
     thickness)."""
     out = {}
     for o in doc.Objects:
-        shape = getattr(o, "Shape", None)
-        if shape is None or not hasattr(shape, "Solids"):
+        if o.Name not in facts:
             continue
-        out[o.Name] = {"type": o.TypeId, "state": list(o.State), "valid": not shape.isNull() and shape.isValid(),
-                       "solids": len(shape.Solids), "volume": shape.Volume if not shape.isNull() else 0.0,
+        shape, valid, volume = facts[o.Name]
+        out[o.Name] = {"type": o.TypeId, "state": list(o.State), "valid": valid,
+                       "solids": len(shape.Solids), "volume": volume,
                        "zmax": shape.BoundBox.ZMax if not shape.isNull() else None,
                        "thickness": o.Thickness.Value if hasattr(o, "Thickness") else None,
                        "visible": bool(o.ViewObject.Visibility) if o.ViewObject is not None else None}
@@ -333,37 +346,26 @@ def _toolbars():
             "commands": [c for c in Gui.listCommands() if c.startswith("HapticSculpt_")]}
 
 
-def _widget_rect(class_name):
-    """[x, y, width, height] on the screen of the first shown widget of that class, else None."""
-    stack = [Gui.getMainWindow()]
-    while stack:
-        w = stack.pop()
-        if w.metaObject().className() == class_name and w.isVisible():
-            return _rect(w)
-        stack.extend(c for c in w.children() if c.isWidgetType())
-    return None
-
-
-def _panels_and_questions():
-    """Two things found in one walk of the main window's widgets: [x, y, width, height] on the screen
-    of each shown panel FreeCAD lays over the 3D view (FreeCAD 1.1's Tasks panel on the view's right:
-    a wheel turned over it does not reach the view, FreeCAD issue 21141; none before 1.0), and the
-    buttons of a question FreeCAD shows (a QMessageBox: "Save all changes...?") by text, at their
-    centres in screen pixels."""
-    panels, buttons, stack = [], {}, [(Gui.getMainWindow(), False)]
+def _console_panels_and_questions():
+    """Three things found in one walk of the main window's widgets: [x, y, width, height] on the
+    screen of the Python console if it is shown (else None), of each shown panel FreeCAD lays over
+    the 3D view (FreeCAD 1.1's Tasks panel on the view's right: a wheel turned over it does not reach
+    the view, FreeCAD issue 21141; none before 1.0), and the buttons of a question FreeCAD shows (a
+    QMessageBox: "Save all changes...?") by text, at their centres in screen pixels."""
+    console, panels, buttons, stack = None, [], {}, [(Gui.getMainWindow(), False)]
     while stack:
         w, in_box = stack.pop()
         name = w.metaObject().className()
-        if name == "Gui::OverlayTabWidget":
-            if w.isVisible():
-                panels.append(_rect(w))
-            continue
+        if name == "Gui::OverlayTabWidget" and w.isVisible():
+            panels.append(_rect(w))
+        if console is None and name == "Gui::PythonConsole" and w.isVisible():
+            console = _rect(w)
         in_box = in_box or (w.inherits("QMessageBox") and w.isVisible())
         if in_box and w.inherits("QPushButton") and w.isVisible() and w.text():
             centre, ratio = w.mapToGlobal(w.rect().center()), w.devicePixelRatioF()
             buttons[w.text().replace("&", "")] = [round(centre.x() * ratio), round(centre.y() * ratio)]
         stack.extend((c, in_box) for c in w.children() if c.isWidgetType())
-    return panels, buttons
+    return console, panels, buttons
 
 
 def _focus():
@@ -383,17 +385,18 @@ def write(*_):
              "workbench": Gui.activeWorkbench().name() if Gui.activeWorkbench() else "",
              "active": FreeCAD.ActiveDocument.Name if FreeCAD.ActiveDocument else None, "docs": {}, "views": _views(),
              "task_dialog": bool(Gui.Control.activeDialog()), "tree": _tree_items(),
-             "task_buttons": _task_buttons(), "toolbars": _toolbars(), "console": _widget_rect("Gui::PythonConsole"),
+             "task_buttons": _task_buttons(), "toolbars": _toolbars(),
              "focus": _focus(), "focus_field": _focus_is_field(), "selection": [[o.ObjectName, list(o.SubElementNames)]
                                               for o in Gui.Selection.getSelectionEx()],
              "preselection": _preselection()}
-    state["overlay_panels"], state["message_buttons"] = _panels_and_questions()
+    state["console"], state["overlay_panels"], state["message_buttons"] = _console_panels_and_questions()
     for name, doc in FreeCAD.listDocuments().items():
+        facts = _shape_facts(doc)
         state["docs"][name] = {"undo": list(doc.UndoNames), "redo": list(doc.RedoNames), "file": doc.FileName,
                                "modified": bool(getattr(doc, "isTouched", lambda: False)()),
                                "gui_modified": bool(getattr(Gui.getDocument(name), "Modified", False)),
                                "sculpts": _sculpts(doc), "objects": [o.Name for o in doc.Objects],
-                               "solids": _solids(doc), "features": _features(doc),
+                               "solids": _solids(doc, facts), "features": _features(doc, facts),
                                "screen": {o.Name: _on_screen(o) for o in doc.Objects if hasattr(o, "Shape")},
                                "edge_points": {o.Name: _edge_points(o) for o in doc.Objects if hasattr(o, "Shape")}}
     try:
@@ -421,7 +424,7 @@ def write(*_):
         state["controller_error"] = str(exc)
     tmp = OUT + ".tmp"
     with open(tmp, "w") as f:
-        json.dump(state, f)
+        f.write(json.dumps(state))  # (dumps encodes in C; dump to a file in Python, 10 times slower)
     os.replace(tmp, OUT)
 
 
