@@ -11,9 +11,12 @@ SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
 PHONY_LONG := stress fuzz bench-peers batch-replay
-.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-gui-repeat test-cpp test-asan test-python \
+.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-parts test-gui-repeat test-cpp test-asan test-python \
         test-gui test-freecad test-addon wheel ocp-venv demo bench install install-udev install-realtime uninstall clean test-other-debians \
-        wheels wheel-check
+        wheels wheel-check check
+# What make keeps outside the checkout, so that a clean clone reuses it: the compiler cache, the
+# Debian roots (tools/debian-root), the virtual environment of the STEP reader.
+HS_CACHE ?= $(or $(XDG_CACHE_HOME),$(HOME)/.cache)/hapticsculpt
 # A compiler cache outside the checkout, as the Debian roots are: a clean clone then compiles only
 # what changed since the last build on this machine (in a root, the cache lives in the root). Paths
 # are taken relative to the checkout and the build folder is not hashed, so that clones in other
@@ -21,20 +24,25 @@ PHONY_LONG := stress fuzz bench-peers batch-replay
 # (On a fresh machine make deps installs it: from the next make on.)
 CCACHE := $(shell command -v ccache)
 ifneq ($(CCACHE),)
-export CCACHE_DIR ?= $(HOME)/.cache/hapticsculpt/ccache
+export CCACHE_DIR ?= $(HS_CACHE)/ccache
 export CCACHE_BASEDIR := $(CURDIR)
 export CCACHE_NOHASHDIR := 1
 export CMAKE_CXX_COMPILER_LAUNCHER := $(CCACHE)
 export CMAKE_C_COMPILER_LAUNCHER := $(CCACHE)
 endif
+# Each part of make test runs through it: its seconds in the log, for tools/test_times.py.
+TIMED := tools/timed
 # The fake vendor libraries (libusb with an emulated Falcon, OpenHaptics, DHD) the device tests
 # load instead of the system's: built with the C++ tests.
 export HS_FAKE_VENDOR := $(CURDIR)/$(BUILD)/release/fake_vendor
 # A private FreeCAD user folder whose Mod/HapticSculpt links this checkout (tests, demo render).
 FC_HOME     := $(BUILD)/freecad-home
 # cadquery (with its own OCCT, OCP) in its own virtual environment: its numpy must not shadow Debian's.
+# Made once per Python and cadquery version in $(HS_CACHE) (a clean clone then does not install it
+# again: 45 s a Debian) and linked as $(BUILD)/ocp-venv.
 OCP_VENV    := $(BUILD)/ocp-venv
 CADQUERY    := cadquery==2.8.0
+OCP_CACHED  := $(HS_CACHE)/ocp-venv-$(shell $(PY) -c 'import sys; print("py%d%d" % sys.version_info[:2])')-$(subst ==,-,$(CADQUERY))
 # Where `make install` links the addon: the Mod folder of the FreeCAD installed here, as FreeCAD
 # itself names it (getUserAppDataDir: ~/.local/share/FreeCAD/ for 0.20 and 1.0, versioned folders
 # such as v1-1/ for 1.1). Give FREECAD_MOD=... to install elsewhere.
@@ -52,7 +60,7 @@ deps:
 
 build: deps
 	cmake -S native_core -B $(BUILD)/release -G Ninja -DCMAKE_BUILD_TYPE=Release
-	cmake --build $(BUILD)/release -j $(JOBS)
+	$(TIMED) build cmake --build $(BUILD)/release -j $(JOBS)
 
 # C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer (no Python extension: it would need
 # the sanitizer runtime preloaded into the interpreter). Debug keeps Eigen's and the core's asserts;
@@ -60,27 +68,30 @@ build: deps
 build-asan: deps
 	cmake -S native_core -B $(BUILD)/asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DHS_SANITIZE=ON -DHS_PYTHON=OFF \
 	  "-DCMAKE_CXX_FLAGS_DEBUG=-g -O1"
-	cmake --build $(BUILD)/asan -j $(JOBS)
+	$(TIMED) build-asan cmake --build $(BUILD)/asan -j $(JOBS)
 
 # The threaded runtime under ThreadSanitizer.
 build-tsan: deps
 	cmake -S native_core -B $(BUILD)/tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHS_TSAN=ON -DHS_PYTHON=OFF
-	cmake --build $(BUILD)/tsan -j $(JOBS)
+	$(TIMED) build-tsan cmake --build $(BUILD)/tsan -j $(JOBS)
 
 test-tsan: build-tsan
-	TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 ctest --test-dir $(BUILD)/tsan --output-on-failure -R "Runtime|TripleBuffer|HapticEstimate|FalconDevice|FalconUsb|VendorDevices|HaplyDevice"
+	TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 $(TIMED) test-tsan ctest --test-dir $(BUILD)/tsan --output-on-failure -R "Runtime|TripleBuffer|HapticEstimate|FalconDevice|FalconUsb|VendorDevices|HaplyDevice"
 
 test-cpp: build
-	ctest --test-dir $(BUILD)/release --output-on-failure -j $(JOBS)
+	$(TIMED) test-cpp ctest --test-dir $(BUILD)/release --output-on-failure -j $(JOBS)
 
 test-asan: build-asan
 	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-	  ctest --test-dir $(BUILD)/asan --output-on-failure -j $(JOBS)
+	  $(TIMED) test-asan ctest --test-dir $(BUILD)/asan --output-on-failure -j $(JOBS)
 
-$(OCP_VENV)/.installed:
-	$(PY) -m venv $(OCP_VENV)
-	$(OCP_VENV)/bin/pip install -q --disable-pip-version-check $(CADQUERY)
+$(OCP_CACHED)/.installed:
+	$(PY) -m venv $(OCP_CACHED)
+	$(TIMED) ocp-venv $(OCP_CACHED)/bin/pip install -q --disable-pip-version-check $(CADQUERY)
 	touch $@
+
+$(OCP_VENV)/.installed: $(OCP_CACHED)/.installed
+	mkdir -p $(BUILD) && rm -rf $(OCP_VENV) && ln -s $(OCP_CACHED) $(OCP_VENV)
 
 ocp-venv: deps $(OCP_VENV)/.installed
 
@@ -92,8 +103,8 @@ $(FC_HOME)/Mod/HapticSculpt:
 # installed addon in test-addon (FreeCAD's runner, then pytest), or from here in test-freecad and
 # test-gui: each test once per FreeCAD in make test.
 test-python: build ocp-venv
-	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) -m pytest -q tests \
-	  --ignore-glob='tests/test_gui_*' --ignore-glob='tests/test_freecad_*' $(PYTEST_ARGS)
+	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(TIMED) test-python $(PY) -m pytest -q tests \
+	  --ignore-glob='tests/test_gui_*' --ignore-glob='tests/test_freecad_*' --durations=10 $(PYTEST_ARGS)
 
 test-gui: build ocp-venv
 	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) -m pytest -q tests/test_gui_*.py $(PYTEST_ARGS)
@@ -108,7 +119,7 @@ $(WHEEL_VENV)/.installed:
 
 wheel: deps $(WHEEL_VENV)/.installed
 	rm -rf $(BUILD)/wheel/raw $(BUILD)/wheel/dist
-	$(WHEEL_VENV)/bin/pip wheel -q --disable-pip-version-check --no-deps -w $(BUILD)/wheel/raw .
+	$(TIMED) wheel $(WHEEL_VENV)/bin/pip wheel -q --disable-pip-version-check --no-deps -w $(BUILD)/wheel/raw .
 	PATH=$(CURDIR)/$(WHEEL_VENV)/bin:$$PATH $(WHEEL_VENV)/bin/auditwheel repair -w $(BUILD)/wheel/dist $(BUILD)/wheel/raw/*.whl
 	@ls $(BUILD)/wheel/dist/*.whl
 
@@ -142,7 +153,7 @@ wheel-debian-%: deps
 GUI_TESTS ?=
 GUI_PYTEST_ARGS ?=
 test-addon: build wheel ocp-venv
-	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) tests/addon_install.py \
+	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(TIMED) addon $(PY) tests/addon_install.py \
 	  --wheel $$(ls $(BUILD)/wheel/dist/*.whl) --pip-python $(WHEEL_VENV)/bin/python --out $(BUILD)/addon-install \
 	  --gui-tests "$(GUI_TESTS)" --pytest-args "$(GUI_PYTEST_ARGS)"
 
@@ -150,17 +161,36 @@ test-addon: build wheel ocp-venv
 # test runs them from the installed addon instead: test-addon).
 test-freecad: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
 	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python FREECAD_USER_HOME=$(CURDIR)/$(FC_HOME) \
-	  freecadcmd -t TestHapticSculpt
+	  $(TIMED) freecad-runner freecadcmd -t TestHapticSculpt
 
-test: test-cpp test-asan test-tsan test-python test-addon demo test-other-debians
+# The edit-test loop, in at most 5 minutes: the C++ tests, pytest without FreeCAD's GUI (500 of the
+# stress seeds) and FreeCAD's runner on this machine's FreeCAD, side by side. CI runs make test,
+# which runs all of this and the rest.
+CHECK_STRESS_SEEDS ?= 0:500
+check: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
+	@HS_TIMED_PREFIX=1 HS_STRESS_SEEDS=$(CHECK_STRESS_SEEDS) $(MAKE) --no-print-directory -j3 test-cpp test-python test-freecad
+
+# make test: every part on this machine's FreeCAD and on the other Debians', in lanes side by side
+# (make -j4): each Debian root is one lane, its parts one after another; the host's parts take the
+# other two slots, in the order listed (its FreeCAD suites first: the longest chain). GUI tests wait
+# on X events and repaints much of the time, so the lanes share the two cores. Every part runs
+# through tools/timed: the log says what each took, and make test ends with that table (its log is
+# in $(BUILD)/make-test.log). A part that fails does not stop the others (-k).
+TEST_LANES ?= 4
+test: deps
+	@mkdir -p $(BUILD); set -o pipefail; \
+	HS_TIMED_PREFIX=1 $(MAKE) --no-print-directory -k -j$(TEST_LANES) test-parts 2>&1 | tee $(BUILD)/make-test.log; \
+	rc=$$?; echo; $(PY) tools/test_times.py $(BUILD)/make-test.log; exit $$rc
+
+test-parts: test-other-debians test-addon demo test-python test-cpp test-asan test-tsan
 
 # The same against the other Debians' FreeCADs, so that 0.20.2, 1.0.0 and 1.1.3 all run: on Debian 12
 # (FreeCAD 0.20.2, Python 3.11) those are Debian 13's 1.0 (Python 3.13, GCC 14) and forky's 1.1.3
 # (Qt6, Python 3.14, GCC 15); on Debian 13, Debian 12's and forky's. Each runs in a root made by
 # debootstrap from Debian's archive with the same packages, built once and cached outside the
 # checkout (tools/debian-root; rebuilt when the package list changes). Its builds, virtual
-# environments and demo go to build/<suite>/. The sanitizers run on the host only (the same code;
-# ASan and TSan builds are the slowest part), so that make test fits in an hour.
+# environments and demo go to build/<suite>/. The sanitizers run on the host only: the same code,
+# and the slowest builds.
 ROOT_PACKAGES := $(APT_PACKAGES) make ca-certificates
 IN_ROOT = tools/debian-root $(1) run env HS_STRESS_SEEDS=$(STRESS_SEEDS_$(1)) make BUILD=build/$(1) DEMO_OUT=build/$(1)/demo
 # The stress test's seeds in each root: the host runs 0..3999, each root 2,000 of its own (the same
@@ -171,10 +201,11 @@ STRESS_SEEDS_forky    := 14000:2000
 test-other-debians: $(addprefix test-debian-,$(OTHER_SUITES))
 
 # Where no root can be made (no mount namespace: tools/debian-root exits 77 with one line saying what
-# is missing), the rest of make test still counts.
+# is missing), the rest of make test still counts. In make test's lanes every line says its Debian.
 test-debian-%: deps
-	@set +e; tools/debian-root $* ensure $(ROOT_PACKAGES) && \
-	  $(call IN_ROOT,$*) test-cpp test-python test-addon demo "GUI_PYTEST_ARGS=$(GUI_PYTEST_ARGS)"; rc=$$?; \
+	@set +e -o pipefail; { HS_SUITE=$* HS_TIMED_PREFIX= $(TIMED) root tools/debian-root $* ensure $(ROOT_PACKAGES) && \
+	  $(call IN_ROOT,$*) test-cpp test-python test-addon demo "GUI_PYTEST_ARGS=$(GUI_PYTEST_ARGS)"; } 2>&1 | \
+	  if [ -n "$$HS_TIMED_PREFIX" ]; then sed -u 's/^/[$*] /'; else cat; fi; rc=$${PIPESTATUS[0]}; \
 	  if [ $$rc = 77 ]; then echo "make test: Debian $*'s FreeCAD was not tested (see the line above)"; exit 0; fi; \
 	  exit $$rc
 
@@ -228,7 +259,7 @@ batch-replay: build
 
 DEMO_OUT ?= out
 demo: build
-	$(PY) demo.py --out $(DEMO_OUT)
+	$(TIMED) demo $(PY) demo.py --out $(DEMO_OUT)
 
 install: build
 	@mod="$(FREECAD_MOD)"; [ -n "$$mod" ] || { echo "FreeCAD's Mod folder not found (is freecadcmd installed?): give FREECAD_MOD=..."; exit 1; }; \

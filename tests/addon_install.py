@@ -41,12 +41,14 @@ sys.stderr.write("HS_SMOKE lift %.2f mm\\n" % lift)
 """
 
 
-def run(what: str, command: list[str], **kwargs) -> subprocess.CompletedProcess:
-    """Runs ``command``, printing what it is and how long it took; fails the script if it fails."""
+def run(what: str, command: list[str], part: str | None = None, **kwargs) -> subprocess.CompletedProcess:
+    """Runs ``command``, printing what it is and how long it took (a ``part`` of make test: through
+    tools/timed, whose lines tools/test_times.py reads); fails the script if it fails."""
     print(f"== {what}", flush=True)
     start = time.monotonic()
-    proc = subprocess.run(command, **kwargs)
-    print(f"   ({time.monotonic() - start:.0f} s)", flush=True)
+    proc = subprocess.run([os.path.join(ROOT, "tools", "timed"), part, *command] if part else command, **kwargs)
+    if not part:
+        print(f"   ({time.monotonic() - start:.0f} s)", flush=True)
     if proc.returncode != 0:
         sys.exit(f"addon install: {what} failed (exit {proc.returncode})")
     return proc
@@ -98,12 +100,12 @@ def main(argv: list[str]) -> int:
             sys.exit(f"addon install: the stroke did not run:\n{smoke.stdout[-2000:]}{smoke.stderr[-2000:]}")
         return 0
     run("freecadcmd -t TestHapticSculpt (from the installed addon)", ["freecadcmd", "-t", "TestHapticSculpt"],
-        env=env, cwd=out)
+        part="freecad-runner", env=env, cwd=out)
     gui_tests = args.gui_tests.split() or sorted(
         os.path.relpath(p, addon) for p in glob.glob(os.path.join(addon, "tests", "test_gui_*.py")))
     run("GUI tests (from the installed addon)",
-        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-rfE", *args.pytest_args.split(), *gui_tests],
-        env=env, cwd=addon)
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-rfE", "--durations=10",
+         *args.pytest_args.split(), *gui_tests], part="gui", env=env, cwd=addon)
     return 0
 
 
