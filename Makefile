@@ -11,7 +11,7 @@ SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
 PHONY_LONG := stress fuzz bench-peers batch-replay
-.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-parts test-gui-repeat test-cpp test-asan test-python \
+.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-parts test-gui-repeat test-gui-repeat-all test-cpp test-asan test-python \
         test-gui test-freecad test-addon wheel ocp-venv demo bench install install-udev install-realtime uninstall clean test-other-debians \
         wheels wheel-check check
 # What make keeps outside the checkout, so that a clean clone reuses it: the compiler cache, the
@@ -210,18 +210,24 @@ test-debian-%: deps
 	  exit $$rc
 
 test-gui-repeat-debian-%: deps
-	tools/debian-root $* ensure $(ROOT_PACKAGES)
-	$(call IN_ROOT,$*) test-gui-repeat GUI_REPEAT=$(GUI_REPEAT)
+	@set -o pipefail; { tools/debian-root $* ensure $(ROOT_PACKAGES) && \
+	  $(call IN_ROOT,$*) test-gui-repeat GUI_REPEAT=$(GUI_REPEAT); } 2>&1 | \
+	  if [ -n "$$HS_TIMED_PREFIX" ]; then sed -u 's/^/[$*] /'; else cat; fi
 
 # Every GUI test and the session tests GUI_REPEAT times in a row (a test that fails one run in three
 # fails CI: three runs is the least that shows it).
 GUI_REPEAT ?= 3
 test-gui-repeat: build ocp-venv
-	set -eo pipefail; for i in $$(seq $(GUI_REPEAT)); do echo "== run $$i of $(GUI_REPEAT)"; \
-	  ctest --test-dir $(BUILD)/release --output-on-failure -R "HapticRuntime" | tail -1; \
-	  HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) -m pytest -q -p no:cacheprovider \
-	    tests/test_gui_*.py tests/test_freecad_session.py -rfE | tail -n 15; \
-	done
+	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(TIMED) gui-repeat bash -c \
+	  'set -eo pipefail; for i in $$(seq $(GUI_REPEAT)); do echo "== run $$i of $(GUI_REPEAT)"; \
+	    ctest --test-dir $(BUILD)/release --output-on-failure -R "HapticRuntime" | tail -1; \
+	    $(PY) -m pytest -q -p no:cacheprovider tests/test_gui_*.py tests/test_freecad_session.py -rfE | tail -n 15; \
+	  done'
+
+# The same on every FreeCAD at once, GUI suites side by side on their own displays as in make
+# test's lanes (each line says its Debian): what "3 of 3 on each FreeCAD" is measured by.
+test-gui-repeat-all: deps
+	@HS_TIMED_PREFIX=1 $(MAKE) --no-print-directory -k -j3 test-gui-repeat $(addprefix test-gui-repeat-debian-,$(OTHER_SUITES))
 
 # libFuzzer on the HID parsers (clang; FUZZ_SECONDS per harness), seeded with the recorded
 # fixtures' descriptors and reports. A crash or sanitizer report fails the target and leaves the
