@@ -326,15 +326,17 @@ class TestDroppedStroke(DocumentTestCase):
             session.poll()
             time.sleep(0.005)
         end = time.monotonic() + 5
-        # (its end dropped: the document's state, taken back at rest, settles by a few hundredths of a mm)
-        while np.abs(session.newest_poles().ravel() - kept).max() > 0.1:
+        # (its end dropped: the document's state, taken back at rest, settles by a few hundredths of a
+        # mm, and goes on settling while the session runs: how far by the stop depends on how loaded
+        # the machine is, so the document is compared with what the session showed just before it)
+        while np.abs((shown := session.newest_poles().ravel()) - kept).max() > 0.1:
             self.assertLess(time.monotonic(), end, "the surface did not go back")
             session.poll()
             time.sleep(0.005)
         session.stop()
         self.assertEqual(list(self.doc.UndoNames), steps)
         self.assertEqual((obj.Strokes, session.status()["strokes"]), (1, 2))
-        np.testing.assert_allclose(np.array(obj.Poles), kept, atol=0.1)
+        np.testing.assert_allclose(np.array(obj.Poles), shown, atol=0.02)  # (the stop keeps what was shown)
 
     def test_a_stop_while_a_dropped_stroke_is_held_keeps_the_document_as_it_was(self):
         obj = hs.make_sculpt(self.doc, material="clay")
