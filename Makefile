@@ -11,7 +11,7 @@ SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
 PHONY_LONG := stress fuzz bench-peers batch-replay
-.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-parts test-gui-repeat test-gui-repeat-all test-cpp test-asan test-python \
+.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-parts test-host test-here test-gui-repeat test-gui-repeat-all test-cpp test-asan test-python \
         test-gui test-freecad test-addon wheel ocp-venv demo bench install install-udev install-realtime uninstall clean test-other-debians \
         wheels wheel-check check
 # What make keeps outside the checkout, so that a clean clone reuses it: the compiler cache, the
@@ -170,19 +170,35 @@ CHECK_STRESS_SEEDS ?= 0:500
 check: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
 	@HS_TIMED_PREFIX=1 HS_STRESS_SEEDS=$(CHECK_STRESS_SEEDS) $(MAKE) --no-print-directory -j3 test-cpp test-python test-freecad
 
-# make test: every part on this machine's FreeCAD and on the other Debians', in lanes side by side
-# (make -j4): each Debian root is one lane, its parts one after another; the host's parts take the
-# other two slots, in the order listed (its FreeCAD suites first: the longest chain). GUI tests wait
-# on X events and repaints much of the time, so the lanes share the two cores. Every part runs
-# through tools/timed: the log says what each took, and make test ends with that table (its log is
-# in $(BUILD)/make-test.log). A part that fails does not stop the others (-k).
-TEST_LANES ?= 4
+# make test: every part on this machine's FreeCAD and on the other Debians', in three lanes side by
+# side (make -j3), one per FreeCAD: the host's (with the sanitizers) and each Debian root's, each
+# running test-here. GUI tests wait on X events and repaints much of the time, so the lanes share
+# the two cores. Every part runs through tools/timed: the log says what each took, and make test
+# ends with that table (its log is in $(BUILD)/make-test.log). A part that fails does not stop the
+# others (-k).
 test: deps
 	@mkdir -p $(BUILD); set -o pipefail; \
-	HS_TIMED_PREFIX=1 $(MAKE) --no-print-directory -k -j$(TEST_LANES) test-parts 2>&1 | tee $(BUILD)/make-test.log; \
+	HS_TIMED_PREFIX=1 $(MAKE) --no-print-directory -k -j3 test-parts 2>&1 | tee $(BUILD)/make-test.log; \
 	rc=$$?; echo; $(PY) tools/test_times.py $(BUILD)/make-test.log; exit $$rc
 
-test-parts: test-other-debians test-addon demo test-python test-cpp test-asan test-tsan
+test-parts: test-other-debians test-host
+
+test-host:
+	@$(MAKE) --no-print-directory test-here SANITIZERS=1
+
+# One FreeCAD's parts in two lanes side by side, once the core is built: its FreeCAD suites (the
+# wheel, then the installed addon: FreeCAD's runner, the GUI tests), the longest chain, and the rest
+# one after another (the order-only rules below: each waits for the one before it).
+SANITIZERS ?=
+test-here:
+	@$(MAKE) --no-print-directory -k -j2 HERE_LANES=1 test-addon test-cpp $(if $(SANITIZERS),test-asan test-tsan) \
+	  test-python demo
+ifdef HERE_LANES
+build-asan: | test-cpp
+build-tsan: | test-asan
+test-python: | $(if $(SANITIZERS),test-tsan,test-cpp)
+demo: | test-python
+endif
 
 # The same against the other Debians' FreeCADs, so that 0.20.2, 1.0.0 and 1.1.3 all run: on Debian 12
 # (FreeCAD 0.20.2, Python 3.11) those are Debian 13's 1.0 (Python 3.13, GCC 14) and forky's 1.1.3
@@ -192,7 +208,8 @@ test-parts: test-other-debians test-addon demo test-python test-cpp test-asan te
 # environments and demo go to build/<suite>/. The sanitizers run on the host only: the same code,
 # and the slowest builds.
 ROOT_PACKAGES := $(APT_PACKAGES) make ca-certificates
-IN_ROOT = tools/debian-root $(1) run env HS_STRESS_SEEDS=$(STRESS_SEEDS_$(1)) make BUILD=build/$(1) DEMO_OUT=build/$(1)/demo
+IN_ROOT = tools/debian-root $(1) run env HS_STRESS_SEEDS=$(STRESS_SEEDS_$(1)) HS_TIMED_PREFIX=$(HS_TIMED_PREFIX) \
+  make BUILD=build/$(1) DEMO_OUT=build/$(1)/demo
 # The stress test's seeds in each root: the host runs 0..3999, each root 2,000 of its own (the same
 # core, built by another compiler: more seeds covered in less time than the same ones three times).
 STRESS_SEEDS_bookworm := 10000:2000
@@ -204,15 +221,15 @@ test-other-debians: $(addprefix test-debian-,$(OTHER_SUITES))
 # is missing), the rest of make test still counts. In make test's lanes every line says its Debian.
 test-debian-%: deps
 	@set +e -o pipefail; { HS_SUITE=$* HS_TIMED_PREFIX= $(TIMED) root tools/debian-root $* ensure $(ROOT_PACKAGES) && \
-	  $(call IN_ROOT,$*) test-cpp test-python test-addon demo "GUI_PYTEST_ARGS=$(GUI_PYTEST_ARGS)"; } 2>&1 | \
-	  if [ -n "$$HS_TIMED_PREFIX" ]; then sed -u 's/^/[$*] /'; else cat; fi; rc=$${PIPESTATUS[0]}; \
+	  $(call IN_ROOT,$*) test-here "GUI_PYTEST_ARGS=$(GUI_PYTEST_ARGS)"; } 2>&1 | \
+	  if [ -n "$$HS_TIMED_PREFIX" ]; then sed -u '/^\[$* /!s/^/[$*] /'; else cat; fi; rc=$${PIPESTATUS[0]}; \
 	  if [ $$rc = 77 ]; then echo "make test: Debian $*'s FreeCAD was not tested (see the line above)"; exit 0; fi; \
 	  exit $$rc
 
 test-gui-repeat-debian-%: deps
 	@set -o pipefail; { tools/debian-root $* ensure $(ROOT_PACKAGES) && \
 	  $(call IN_ROOT,$*) test-gui-repeat GUI_REPEAT=$(GUI_REPEAT); } 2>&1 | \
-	  if [ -n "$$HS_TIMED_PREFIX" ]; then sed -u 's/^/[$*] /'; else cat; fi
+	  if [ -n "$$HS_TIMED_PREFIX" ]; then sed -u '/^\[$* /!s/^/[$*] /'; else cat; fi
 
 # Every GUI test and the session tests GUI_REPEAT times in a row (a test that fails one run in three
 # fails CI: three runs is the least that shows it).
