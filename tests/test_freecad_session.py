@@ -98,7 +98,10 @@ class TestSession(DocumentTestCase):
             self.assertEqual(py.position, tuple(xyz[k]))
         errors = session.force_errors()
         self.assertLess(np.median(errors), 0.01)
-        if session.status()["dropped_sim_time"] == 0:  # the tail holds while the simulation keeps pace
+        # The tail holds while the simulation keeps pace: nothing dropped, and at most 1 % of its
+        # steps doubled (a loaded machine doubles ~5 %, and then the tail reached 0.06).
+        status = session.status()
+        if status["dropped_sim_time"] == 0 and status["doubled_steps"] <= 0.01 * status["sim_steps"]:
             self.assertLess(np.percentile(errors, 99), 0.05)
 
     def test_closing_the_document_stops_the_session(self):
