@@ -43,13 +43,19 @@ def click_in_view(d: Desktop, points: list[list[float]], name: str, add: bool = 
     """Moves the mouse over object ``name`` in the 3D view, trying viewport pixels ``points`` and
     a few pixels around each until FreeCAD highlights it, and clicks (ctrl+click: adds to the
     selection), as a designer hovers until the line lights up."""
+    def cursor(s: dict) -> list | None:  # (where the view's last mouse event was)
+        return next((v["pixel"] for v in s["views"] if v["active"]), None)
+
     for at in points:
         x0, y0 = d.to_screen(at)
         # (FreeCAD 0.20's getPointOnScreen is some pixels off the view's own event coordinates)
         for dx, dy in [(0, 0)] + [(dx, dy) for dy in range(-24, 25, 2) for dx in (0, 3)]:
+            before = cursor(d.state())
             d.xdo("mousemove", str(x0 + dx), str(y0 + dy))
-            try:
-                d.wait(lambda s: (s["preselection"] or [None])[0] == name, f"{name} highlighted", 0.4, shot=False)
+            try:  # (a highlight the view showed for this point: on a loaded machine the state written
+                # last can still be the point before, and a click here then missed the patch)
+                d.wait(lambda s: cursor(s) != before and (s["preselection"] or [None])[0] == name,
+                       f"{name} highlighted", 0.4, shot=False)
             except AssertionError:
                 continue
             d.xdo(*(["keydown", "ctrl", "click", "1", "keyup", "ctrl"] if add else ["click", "1"]))

@@ -199,6 +199,8 @@ class Desktop:
 
     def shot(self, name: str) -> np.ndarray:
         import matplotlib.image as mpimg
+        if name == "timeout":  # (one per test: a later test's timeout would overwrite it)
+            name += "_" + os.environ.get("PYTEST_CURRENT_TEST", "").split("::")[-1].split(" ")[0][:80]
         path = os.path.join(SHOTS, f"real_{name}.png")
         subprocess.run(["import", "-window", "root", path], env=self.env, check=True)
         return mpimg.imread(path)[..., :3]
