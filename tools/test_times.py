@@ -17,7 +17,7 @@ import sys
 from dataclasses import asdict, dataclass
 
 START = re.compile(r"== \[part\] (\S+) (\S+): start ([0-9.]+)")
-END = re.compile(r"== \[part\] (\S+) (\S+): (\d+) s, exit (\d+) \(([0-9.]+)\)")
+END = re.compile(r"== \[part\] (\S+) (\S+): (\d+) s,(?: CPU (\d+) s,)? exit (\d+) \(([0-9.]+)\)")
 #: The FreeCAD each Debian has (the roots' and the hosts').
 FREECAD = {"bookworm": "0.20.2", "trixie": "1.0.0", "forky": "1.1.3"}
 
@@ -29,6 +29,7 @@ class Part:
     start: float
     end: float | None = None
     exit: int | None = None
+    cpu: float | None = None  # user + system seconds, on any core
 
     @property
     def seconds(self) -> float | None:
@@ -48,7 +49,8 @@ def parts_of(lines) -> list[Part]:
         elif m := END.search(line):
             part = open_parts.pop((m[1], m[2]), None)
             if part is not None:
-                part.end, part.exit = float(m[5]), int(m[4])
+                part.end, part.exit = float(m[6]), int(m[5])
+                part.cpu = None if m[4] is None else float(m[4])
     return parts
 
 
@@ -57,10 +59,11 @@ def table(parts: list[Part]) -> str:
     if not parts:
         return "no timed parts in this log (make test prints them through tools/timed)"
     t0 = min(p.start for p in parts)
-    rows = [("Debian (FreeCAD)", "part", "seconds", "from", "to", "exit")]
+    rows = [("Debian (FreeCAD)", "part", "seconds", "CPU s", "from", "to", "exit")]
     for p in parts:
         rows.append((f"{p.suite} ({FREECAD.get(p.suite, '?')})", p.name,
-                     "-" if p.seconds is None else f"{p.seconds:.0f}", f"{p.start - t0:.0f}",
+                     "-" if p.seconds is None else f"{p.seconds:.0f}", "-" if p.cpu is None else f"{p.cpu:.0f}",
+                     f"{p.start - t0:.0f}",
                      "running" if p.end is None else f"{p.end - t0:.0f}", "" if p.exit is None else str(p.exit)))
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     out = ["  ".join(c.ljust(w) if i < 2 else c.rjust(w) for i, (c, w) in enumerate(zip(r, widths))) for r in rows]
@@ -68,6 +71,11 @@ def table(parts: list[Part]) -> str:
     ends = [p.end for p in parts if p.end is not None]
     if ends:
         out.append(f"\nwall time: {max(ends) - t0:.0f} s from the first part's start to the last part's end")
+        outer = [p for p in parts if p.cpu is not None and not any(q is not p and q.suite == p.suite and q.end is not None
+                                                                    and q.start <= p.start and p.end <= q.end
+                                                                    for q in parts)]
+        if outer:
+            out.append(f"CPU time: {sum(p.cpu for p in outer):.0f} s in all (the parts not inside another)")
     for suite in dict.fromkeys(p.suite for p in parts):
         done = [p for p in parts if p.suite == suite and p.seconds is not None]
         out.append(f"  {suite}: busy {busy(done):.0f} s ({len(done)} parts; a part inside another counts once)")
