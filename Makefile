@@ -179,14 +179,20 @@ test-addon-%: build wheel ocp-venv
 # test runs them from the installed addon instead: test-addon).
 test-freecad: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
 	HS_REQUIRE_OCP=1 HS_OCP_PYTHON=$(CURDIR)/$(OCP_VENV)/bin/python FREECAD_USER_HOME=$(CURDIR)/$(FC_HOME) \
-	  $(TIMED) freecad-runner freecadcmd -t TestHapticSculpt
+	  HS_TEST_SHARD=$(SHARD) $(TIMED) freecad-runner$(if $(SHARD),-$(subst /,-of-,$(SHARD))) freecadcmd -t TestHapticSculpt
+
+# Half of them each (every other test class), for make check's two runners side by side.
+test-freecad-half-%: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
+	@$(MAKE) --no-print-directory test-freecad SHARD=$*/2
 
 # The edit-test loop, in at most 5 minutes: the C++ tests, pytest without FreeCAD's GUI (500 of the
-# stress seeds) and FreeCAD's runner on this machine's FreeCAD, side by side. CI runs make test,
+# stress seeds) and FreeCAD's runner on this machine's FreeCAD (two runners, half the tests each),
+# side by side. CI runs make test,
 # which runs all of this and the rest.
 CHECK_STRESS_SEEDS ?= 0:500
 check: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
-	@HS_TIMED_PREFIX=1 HS_STRESS_SEEDS=$(CHECK_STRESS_SEEDS) $(MAKE) --no-print-directory -j3 test-cpp test-python test-freecad
+	@HS_TIMED_PREFIX=1 HS_STRESS_SEEDS=$(CHECK_STRESS_SEEDS) $(MAKE) --no-print-directory -j4 test-cpp test-python \
+	  test-freecad-half-1 test-freecad-half-2
 
 # make test: every part on every FreeCAD here, this machine's and the other Debians' (in their
 # roots), side by side: make -j3 over the parts below, which run where their FreeCAD is. A FreeCAD's
@@ -198,7 +204,7 @@ check: build ocp-venv $(FC_HOME)/Mod/HapticSculpt
 # took, and make test ends with that table (its log is in $(BUILD)/make-test.log). A part that
 # fails does not stop the others (-k).
 test: deps
-	@mkdir -p $(BUILD); set -o pipefail; \
+	@mkdir -p $(BUILD); rm -f $(BUILD)/no-root-* $(BUILD)/unprepared-*; set -o pipefail; \
 	HS_TIMED_PREFIX=1 $(MAKE) --no-print-directory -k -j3 test-parts 2>&1 | tee $(BUILD)/make-test.log; \
 	rc=$$?; echo; $(PY) tools/test_times.py $(BUILD)/make-test.log; exit $$rc
 
@@ -217,26 +223,38 @@ PART_TARGET_asan   := test-asan
 PART_TARGET_tsan   := test-tsan
 part_suite = $(word 1,$(subst -, ,$(1)))
 part_name  = $(word 2,$(subst -, ,$(1)))
+# A prep that fails (or a root that cannot be made) marks its FreeCAD unprepared and passes, so that
+# the parts waiting for every prep (below) still run; that FreeCAD's own parts then fail, saying so.
 part-%:
-	@if [ -f $(BUILD)/no-root-$(call part_suite,$*) ]; then echo "[$*] not run: no Debian $(call part_suite,$*) root here"; exit 0; fi; \
+	@suite=$(call part_suite,$*); \
+	if [ -f $(BUILD)/no-root-$$suite ]; then echo "[$*] not run: no Debian $$suite root here"; exit 0; fi; \
+	if [ -f $(BUILD)/unprepared-$$suite ]; then echo "[$*] not run: $$suite's core or root could not be made (above)"; \
+	  exit $(if $(filter prep,$(call part_name,$*)),0,1); fi; \
 	$(if $(filter $(HOST_SUITE),$(call part_suite,$*)),$(MAKE) --no-print-directory,\
 	  set -o pipefail; $(call IN_ROOT,$(call part_suite,$*))) \
 	  $(if $(filter prep,$(call part_name,$*)),,BUILT=1) $(PART_TARGET_$(call part_name,$*)) \
 	  "GUI_PYTEST_ARGS=$(GUI_PYTEST_ARGS)" \
-	  $(if $(filter $(HOST_SUITE),$(call part_suite,$*)),,2>&1 | sed -u '/^\[$(call part_suite,$*) /!s/^/[$(call part_suite,$*)] /')
+	  $(if $(filter $(HOST_SUITE),$(call part_suite,$*)),,2>&1 | sed -u '/^\[$(call part_suite,$*) /!s/^/[$(call part_suite,$*)] /') \
+	  $(if $(filter prep,$(call part_name,$*)),|| { touch $(BUILD)/unprepared-$$suite; echo "[$*] failed: $$suite's parts will not run"; })
 # Each FreeCAD's parts after its prep, a root's prep after the root is there; the third FreeCAD's GUI
-# tests after the host's (two GUI suites at a time).
+# tests after the host's (two GUI suites at a time). Every other part waits for all preps: make
+# queues what is ready in turn, and a runner queued while a root's prep still ran went before that
+# root's GUI tests, which then started last and ended last.
 $(foreach s,$(SUITES),$(foreach p,cpp python runner gui demo,$(eval part-$(s)-$(p): part-$(s)-prep)))
 $(foreach s,$(OTHER_SUITES),$(eval part-$(s)-prep: root-$(s)))
 part-$(lastword $(SUITES))-gui: | part-$(HOST_SUITE)-gui
+$(foreach s,$(SUITES),$(foreach p,cpp python runner demo,$(eval part-$(s)-$(p): | $(foreach t,$(SUITES),part-$(t)-prep))))
+part-$(HOST_SUITE)-asan part-$(HOST_SUITE)-tsan: | $(foreach t,$(SUITES),part-$(t)-prep)
 
+# (root-% does not run deps again: make test did, and a phony prerequisite here would let the host's
+# sanitizer builds take make's first three slots while it ran, the roots' GUI suites waiting behind.)
 # Where no root can be made (no mount namespace: tools/debian-root exits 77 with one line saying what
 # is missing), the rest of make test still counts: that root's parts then say so and pass.
-root-%: deps
-	@mkdir -p $(BUILD); rm -f $(BUILD)/no-root-$*; set -o pipefail; \
+root-%:
+	@mkdir -p $(BUILD); set -o pipefail; \
 	HS_SUITE=$* HS_TIMED_PREFIX= $(TIMED) root tools/debian-root $* ensure $(ROOT_PACKAGES) 2>&1 | sed -u 's/^/[$*] /'; \
-	rc=$$?; if [ $$rc = 77 ]; then touch $(BUILD)/no-root-$*; echo "make test: Debian $*'s FreeCAD was not tested (see the line above)"; exit 0; fi; \
-	exit $$rc
+	rc=$$?; if [ $$rc = 77 ]; then touch $(BUILD)/no-root-$*; echo "make test: Debian $*'s FreeCAD was not tested (see the line above)"; \
+	elif [ $$rc != 0 ]; then touch $(BUILD)/unprepared-$*; echo "[$*] the root could not be made: its parts will not run"; fi
 
 # The same against the other Debians' FreeCADs, so that 0.20.2, 1.0.0 and 1.1.3 all run: on Debian 12
 # (FreeCAD 0.20.2, Python 3.11) those are Debian 13's 1.0 (Python 3.13, GCC 14) and forky's 1.1.3
