@@ -107,6 +107,7 @@ def _solids(doc, facts):
                     "faces": len(shape.Faces), "wires": sorted(len(f.Wires) for f in shape.Faces),
                     "seams": json.loads(o.SeamReport or "[]"), "error": o.RebuildError,
                     "sculpt_faces": list(o.SculptFaces), "mirror_mm": _mirror_distance(o),
+                    "boundary": json.loads(o.Boundary or "{}"),
                     "base_visible": bool(o.Base.ViewObject.Visibility) if o.Base is not None else None})
     return out
 
@@ -189,6 +190,18 @@ def _on_screen(o):
         return [list(view.getPointOnScreen(p)) for p in pts]
     except Exception:  # noqa: BLE001 - no active 3D view
         return []
+
+
+def _probed_points():
+    """Where the 3D points a test asked about (the JSON list in OUT.points: [x, y, z] each) are in
+    the active 3D view's viewport, as [request id, [[x, y], ...]]; None when none were asked."""
+    try:
+        with open(OUT + ".points") as f:
+            request = json.load(f)
+        view = Gui.ActiveDocument.ActiveView
+        return [request["id"], [list(view.getPointOnScreen(FreeCAD.Vector(*p))) for p in request["points"]]]
+    except Exception:  # noqa: BLE001 - nothing asked, or no 3D view yet
+        return None
 
 
 def _preselection():
@@ -346,16 +359,23 @@ def _toolbars():
             "commands": [c for c in Gui.listCommands() if c.startswith("HapticSculpt_")]}
 
 
+#: How much of the report view's text (its end) the state carries.
+REPORT_CHARS = 6000
+
+
 def _console_panels_and_questions():
-    """Three things found in one walk of the main window's widgets: [x, y, width, height] on the
+    """Four things found in one walk of the main window's widgets: [x, y, width, height] on the
     screen of the Python console if it is shown (else None), of each shown panel FreeCAD lays over
     the 3D view (FreeCAD 1.1's Tasks panel on the view's right: a wheel turned over it does not reach
     the view, FreeCAD issue 21141; none before 1.0), and the buttons of a question FreeCAD shows (a
-    QMessageBox: "Save all changes...?") by text, at their centres in screen pixels."""
-    console, panels, buttons, stack = None, [], {}, [(Gui.getMainWindow(), False)]
+    QMessageBox: "Save all changes...?") by text, at their centres in screen pixels, and the end of
+    the report view's text (REPORT_CHARS)."""
+    console, panels, buttons, report, stack = None, [], {}, "", [(Gui.getMainWindow(), False)]
     while stack:
         w, in_box = stack.pop()
         name = w.metaObject().className()
+        if name == "Gui::DockWnd::ReportOutput":
+            report = w.toPlainText()[-REPORT_CHARS:]
         if name == "Gui::OverlayTabWidget" and w.isVisible():
             panels.append(_rect(w))
         if console is None and name == "Gui::PythonConsole" and w.isVisible():
@@ -365,7 +385,7 @@ def _console_panels_and_questions():
             centre, ratio = w.mapToGlobal(w.rect().center()), w.devicePixelRatioF()
             buttons[w.text().replace("&", "")] = [round(centre.x() * ratio), round(centre.y() * ratio)]
         stack.extend((c, in_box) for c in w.children() if c.isWidgetType())
-    return console, panels, buttons
+    return console, panels, buttons, report
 
 
 def _focus():
@@ -388,8 +408,8 @@ def write(*_):
              "task_buttons": _task_buttons(), "toolbars": _toolbars(),
              "focus": _focus(), "focus_field": _focus_is_field(), "selection": [[o.ObjectName, list(o.SubElementNames)]
                                               for o in Gui.Selection.getSelectionEx()],
-             "preselection": _preselection()}
-    state["console"], state["overlay_panels"], state["message_buttons"] = _console_panels_and_questions()
+             "preselection": _preselection(), "points": _probed_points()}
+    state["console"], state["overlay_panels"], state["message_buttons"], state["report"] = _console_panels_and_questions()
     for name, doc in FreeCAD.listDocuments().items():
         facts = _shape_facts(doc)
         state["docs"][name] = {"undo": list(doc.UndoNames), "redo": list(doc.RedoNames), "file": doc.FileName,
