@@ -47,15 +47,23 @@ def test_zebra_has_both_bands_on_a_dome_and_none_on_a_plane():
 
 def test_combs_point_along_the_normal_and_scale_with_curvature():
     _, mesh, curv = dome()
-    segs, scale = analysis.curvature_combs(mesh, curv, every=5)
+    segs, envelope, scale = analysis.curvature_combs(mesh, curv, every=5)
     assert segs.shape[1:] == (2, 3) and scale > 0
     teeth = np.linalg.norm(segs[:, 1] - segs[:, 0], axis=1)
     size = np.linalg.norm(mesh.reshape(-1, 3).max(0) - mesh.reshape(-1, 3).min(0))
     assert np.isclose(teeth.max(), 0.1 * size, rtol=1e-6)
+    # the envelope joins each comb line's tips in order: one segment fewer than teeth per line
+    g, h = mesh.shape[:2]
+    lines = len(range(0, g, 5)) + len(range(0, h, 5))
+    assert len(envelope) == len(segs) - lines
+    tips = {tuple(np.round(t, 9)) for t in segs[:, 1]}
+    assert all(tuple(np.round(p, 9)) in tips for p in envelope.reshape(-1, 3))
+    first = segs[:h, 1]  # the first iso-u line's tips, in order
+    assert np.allclose(envelope[: h - 1, 0], first[:-1]) and np.allclose(envelope[: h - 1, 1], first[1:])
     # the GUI's scale (gain) and density (every) controls
-    longer, doubled = analysis.curvature_combs(mesh, curv, every=5, gain=2.0)
+    longer, _, doubled = analysis.curvature_combs(mesh, curv, every=5, gain=2.0)
     assert np.isclose(doubled, 2 * scale) and len(longer) == len(segs)
-    denser, _ = analysis.curvature_combs(mesh, curv, every=2)
+    denser, _, _ = analysis.curvature_combs(mesh, curv, every=2)
     assert len(denser) > 2 * len(segs)
 
 

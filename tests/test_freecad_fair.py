@@ -12,6 +12,7 @@ from test_freecad_layer import stroke
 
 import HapticSculpt as hs
 from HapticSculpt.app.api import FAIR_BENDING
+from HapticSculpt.app.fairness import fair_text
 
 
 def curvature_variation(obj) -> float:
@@ -30,8 +31,18 @@ class TestFair(DocumentTestCase):
         held = obj.Proxy.live.snapshot().held_poles
         n = self.doc.UndoCount
         variation = curvature_variation(obj)
-        hs.fair(obj)
+        peak = float(np.abs(obj.Proxy.live.snapshot().curvature_grid()[..., 2:4]).max())
+        report = hs.fair(obj)
         self.assertEqual(self.doc.UndoCount, n + 1)
+        # it says what it moved: the poles' largest move and the peak curvature before and after
+        moved = float(np.abs(np.array(obj.Poles).reshape(-1, 3) - poles).max())
+        self.assertAlmostEqual(report["moved_mm"], moved, delta=1e-12)
+        self.assertAlmostEqual(report["peak_curvature_before"], peak, delta=1e-12)
+        self.assertAlmostEqual(report["peak_curvature_after"],
+                               float(np.abs(obj.Proxy.live.snapshot().curvature_grid()[..., 2:4]).max()), delta=1e-12)
+        self.assertIs(obj.Proxy.live.last_fair, report)
+        self.assertIn(f"poles moved up to {moved:.2g} mm", fair_text(report))
+        self.assertEqual(fair_text({**report, "moved_mm": 0.0}), "nothing moved (it was fair already)")
         self.assertEqual(self.doc.UndoNames[0], "Fair")
         after = np.array(obj.Poles).reshape(-1, 3)
         np.testing.assert_array_equal(after[held], poles[held])
@@ -53,7 +64,9 @@ class TestFair(DocumentTestCase):
             while session.status()["elapsed"] < 0.2:
                 self.assertLess(time.monotonic(), end, "the session never ran")
                 time.sleep(0.01)
-            hs.fair(obj)
+            report = hs.fair(obj)  # (what it moved, known at once though the session commits it later)
+            self.assertGreater(report["moved_mm"], 1e-3)
+            self.assertNotEqual(report["peak_curvature_after"], report["peak_curvature_before"])
             while not session.applied_edits:
                 self.assertLess(time.monotonic(), end, "the fair never applied")
                 session.poll()

@@ -33,7 +33,10 @@ rnd = next(f"Face{k + 1}" for k, f in enumerate(faces) if isinstance(f.Surface, 
 solid = hs.sculpt_solid(doc, part, [top, rnd], controls=(8, 12))
 doc.recompute()
 doc.saveAs(PATH)
-json.dump({"seams": hs.seam_report_of(solid)}, open({answer}, "w"))
+from HapticSculpt.app.sculpted_solid import chain_of_solid
+seam = next(iter(chain_of_solid(solid).seam_edges()))
+front = next(e for e, k in hs.boundary_of(solid).items() if k == "G1" and e != seam)  # (the round's with the front)
+json.dump({"seams": hs.seam_report_of(solid), "seam": seam, "front": front}, open({answer}, "w"))
 os._exit(0)
 """
 
@@ -51,7 +54,7 @@ def test_continuity_check_on_a_top_and_its_round_sculpted_as_one(tmp_path):
     os.makedirs(SHOTS, exist_ok=True)
     path = str(tmp_path / "block.FCStd")
     made = run_freecad_gui(f"PATH = {path!r}\n" + BLOCK, str(tmp_path))
-    seam = next(r["edge"] for r in made["seams"] if r["g1_deg"] is not None)  # (the one held G1: the seam)
+    seam, front = made["seam"], made["front"]  # (the seam between the two; the round's tangent edge with the front)
     d = Desktop(str(tmp_path), "CAD", open_file=path)
     try:
         s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["sculpts"], "the file")
@@ -87,9 +90,9 @@ def test_continuity_check_on_a_top_and_its_round_sculpted_as_one(tmp_path):
         d.click_button("Session")
         s = d.wait(lambda s: not sculpt(s)["session"], "the session to stop")
         after = overlay(s)["continuity_worst"]
-        # the edges held G0 still meet their neighbours, the seam held G1 is still tangent (the round's
-        # edge with the front, tangent in the base, held G0 only: it may turn)
-        assert after["g0_mm"] <= 1e-7 and after["levels"][seam] == "G1", after
+        # the edges held G0 still meet their neighbours, the seam held G1 is still tangent, and so is
+        # the round's edge with the front (tangent in the part: held G1 as the part has it)
+        assert after["g0_mm"] <= 1e-7 and after["levels"][seam] == "G1" and after["levels"][front] == "G1", after
         assert after != worst, "the stroke changed what the check measures"
         assert moving["overlays"], moving
         stroked = d.shot("continuity_stroked")

@@ -43,6 +43,7 @@ try:
     out["undo_names"] = doc.UndoNames[:doc.UndoCount - undo]
     faired = np.array(obj.Poles).reshape(-1, 3)
     out["moved"] = float(np.abs(faired - poles).max())
+    out["report"] = obj.Proxy.live.last_fair  # (what the report view's line says)
     out["held_moved"] = float(np.abs(faired[[0, 7, 56, 63]] - poles[[0, 7, 56, 63]]).max())
     shown = obj.Shape.Faces[0].Surface.getPoles()
     out["change"] = max(abs(shown[i][j].z - faired[i * 8 + j][2]) for i in range(8) for j in range(8))
@@ -68,6 +69,9 @@ def test_fair_command_is_one_undo_step_shown_at_once(tmp_path):
     assert out["active"]
     assert out["undo_names"] == ["Fair"]
     assert out["moved"] > 0.05 and out["held_moved"] == 0.0
+    # it says what it moved: the poles (exactly the move made) and the peak curvature, which fell
+    assert out["report"]["moved_mm"] == out["moved"]
+    assert out["report"]["peak_curvature_after"] < out["report"]["peak_curvature_before"]
     assert out["change"] < 1e-9  # the face shows the faired poles at once
     assert out["undone"] == 0.0
     import matplotlib.image as mpimg

@@ -80,25 +80,29 @@ def zebra_colours(mesh: np.ndarray, view_direction: np.ndarray, stripes: float =
 
 
 def curvature_combs(mesh: np.ndarray, curv: np.ndarray, every: int = 4, scale: float | None = None,
-                    gain: float = 1.0) -> tuple[np.ndarray, float]:
+                    gain: float = 1.0) -> tuple[np.ndarray, np.ndarray, float]:
     """Curvature combs along the u and v iso-lines (every `every`-th line): for each mesh point on
     those lines a tooth from the point along the normal, of length scale * normal curvature along the
-    line. Returns segments (n, 2, 3) and the scale used (mm per 1/mm): ``scale``, else one that makes
-    the longest tooth ``gain`` tenths of the patch size."""
+    line, and the envelope joining each line's tips (what a designer reads the curvature's flow
+    from: teeth alone read as a fence). Returns the teeth (n, 2, 3), the envelope's segments
+    (m, 2, 3) and the scale used (mm per 1/mm): ``scale``, else one that makes the longest tooth
+    ``gain`` tenths of the patch size."""
     n = vertex_normals(mesh)
     g, h = mesh.shape[:2]
     size = float(np.linalg.norm(mesh.reshape(-1, 3).max(0) - mesh.reshape(-1, 3).min(0)))
     k_max = float(np.abs(curv[..., :2]).max()) if curv.size else 0.0
     if scale is None:
         scale = 0.1 * gain * size / k_max if k_max > 0 else 0.0
-    segs = []
-    for i in range(0, g, every):  # iso-u lines: curvature along v
-        tip = mesh[i] + n[i] * (scale * curv[i, :, 1])[:, None]
-        segs.append(np.stack([mesh[i], tip], axis=1))
-    for j in range(0, h, every):  # iso-v lines: curvature along u
-        tip = mesh[:, j] + n[:, j] * (scale * curv[:, j, 0])[:, None]
-        segs.append(np.stack([mesh[:, j], tip], axis=1))
-    return (np.concatenate(segs) if segs else np.zeros((0, 2, 3))), scale
+    teeth, envelope = [], []
+    lines = [(mesh[i], n[i], curv[i, :, 1]) for i in range(0, g, every)]  # iso-u lines: curvature along v
+    lines += [(mesh[:, j], n[:, j], curv[:, j, 0]) for j in range(0, h, every)]  # iso-v: along u
+    for points, normals, kappa in lines:
+        tips = points + normals * (scale * kappa)[:, None]
+        teeth.append(np.stack([points, tips], axis=1))
+        envelope.append(np.stack([tips[:-1], tips[1:]], axis=1))
+    if not teeth:
+        return np.zeros((0, 2, 3)), np.zeros((0, 2, 3)), scale
+    return np.concatenate(teeth), np.concatenate(envelope), scale
 
 
 def map_colours(values: np.ndarray, shape: tuple[int, int]) -> tuple[np.ndarray, tuple[float, float]]:

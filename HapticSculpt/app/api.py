@@ -376,7 +376,7 @@ def fair_weights(mesh: np.ndarray, region: Any = None) -> np.ndarray:
     return weights
 
 
-def fair(obj: Any, region: Any = None, strength: float = 10.0) -> None:
+def fair(obj: Any, region: Any = None, strength: float = 10.0) -> dict[str, float]:
     """Relaxes the curvature variation of the sculpt's shape (Fair): where ``region`` (None: the
     whole surface; else ``(centre, radius)`` in the sculpt's coordinates, weighted smoothly to
     zero at the rim) the poles balance the change of curvature (third differences of the mesh,
@@ -386,17 +386,29 @@ def fair(obj: Any, region: Any = None, strength: float = 10.0) -> None:
     symmetry hold exactly (penalty constraints are not part of it: they act again at the next step).
     A clay sculpt keeps the faired shape (it becomes its rest shape); an elastic one springs back
     toward its rest shape when it is next stepped, as after a stroke. One undo step; a running
-    session takes the faired shape at once, at rest."""
+    session takes the faired shape at once, at rest.
+
+    Returns what it changed: ``moved_mm`` (the largest pole move) and the largest principal
+    curvature on the mesh before and after (``peak_curvature_before``/``_after``, 1/mm), also kept
+    as ``obj.Proxy.live.last_fair`` (the GUI's report line; a session commits the change later)."""
     obj = _sculpt(obj, solids=True)
     strength = _finite(strength, "strength", nonnegative=True)
     weights = fair_weights(obj.Proxy.live.snapshot().mesh, region)  # validated before the document changes
 
-    def change(s: core.DynamicSurface) -> None:
+    def peak(s: core.DynamicSurface) -> float:
+        return float(np.nanmax(np.abs(np.asarray(s.curvature_grid())[..., 2:4]), initial=0.0))
+
+    def change(s: core.DynamicSurface) -> dict[str, float]:
+        poles, before = np.array(s.poles, float), peak(s)
         s.fair(weights, strength)
         if s.plasticity[0]:
             s.relax()
+        return {"moved_mm": float(np.abs(np.asarray(s.poles) - poles).max(initial=0.0)),
+                "peak_curvature_before": before, "peak_curvature_after": peak(s)}
 
-    obj.Proxy.live.edit(change, "Fair", new_shape=True)
+    report = obj.Proxy.live.edit(change, "Fair", new_shape=True)
+    obj.Proxy.live.last_fair = report
+    return report
 
 
 def set_curvature_target(obj: Any, u: float | None = None, v: float | None = None) -> None:

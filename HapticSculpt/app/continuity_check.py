@@ -42,6 +42,49 @@ def level(profile: face_in_solid.EdgeProfile) -> str:
     return "G2"
 
 
+#: The levels in order, weakest first (what :func:`sample_levels` numbers them by).
+LEVELS = ("none", "G0", "G1", "G2")
+
+
+def sample_levels(profile: face_in_solid.EdgeProfile) -> np.ndarray:
+    """The level at each of the profile's samples (indices into :data:`LEVELS`), as :func:`level`
+    judges the whole edge: where a seam is G2 in its middle and only G1 toward its ends, the
+    samples say so (the edge's level is its worst point)."""
+    n = len(profile.points)
+    if profile.held is not None or len(profile.sides) < 2:
+        return np.full(n, LEVELS.index(level(profile)), int)
+    if profile.g0_mm > G0_MM:
+        return np.zeros(n, int)
+    (na, ka), (nb, kb) = profile.sides
+    cosine = np.clip(np.einsum("ij,ij->i", na, nb), -1.0, 1.0)
+    tangent = np.degrees(np.arccos(cosine)) <= G1_DEG
+    scale = np.maximum(np.maximum(np.abs(ka), np.abs(kb)), profile.floor)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        curvature = 100.0 * np.abs(ka - kb) / scale <= G2_PCT
+    return np.where(tangent, np.where(curvature, 3, 2), 1)
+
+
+def shares(found: list[face_in_solid.EdgeProfile], kinds: dict[str, str]) -> list[dict[str, Any]]:
+    """For each edge with two sides held G1 or more (``kinds``: its hold; a seam's, as the Boundary
+    says), the share of its length that meets that hold (G3 judged as G2): ``{"edge", "kind",
+    "share"}`` (0..1), the least first."""
+    out = []
+    for p in found:
+        kind = kinds.get(p.edge)
+        if len(p.sides) < 2 or kind not in ("G1", "G2", "G3"):
+            continue
+        target = LEVELS.index(min(kind, "G2"))
+        out.append({"edge": p.edge, "kind": LEVELS[target], "share": float(np.mean(sample_levels(p) >= target))})
+    return sorted(out, key=lambda r: (r["share"], int(r["edge"][4:]) if r["edge"][4:].isdigit() else 0))
+
+
+def holds(sculpt: Any) -> dict[str, str]:
+    """How the edges and seams of the sculpt's SculptedSolid are held (its Boundary), {} for a
+    sculpt on its own (its held edges hold by construction)."""
+    solid = solid_of(sculpt)
+    return boundary_of(solid) if solid is not None else {}
+
+
 def profiles(sculpt: Any, state: Any = None) -> list[face_in_solid.EdgeProfile]:
     """The profiles of the sculpt (a Sculpt; its SculptedSolid's edges if it is the face of one),
     with the poles of ``state`` (a SculptState: a session's newest frame) or the stored ones."""

@@ -244,10 +244,13 @@ def _order(edges_of: dict[str, list[face_in_solid.FaceEdge]],
             raise ValueError(f"faces: {f} shares no edge with the other faces ({', '.join(x for x in faces if x != f)})")
         if len(ns) > 2:
             raise ValueError(f"faces: {f} borders {len(ns)} of the others; faces are sculpted together in a row "
-                             f"(each next to at most two)")
+                             f"(each next to at most two). Sculpt {f} alone: its edges are then held as the part "
+                             f"meets the others (tangent where it is tangent)")
     ends = [f for f, ns in neighbours.items() if len(ns) == 1]
     if len(ends) != 2:
-        raise ValueError("faces: they close into a ring; faces are sculpted together in an open row")
+        raise ValueError(f"faces: {', '.join(faces)} close into a ring; faces are sculpted together in an open row. "
+                         f"Leave one of them out, or sculpt one alone: its edges are then held as the part meets "
+                         f"the others")
     order = [ends[0]]
     while len(order) < len(faces):
         order.append(next(n for n in neighbours[order[-1]] if n not in order))
@@ -301,7 +304,8 @@ def chain_of(shape: Any, faces: Sequence[str]) -> FaceChain:
         sides = list(want)
         if len(sides) == 2 and sides[0][0] != sides[1][0]:
             raise ValueError(f"faces: {f} meets its neighbours on two adjacent sides ({prev}, {nxt}), not opposite "
-                             f"ones; the faces cannot be joined into one surface")
+                             f"ones; the faces cannot be joined into one surface. Sculpt {f} alone: its edges are "
+                             f"then held as the part meets the others")
         side, target = sides[0], want[sides[0]]
         swap = side[0] == "v"
         reverse_u = (side[1] != target[1])
@@ -337,7 +341,8 @@ def _match_v(before: Placement, after: Placement, nfaces: dict[str, Any], v_rang
             return candidate
         gaps.append(gap)
     raise ValueError(f"faces: {before.face} and {after.face} are not parameterised alike along {edge} (their points "
-                     f"at the same parameter are {min(gaps):.3g} mm apart); they cannot be joined into one surface")
+                     f"at the same parameter are {min(gaps):.3g} mm apart); they cannot be joined into one surface. "
+                     f"Sculpt {before.face} alone: its edges are then held as the part meets the others")
 
 
 # --- the joined surface -----------------------------------------------------------------------------

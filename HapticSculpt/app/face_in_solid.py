@@ -184,14 +184,23 @@ def held_poles(knots_u: np.ndarray, knots_v: np.ndarray, degree: tuple[int, int]
     nv = controls[1]
     p, q = degree
     held: set[int] = set()
+    found: dict[tuple[int, float, int], frozenset[int]] = {}  # (an edge on a side: one of u, v the same throughout)
+
+    def active(direction: int, x: float, order: int) -> frozenset[int]:
+        key = (direction, x, order)
+        if key not in found:
+            found[key] = frozenset(_active(knots_v if direction else knots_u, q if direction else p, x, order))
+        return found[key]
+
     for e in edges:
         kind = kinds[e.name]
         if kind == "free":
             continue
         order = KINDS.index(kind) - 1
+        pairs: set[tuple[frozenset[int], frozenset[int]]] = set()
         for u, v in e.uv:
-            iu = _active(knots_u, p, float(u), order)
-            jv = _active(knots_v, q, float(v), order)
+            pairs.add((active(0, float(u), order), active(1, float(v), order)))
+        for iu, jv in pairs:
             held.update(i * nv + j for i in iu for j in jv)
     return sorted(held)
 
@@ -399,6 +408,7 @@ class EdgeProfile:
     g1_deg_sides: float | None = None
     held: str | None = None
     base_deg: float | None = None  # the largest angle between the sides' normals as the base has them
+    floor: float = 0.0  # |kappa| below it counts as it in g2_pct (see curvature_jump_pct)
 
 
 def _angle_between(a: np.ndarray, b: np.ndarray) -> float:
@@ -448,7 +458,7 @@ def edge_profiles(surface: Any, shape: Any, face_name: str, kinds: dict[str, str
             if kinds.get(name) in TANGENT:
                 g1 = max(g1 or 0.0, _angle_between(normals, was))
             sampled.append((occ, uv, ts, points, tangents, derivatives, normals, values, was))
-        profile = EdgeProfile(name, sampled[0][7], [], g0, g1, None)
+        profile = EdgeProfile(name, sampled[0][7], [], g0, g1, None, floor=floor)
         edge = shape.getElement(name)
         if not edge.Degenerated:
             occ, uv, ts, points, tangents, derivatives, normals, _, was = sampled[0]
@@ -504,4 +514,4 @@ def seam_profile(surfaces: dict[str, Any], shape: Any, faces: tuple[str, str], e
     between = _angle_between(sides[0][0], sides[1][0])
     return EdgeProfile(edge, values[0], sides, gap, between if kind in TANGENT else None,
                        curvature_jump_pct(sides[0][1], sides[1][1], _curvature_floor(shape)), between,
-                       base_deg=_angle_between(bases[0], bases[1]))
+                       base_deg=_angle_between(bases[0], bases[1]), floor=_curvature_floor(shape))

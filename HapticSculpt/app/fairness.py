@@ -132,3 +132,13 @@ def central_sections(centre: tuple[float, float], spread: float = 0.05, diagonal
             ahead = min((ub - cu) if su > 0 else (cu - ua), (vb - cv) if sv > 0 else (cv - va))
             out.append(((cu - su * back, cv - sv * back), (cu + su * ahead, cv + sv * ahead)))
     return out
+
+
+def fair_text(report: dict[str, float]) -> str:
+    """A Fair's report (api.fair) as the report view says it: how far the poles moved and how the
+    peak curvature changed, or that nothing moved."""
+    moved = report["moved_mm"]
+    before, after = report["peak_curvature_before"], report["peak_curvature_after"]
+    if moved < 1e-9:
+        return "nothing moved (it was fair already)"
+    return f"poles moved up to {moved:.2g} mm, peak curvature {before:.3g} -> {after:.3g} 1/mm"

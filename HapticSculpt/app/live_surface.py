@@ -75,6 +75,8 @@ class LiveSurface:
         self._head: sculpt_state.SculptState | None = None
         #: True while this object writes the document properties (their change is no news then)
         self.writing = False
+        #: What the last Fair changed (api.fair's report), for the GUI's report line
+        self.last_fair: dict[str, float] | None = None
 
     # --- who owns the surface ---------------------------------------------------------------------
     @property

@@ -158,6 +158,16 @@ def boundary_of(obj: Any) -> dict[str, str]:
     return json.loads(obj.Boundary) if obj.Boundary else {}
 
 
+def held_by_kind(kinds: dict[str, str]) -> str:
+    """Edges grouped by how they are held, strongest first: "G1 Edge2, Edge5; G0 Edge1"."""
+    groups = []
+    for kind in ("G3", "G2", "G1", "G0", "free"):
+        names = sorted((e for e, k in kinds.items() if k == kind), key=lambda e: int(e[4:]))
+        if names:
+            groups.append(f"{kind} {', '.join(names)}")
+    return "; ".join(groups)
+
+
 def seam_report_of(obj: Any) -> list[dict[str, Any]]:
     """The parsed ``SeamReport``."""
     return json.loads(obj.SeamReport) if obj.SeamReport else []

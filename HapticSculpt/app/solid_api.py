@@ -9,7 +9,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from .. import core
-from . import curve_api, face_chain, face_in_solid, face_symmetry, sculpt_state
+from . import base_continuity, curve_api, face_chain, face_in_solid, face_symmetry, sculpt_state
 from .api import _add_sculpt, _checked_resolution, _document, _material, _sculpt_state
 from .source_surface import SourceSurface
 from .face_net import TRIM_SPANS, Mirror, face_held, face_source, g2_net, mirror_of, seam_kinds, seam_links
@@ -27,25 +27,32 @@ from .sculpted_solid import (
 from .undo import transaction
 
 
-def _boundary_kinds(boundary: Any, edges: list[face_in_solid.FaceEdge], faces: Sequence[str]) -> dict[str, str]:
-    """Every edge of the faces to "free" or "G0" to "G3" (G0 where ``boundary`` does not say)."""
+def _boundary_kinds(boundary: Any, edges: list[face_in_solid.FaceEdge], faces: Sequence[str],
+                    shape: Any, seams: frozenset[str]) -> dict[str, str]:
+    """Every edge of the faces to "free" or "G0" to "G3": as ``boundary`` says, and where it says
+    "base" (or a dict does not say), as the base meets its neighbour there (base_continuity; the
+    seams in ``seams`` then G0 here: :func:`face_net.seam_kinds` judges them on the net)."""
     names = [e.name for e in edges]
+    allowed = (*face_in_solid.KINDS, base_continuity.AS_BASE)
     if isinstance(boundary, str):
-        if boundary not in face_in_solid.KINDS:
-            raise ValueError(f"boundary: one of {', '.join(face_in_solid.KINDS)}, not {boundary!r}")
+        if boundary not in allowed:
+            raise ValueError(f"boundary: one of {', '.join(allowed)}, not {boundary!r}")
         kinds = {n: boundary for n in names}
     elif isinstance(boundary, dict):
-        kinds = {n: "G0" for n in names}
+        kinds = {n: base_continuity.AS_BASE for n in names}
         for edge, kind in boundary.items():
             if edge not in names:
                 raise ValueError(f"boundary: {edge!r} is not an edge of {', '.join(faces)} "
                                  f"(their edges: {', '.join(names)})")
-            if kind not in face_in_solid.KINDS:
-                raise ValueError(f"boundary: {edge} must be one of {', '.join(face_in_solid.KINDS)}, not {kind!r}")
+            if kind not in allowed:
+                raise ValueError(f"boundary: {edge} must be one of {', '.join(allowed)}, not {kind!r}")
             kinds[edge] = kind
     else:
-        raise TypeError(f"boundary: one of {', '.join(face_in_solid.KINDS)} or a dict from edge name to one "
+        raise TypeError(f"boundary: one of {', '.join(allowed)} or a dict from edge name to one "
                         f"of them, not {boundary!r}")
+    if base_continuity.AS_BASE in kinds.values():
+        base = base_continuity.base_kinds(shape, faces, seams)
+        kinds = {n: (base.get(n, "G0") if k == base_continuity.AS_BASE else k) for n, k in kinds.items()}
     for e in edges:
         if kinds[e.name] == "free" and not set(e.neighbours) <= set(faces):
             what = "the seam of " + e.neighbours[0] if e.neighbours == (faces[0],) else \
@@ -118,7 +125,7 @@ def free_inside(made: Any, held: list[int], links: list[Any], shape: Any, faces:
     return free, inside
 
 
-def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0", symmetry: Any = None,
+def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "base", symmetry: Any = None,
                  controls: tuple[int, int] = (8, 8), degree: tuple[int, int] = (3, 3),
                  mesh: tuple[int, int] = (40, 40), name: str = "SculptedSolid", material: str = "clay") -> Any:
     """A new SculptedSolid in ``doc``: ``base``'s solid with ``faces`` (names like ``["Face6"]``)
@@ -132,8 +139,11 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
     ``boundary``: how the faces' edges are held while sculpting, "G0" (they stay where they are, so
     the neighbour faces still meet them: the poles that shape the surface along them do not move),
     "G1" (their tangent planes too), "G2" (the curvature across them too: the neighbour face meets
-    the sculpted one as it met the base, to second order), "G3" (that curvature's rate too) or
-    "free", for all edges or as a dict from edge name ("Edge3") to one of them, G0 for the others. A free edge must not border a face that is not sculpted (it
+    the sculpted one as it met the base, to second order), "G3" (that curvature's rate too),
+    "free", or "base" (the default): each edge as the base meets its neighbour there, G2 where
+    curvature-continuous, G1 where tangent, G0 at a crease (base_continuity), so a sculpted top
+    stays tangent to its rounds. One kind for all edges, or a dict from edge name ("Edge3") to one
+    of them, "base" for the others. A free edge must not border a face that is not sculpted (it
     would open the solid). A seam between two of the faces is G1 where they meet tangentially and
     G0 (a crease that may move) where they meet at an angle, unless the dict says otherwise.
     ``controls``/``degree`` are the least net per face (each face is converted exactly, then
@@ -174,7 +184,7 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
         controls, mesh = (controls[0] * len(faces), controls[1]), (mesh[0] * len(faces), mesh[1])
     edges = chain.edges(shape)
     seams = chain.seam_edges()
-    kinds = _boundary_kinds(boundary, edges + _seam_edges(chain), faces)
+    kinds = _boundary_kinds(boundary, edges + _seam_edges(chain), faces, shape, frozenset(seams))
     mirror = None
     if symmetry is not None:
         point, normal = face_symmetry.plane_of(symmetry, doc)
@@ -219,6 +229,27 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "G0"
     return obj
 
 
+def _rehold_as_base(obj: Any, made: Any, edges: list[face_in_solid.FaceEdge], kinds: dict[str, str]) -> Any:
+    """``made`` with the poles that ``kinds`` holds and the current holds did not put back where the
+    base net has them: an edge held G1 after strokes with it held G0 meets its neighbour
+    tangentially again, as the base did, instead of keeping the kink the strokes made."""
+    s = made.surface
+    source = np.asarray(obj.SourcePoles, float)
+    poles = np.asarray(s.poles, float)
+    if source.size != poles.size:
+        return made
+    mirror = mirror_of(obj)
+    before = set(face_held(made, edges, {**{e.name: "G0" for e in edges}, **boundary_of(obj)}, mirror))
+    newly = [i for i in face_held(made, edges, kinds, mirror) if i not in before]
+    if not newly:
+        return made
+    flat = poles.reshape(-1, 3).copy()
+    flat[newly] = source.reshape(-1, 3)[newly]
+    return SourceSurface(core.BSplineSurface(flat.reshape(poles.shape), tuple(s.degree), list(s.knots_u),
+                                             list(s.knots_v), None if s.weights is None else np.asarray(s.weights)),
+                         made.method, made.error, made.description)
+
+
 def _boundary_plan(obj: Any, boundary: Any) -> tuple[dict[str, str], Any, list[int], list[Any], list[Any]]:
     """What :func:`set_boundary` would hold: every edge's kind, the net (its G2 seams made
     curvature-continuous), the held poles, the seams' links and the walls (ValueError where it
@@ -231,8 +262,8 @@ def _boundary_plan(obj: Any, boundary: Any) -> tuple[dict[str, str], Any, list[i
     edges = chain.edges(shape)
     if isinstance(boundary, dict):
         boundary = {**boundary_of(obj), **boundary}
-    kinds = _boundary_kinds(boundary, edges + _seam_edges(chain), faces)
-    made = _made_of(sculpt_of(obj))
+    kinds = _boundary_kinds(boundary, edges + _seam_edges(chain), faces, shape, frozenset(chain.seam_edges()))
+    made = _rehold_as_base(obj, _made_of(sculpt_of(obj)), edges, kinds)
     if isinstance(boundary, str):  # (a seam is as tangent as its faces let it be)
         kinds = seam_kinds(made, chain, kinds, set())
     made, held, links = _holds(made, chain, edges, kinds, mirror_of(obj), ", ".join(faces))
@@ -310,3 +341,39 @@ def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
         obj.Boundary = json.dumps(kinds)
         rebuild(obj)
     return kinds
+
+
+def next_holds(obj: Any, edges: Sequence[str] = ()) -> dict[str, str]:
+    """What Hold edges does next to a SculptedSolid, as a ``set_boundary`` dict: with ``edges``
+    (base edge names: the designer's pick) those edges go one step further, G0 -> G1 -> G2 -> G3
+    -> G0 (a seam between sculpted faces stops at G2), from the weakest of them; with none, every
+    outer edge goes around "base" (as the part meets its other faces there) -> G0 -> ... -> G3.
+    Seams and edges not picked keep what they hold. Steps the net cannot hold are skipped; {} if
+    none can."""
+    shape = base_solid(obj.Base)
+    chain = chain_of_solid(obj, shape)
+    seams = chain.seam_edges()
+    kinds = boundary_of(obj)
+    unknown = [e for e in edges if e not in kinds]
+    if unknown:
+        raise ValueError(f"{obj.Label}: {', '.join(unknown)} is not an edge of its sculpted faces")
+    if edges:
+        cycle = ["G0", "G1", "G2"] + ([] if set(edges) & seams else ["G3"])
+        now = min(cycle.index(kinds[e]) if kinds[e] in cycle else 0 for e in edges)
+        plans = [{e: kind for e in edges} for kind in cycle[now + 1:] + cycle[:now + 1]]
+    else:
+        # the distinct states of the outer edges: as the part has them, then each kind for all
+        # (where the part's is one of those, it is that one: G0 to G3 then go round in turn)
+        outer = [e for e in kinds if e not in seams]
+        as_base = _boundary_kinds(base_continuity.AS_BASE, chain.edges(shape), list(obj.SculptFaces), shape,
+                                  frozenset(seams))
+        states = [{e: as_base[e] for e in outer}] + [{e: kind for e in outer} for kind in ("G0", "G1", "G2", "G3")]
+        if states[0] in states[1:]:
+            states.pop(0)
+        current = {e: kinds[e] for e in outer}
+        now = states.index(current) if current in states else len(states) - 1
+        plans = states[now + 1:] + states[:now]
+    for plan in plans:
+        if can_hold(obj, plan):
+            return plan
+    return {}

@@ -165,15 +165,16 @@ class SculptFace:
 
     def GetResources(self) -> dict[str, str]:
         return {"Pixmap": icon("SculptFace"), "MenuText": "Sculpt selected face",
-                "ToolTip": "Sculpt the selected faces: in place in their solid (edges held G0, holes kept, faces "
-                           "in a row sculpted as one, tangent seams held G1; Hold edges switches G0/G1; select a "
+                "ToolTip": "Sculpt the selected faces: in place in their solid (each edge held as the part meets "
+                           "its other face there: G1 where tangent, G2 where curvature-continuous, G0 at a crease; "
+                           "holes kept, faces in a row sculpted as one; Hold edges changes the holds; select a "
                            "plane too for a mirror-symmetric sculpt), or one face as a separate B-spline patch"}
 
     def IsActive(self) -> bool:
         return _face_selection() is not None
 
     def Activated(self) -> None:
-        from ..app.sculpted_solid import boundary_of, chain_of_solid
+        from ..app.sculpted_solid import boundary_of, chain_of_solid, held_by_kind
         from .echo import ref, run_echoed
         picked = _face_selection()
         if picked is None:
@@ -185,9 +186,12 @@ class SculptFace:
             run_echoed(f"HapticSculpt.sculpt_solid(App.getDocument({doc.Name!r}), {ref(base)}, {faces!r}{mirror})")
             obj = doc.Objects[-1]
             kinds = boundary_of(obj)
-            seams = [f"{e} {kinds[e]}" for e in sorted(chain_of_solid(obj).seam_edges())]
+            seam_names = chain_of_solid(obj).seam_edges()
+            seams = [f"{e} {kinds[e]}" for e in sorted(seam_names, key=lambda e: int(e[4:]))]
+            outer = {e: k for e, k in kinds.items() if e not in seam_names}
             FreeCAD.Console.PrintMessage(
-                f"HapticSculpt: {obj.Label}: {', '.join(faces)} of {base.Label} sculpted in place, edges held G0"
+                f"HapticSculpt: {obj.Label}: {', '.join(faces)} of {base.Label} sculpted in place, edges held as "
+                f"the part meets its other faces there ({held_by_kind(outer)})"
                 + (f", mirrored in {plane.Label}" if plane is not None else "")
                 + (f", seams {', '.join(seams)}" if seams else "") + "\n")
             # The picked faces are gone with the base, hidden under the new solid: nothing stays
@@ -338,13 +342,14 @@ class Fair(_SculptCommand):
            "linked poles and its symmetry hold; one undo step")
 
     def Activated(self) -> None:
+        from ..app.fairness import fair_text
         from .echo import ref, run_echoed
         obj = _ctl().active_sculpt()
-        before = obj.Proxy.live.stored().arrays["Poles"]
+        obj.Proxy.live.last_fair = None
         run_echoed(f"HapticSculpt.fair({ref(obj)})")
-        moved = float(np.abs(obj.Proxy.live.stored().arrays["Poles"] - before).max(initial=0.0))
-        FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label} faired: poles moved up to {moved:.2g} mm"
-                                     + (" (it was fair already)" if moved < 1e-6 else "") + "\n")
+        report = obj.Proxy.live.last_fair
+        if report is not None:
+            FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label} faired: {fair_text(report)}\n")
 
 
 class HoldEdges(_SculptCommand):
@@ -363,28 +368,12 @@ class HoldEdges(_SculptCommand):
 
     def Activated(self) -> None:
         from ..app.api import BOUNDARIES, boundary_poles, held_boundary
-        from ..app.sculpted_solid import boundary_of, chain_of_solid, solid_of
-        from ..app.solid_api import can_hold
+        from ..app.sculpted_solid import solid_of
         from .echo import ref, run_echoed
         obj = _ctl().active_sculpt()
         solid = solid_of(obj)
-        if solid is not None:  # (the seams between its faces stay as tangent as they can)
-            seams = chain_of_solid(solid).seam_edges()
-            outer = {v for k, v in boundary_of(solid).items() if k not in seams}
-            cycle = BOUNDARIES[1:]  # (a solid's edges are never free: that would open it)
-            only = next(iter(outer)) if len(outer) == 1 else None
-            now = cycle.index(only) if only in cycle else -1
-            if obj.Proxy.live.session is not None:
-                FreeCAD.Console.PrintWarning(f"HapticSculpt: {solid.Label}: stop the sculpting session to change how "
-                                             "its edges are held\n")
-                return
-            following = next((k for k in cycle[now + 1:] + cycle[:now + 1] if can_hold(solid, k)), "G0")
-            try:
-                run_echoed(f"HapticSculpt.set_boundary({ref(solid)}, {following!r})")
-            except Exception as exc:  # noqa: BLE001 - doCommand raises what the call raised
-                FreeCAD.Console.PrintWarning(f"HapticSculpt: {solid.Label}: {exc}\n")
-                return
-            FreeCAD.Console.PrintMessage(f"HapticSculpt: {solid.Label}: edges held {following}\n")
+        if solid is not None:
+            _hold_solid_edges(solid)
             return
         now = set(held_boundary(obj).values())
         current = BOUNDARIES.index(now.pop()) if len(now) == 1 else 0
@@ -403,6 +392,38 @@ class HoldEdges(_SculptCommand):
             FreeCAD.Console.PrintWarning(f"HapticSculpt: {obj.Label}: {exc}\n")
             return
         FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label}: edges {following}\n")
+
+
+def _hold_solid_edges(solid: Any) -> None:
+    """Hold edges on a SculptedSolid: the edges and seams of it the designer picked go one step
+    further (all its outer edges when none is picked), through set_boundary, echoed; the report
+    view says what each now holds, or in one line why nothing changed."""
+    from ..app.edge_pick import base_edge_names
+    from ..app.sculpted_solid import boundary_of, chain_of_solid, held_by_kind
+    from ..app.solid_api import next_holds
+    from .echo import ref, run_echoed
+    if solid.Sculpts[0].Proxy.live.session is not None:
+        FreeCAD.Console.PrintWarning(f"HapticSculpt: {solid.Label}: stop the sculpting session to change how "
+                                     "its edges are held\n")
+        return
+    picked = [n for s in Gui.Selection.getSelectionEx() if s.Object == solid
+              for n in s.SubElementNames if n.startswith("Edge")]
+    try:
+        edges = base_edge_names(solid, picked) if picked else []
+        plan = next_holds(solid, edges)
+        if not plan:
+            FreeCAD.Console.PrintWarning(f"HapticSculpt: {solid.Label}: {', '.join(edges) or 'its edges'} cannot be "
+                                         "held any other way on this net\n")
+            return
+        run_echoed(f"HapticSculpt.set_boundary({ref(solid)}, {plan!r})")
+    except (ValueError, RuntimeError) as exc:  # (doCommand raises what the call raised)
+        FreeCAD.Console.PrintWarning(f"HapticSculpt: {solid.Label}: {exc}\n")
+        return
+    kinds = boundary_of(solid)
+    seams = chain_of_solid(solid).seam_edges()
+    what = ", ".join(f"{'seam ' if e in seams else ''}{e} held {kinds[e]}" for e in plan) if edges else \
+        f"edges held {held_by_kind({e: kinds[e] for e in plan})}"
+    FreeCAD.Console.PrintMessage(f"HapticSculpt: {solid.Label}: {what}\n")
 
 
 def _curve_selection() -> tuple[Any, str, Any, str] | None:
@@ -854,6 +875,35 @@ class Group:
         return any(COMMANDS[name]().IsActive() for name in self.commands)
 
 
+def refuse(what: str, exc: BaseException) -> None:
+    """A refusal as a designer reads it: one plain line in the report view, and in the HUD of a
+    running session (never a traceback: the message says what to do)."""
+    text = f"{what}: {exc}"
+    FreeCAD.Console.PrintWarning(f"HapticSculpt: {text}\n")
+    ctl = _ctl()
+    if ctl.session is not None:
+        for overlay in ctl.overlays_of(ctl.session.obj):
+            overlay.refusal(text)
+
+
+def _refusals_said_plainly(command: type) -> type:
+    """``command`` whose Activated reports what the scripting API refused (ValueError, TypeError,
+    RuntimeError: the API's refusals, each saying why) through :func:`refuse`; anything else is a
+    bug and still shows as one."""
+    activated = getattr(command, "Activated", None)
+    if activated is None or getattr(activated, "said_plainly", False):
+        return command
+
+    def run(self: Any) -> None:
+        try:
+            activated(self)
+        except (ValueError, TypeError, RuntimeError) as exc:
+            refuse(self.GetResources()["MenuText"], exc)
+    run.__doc__, run.said_plainly = activated.__doc__, True  # type: ignore[attr-defined]
+    command.Activated = run
+    return command
+
+
 COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_NewClampedPatch": NewClampedPatch,
             "HapticSculpt_SculptFace": SculptFace, "HapticSculpt_Session": Session,
             "HapticSculpt_Material": Material, "HapticSculpt_KeepShape": KeepShape,
@@ -871,3 +921,4 @@ COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_NewClampedPatch": N
             "HapticSculpt_ZebraDirection": ZebraDirection,
             "HapticSculpt_CombDensity": CombDensity, "HapticSculpt_CombScale": CombScale,
             "HapticSculpt_Panel": Panel, "HapticSculpt_Thicken": Thicken, "HapticSculpt_ExportStep": ExportStep}
+COMMANDS = {name: _refusals_said_plainly(command) for name, command in COMMANDS.items()}

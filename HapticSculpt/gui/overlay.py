@@ -38,6 +38,8 @@ SCAN_REMEASURE_S = 0.5
 JACK_COLOURS = {"point": (1.0, 0.0, 0.0), "tangent": (1.0, 0.5, 0.0), "normal": (0.0, 0.3, 1.0), "curvature": (1.0, 1.0, 1.0)}
 #: Curves the surface follows, drawn on it: G0 (through) and G1 (with its normal).
 CURVE_COLOURS = {"G0": (0.0, 0.9, 1.0), "G1": (1.0, 0.6, 0.0)}
+#: How long the HUD shows what a command refused (s).
+REFUSAL_SHOWN_S = 8.0
 #: The continuity check's combs, by what holds across the edge.
 CONTINUITY_COLOURS = {"G2": (0.1, 0.85, 0.2), "G1": (1.0, 0.9, 0.0), "G0": (1.0, 0.45, 0.0), "none": (1.0, 0.0, 0.0)}
 
@@ -69,6 +71,7 @@ class Overlay:
         self.stripe_mode = "reflection"  # zebra: "reflection" (view-dependent) or "isophote" (world-fixed)
         self.stripes = 12.0  # zebra: bands over a half turn
         self.status_text = ""  # the HUD's status line, as last drawn
+        self._refusal: tuple[str, float] | None = None  # (what was refused, when): shown a while
         self.stripe_direction = (0.0, 0.0, 1.0)  # isophote: the direction the bands' angle is taken to
         self.stripe_angle = 0.0  # reflection: the light strips' angle from the view's up direction (degrees)
         self.per_pixel = True  # zebra per pixel where the driver runs GLSL (False: per mesh vertex)
@@ -163,6 +166,11 @@ class Overlay:
         self.surface_drawn = False
         if self.hud is not None:
             self.hud.clear()
+
+    def refusal(self, text: str) -> None:
+        """Shows what a command refused in the HUD's status line for REFUSAL_SHOWN_S (a session's
+        designer has the device in hand, not the report view in sight)."""
+        self._refusal = (text, time.monotonic())  # (a session draws each frame: no redraw to ask for)
 
     def alive(self) -> bool:
         """False once its view is closed or its object deleted."""
@@ -298,9 +306,10 @@ class Overlay:
         decor = coin.SoSeparator()
         decor.addChild(light)
         if self.combs and seen:
-            segments, _ = analysis.curvature_combs(mesh, s.curvature_grid().reshape(mesh.shape[:2] + (6,)),
-                                                   every=self.comb_every, gain=self.comb_gain)
-            decor.addChild(shapes.lines(segments, (1.0, 0.0, 1.0), 1.0))
+            teeth, envelope, _ = analysis.curvature_combs(mesh, s.curvature_grid().reshape(mesh.shape[:2] + (6,)),
+                                                          every=self.comb_every, gain=self.comb_gain)
+            decor.addChild(shapes.lines(teeth, (1.0, 0.0, 1.0), 1.0))
+            decor.addChild(shapes.lines(envelope, (1.0, 0.0, 1.0), 2.0))
         if self.continuity and seen:
             decor.addChild(self._continuity_combs(s))
         if seen:
@@ -474,6 +483,11 @@ class Overlay:
             parts.append(continuity_text(self.continuity_worst))
         if self.mode:
             parts.append(self.mode)
+        if self._refusal is not None:
+            if time.monotonic() - self._refusal[1] <= REFUSAL_SHOWN_S:
+                parts.append(f"refused: {self._refusal[0]}")
+            else:
+                self._refusal = None
         return "  |  ".join(parts)
 
     def _deviation_text(self) -> str:
@@ -592,7 +606,8 @@ class Overlay:
                 found = []
             self._continuity = (key, found, now, time.perf_counter() - now)
             self.continuity_worst = {**continuity_check.worst(found), "profiles": len(found),
-                                     "levels": {p.edge: continuity_check.level(p) for p in found}}
+                                     "levels": {p.edge: continuity_check.level(p) for p in found},
+                                     "shares": continuity_check.shares(found, continuity_check.holds(self.obj))}
         found = self._continuity[1]
         sep = coin.SoSeparator()
         kappa = max((float(np.nanmax(np.abs(k))) for p in found for _, k in p.sides if np.isfinite(k).any()),
@@ -601,14 +616,20 @@ class Overlay:
         size = float(np.linalg.norm(flat.max(0) - flat.min(0))) or 1.0
         scale = 0.1 * size * self.comb_gain / kappa if kappa > 0 else 0.0
         for p in found:
-            colour = CONTINUITY_COLOURS[continuity_check.level(p)]
+            # coloured along its length by what holds at each point (a seam G2 in its middle and G1
+            # toward its ends shows both), not by its worst point alone
+            levels = continuity_check.sample_levels(p)
             for k, (normals, curvature) in enumerate(p.sides):
                 ok = np.isfinite(curvature) & np.all(np.isfinite(normals), axis=1)
-                base = p.points[ok]
+                base, at = p.points[ok], levels[ok]
                 tips = base - normals[ok] * (curvature[ok] * scale)[:, None]
-                teeth = np.stack([base, tips], axis=1)[:: 2 if k else 1]  # (the far side's: every other tooth)
+                teeth = np.stack([base, tips], axis=1)
                 outline = np.stack([tips[:-1], tips[1:]], axis=1)
-                sep.addChild(shapes.lines(np.concatenate([teeth, outline]), colour, 1.5 if k else 2.0))
+                every = np.arange(len(teeth)) % (2 if k else 1) == 0  # (the far side's: every other tooth)
+                for index, name in enumerate(continuity_check.LEVELS):
+                    segments = np.concatenate([teeth[every & (at == index)], outline[at[:-1] == index]])
+                    if len(segments):
+                        sep.addChild(shapes.lines(segments, CONTINUITY_COLOURS[name], 1.5 if k else 2.0))
         return sep
 
     def _curves_text(self) -> str:
@@ -672,6 +693,10 @@ def stroke_text(last: dict[str, float]) -> str:
     return text
 
 
+#: Edges whose share of their hold the HUD's continuity line lists (the least met first).
+SHARES_SHOWN = 4
+
+
 def continuity_text(worst: dict[str, Any]) -> str:
     """The HUD's line for the continuity check: the worst g0, g1 and g2 over the smooth edges."""
     if not worst or worst.get("g0_mm") is None:
@@ -680,8 +705,14 @@ def continuity_text(worst: dict[str, Any]) -> str:
 
     def show(value: float | None, unit: str, digits: str) -> str:
         return "-" if value is None else f"{value:{digits}}{unit}"
-    return (f"continuity: worst g0 {show(worst['g0_mm'], ' mm', '.1e')}, g1 {show(worst['g1_deg'], ' deg', '.3g')}, "
+    text = (f"continuity: worst g0 {show(worst['g0_mm'], ' mm', '.1e')}, g1 {show(worst['g1_deg'], ' deg', '.3g')}, "
             f"g2 {show(worst['g2_pct'], ' %', '.3g')} ({worst['smooth']} smooth of {worst['edges']} edges)")
+    held = worst.get("shares") or []
+    if held:  # (the least first: where a hold is met over part of an edge only, it says how much)
+        listed = [f"{r['edge']} {r['kind']} over {100 * r['share']:.0f} %" for r in held[:SHARES_SHOWN]]
+        more = len(held) - SHARES_SHOWN
+        text += "; " + ", ".join(listed) + (f" and {more} more" if more > 0 else "")
+    return text
 
 
 def _size(mesh: np.ndarray) -> float:

@@ -1,0 +1,42 @@
+"""Which edges of the base a designer picked on a SculptedSolid: FreeCAD names the rebuilt solid's
+edges in its own order, and a sculpt's holds are kept by the base's names (its Boundary). An edge
+of the sculpted faces is found by where it runs now (the continuity check's samples along every
+edge and seam as sculpted); other edges of the solid are not the sculpt's to hold."""
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import numpy as np
+
+from . import continuity_check
+from .sculpted_solid import sculpt_of
+
+#: Points of each sculpted edge compared with a picked edge (at these shares of its samples).
+PROBES = (0.1, 0.3, 0.5, 0.7, 0.9)
+
+
+def base_edge_names(solid: Any, picked: Sequence[str]) -> list[str]:
+    """The base's names of the SculptedSolid's edges ``picked`` (its own names: "Edge7"), in order;
+    ValueError naming a picked edge that is no edge or seam of the sculpted faces."""
+    import Part
+    profiles = [p for p in continuity_check.profiles(sculpt_of(solid)) if p.edge.startswith("Edge")]
+    box = solid.Shape.BoundBox
+    tolerance = 1e-6 * max(box.DiagonalLength, 1.0) + 1e-4
+    names = []
+    for sub in picked:
+        try:
+            edge = solid.Shape.getElement(sub)
+        except Exception:  # noqa: BLE001 - FreeCAD raises several types for a missing element
+            raise ValueError(f"{solid.Label} has no {sub}") from None
+        best, distance = None, np.inf
+        for p in profiles:
+            probes = p.points[[int(round(share * (len(p.points) - 1))) for share in PROBES]]
+            d = max(edge.distToShape(Part.Vertex(*q))[0] for q in probes)
+            if d < distance:
+                best, distance = p.edge, d
+        if best is None or distance > tolerance:
+            raise ValueError(f"{solid.Label}'s {sub} is not an edge of its sculpted faces "
+                             f"({', '.join(solid.SculptFaces)}): pick one of their edges or seams")
+        if best not in names:
+            names.append(best)
+    return names
