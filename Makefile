@@ -11,7 +11,7 @@ SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
 PHONY_LONG := stress fuzz bench-peers batch-replay
-.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-parts test-gui-repeat test-gui-repeat-all test-cpp test-asan test-python \
+.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-parts gui-lane test-gui-repeat test-gui-repeat-all test-cpp test-asan test-python \
         test-gui test-freecad test-addon wheel ocp-venv demo bench install install-udev install-realtime uninstall clean test-other-debians \
         wheels wheel-check check
 # What make keeps outside the checkout, so that a clean clone reuses it: the compiler cache, the
@@ -209,8 +209,18 @@ test: deps
 	rc=$$?; echo; $(PY) tools/test_times.py $(BUILD)/make-test.log; exit $$rc
 
 SUITES := $(HOST_SUITE) $(OTHER_SUITES)
-test-parts: $(foreach p,gui runner python,$(foreach s,$(SUITES),part-$(s)-$(p))) part-$(HOST_SUITE)-asan \
+# The GUI suites, the longest parts, in two lanes: the host's and then the last root's one after the
+# other (gui-lane), the other root's beside them; every other part in the third of make's slots.
+GUI_LANE   := $(HOST_SUITE) $(lastword $(SUITES))
+GUI_BESIDE := $(filter-out $(GUI_LANE),$(SUITES))
+test-parts: gui-lane $(foreach s,$(GUI_BESIDE),part-$(s)-gui) \
+  $(foreach p,runner python,$(foreach s,$(SUITES),part-$(s)-$(p))) part-$(HOST_SUITE)-asan \
   part-$(HOST_SUITE)-tsan $(foreach p,cpp demo,$(foreach s,$(SUITES),part-$(s)-$(p)))
+
+# (one make slot throughout: make queues what is ready in turn, and the last root's GUI suite, ready
+# only when the host's ended, started behind every runner and pytest queued before it, and ended last)
+gui-lane: $(foreach s,$(GUI_LANE),part-$(s)-prep)
+	@rc=0; for s in $(GUI_LANE); do $(MAKE) --no-print-directory PREPPED=1 part-$$s-gui || rc=1; done; exit $$rc
 
 # part-SUITE-PART: one part for SUITE's FreeCAD, here or in its Debian root (make test's lanes).
 PART_TARGET_prep   := build wheel ocp-venv
@@ -236,15 +246,16 @@ part-%:
 	  "GUI_PYTEST_ARGS=$(GUI_PYTEST_ARGS)" \
 	  $(if $(filter $(HOST_SUITE),$(call part_suite,$*)),,2>&1 | sed -u '/^\[$(call part_suite,$*) /!s/^/[$(call part_suite,$*)] /') \
 	  $(if $(filter prep,$(call part_name,$*)),|| { touch $(BUILD)/unprepared-$$suite; echo "[$*] failed: $$suite's parts will not run"; })
-# Each FreeCAD's parts after its prep, a root's prep after the root is there; the third FreeCAD's GUI
-# tests after the host's (two GUI suites at a time). Every other part waits for all preps: make
-# queues what is ready in turn, and a runner queued while a root's prep still ran went before that
-# root's GUI tests, which then started last and ended last.
+# Each FreeCAD's parts after its prep, a root's prep after the root is there. Every part but the GUI
+# suites waits for all preps: make queues what is ready in turn, and a runner queued while a root's
+# prep still ran went before that root's GUI tests, which then started last and ended last.
+# (PREPPED=1: gui-lane's own makes, once the preps it waited for are done)
+ifndef PREPPED
 $(foreach s,$(SUITES),$(foreach p,cpp python runner gui demo,$(eval part-$(s)-$(p): part-$(s)-prep)))
 $(foreach s,$(OTHER_SUITES),$(eval part-$(s)-prep: root-$(s)))
-part-$(lastword $(SUITES))-gui: | part-$(HOST_SUITE)-gui
 $(foreach s,$(SUITES),$(foreach p,cpp python runner demo,$(eval part-$(s)-$(p): | $(foreach t,$(SUITES),part-$(t)-prep))))
 part-$(HOST_SUITE)-asan part-$(HOST_SUITE)-tsan: | $(foreach t,$(SUITES),part-$(t)-prep)
+endif
 
 # (root-% does not run deps again: make test did, and a phony prerequisite here would let the host's
 # sanitizer builds take make's first three slots while it ran, the roots' GUI suites waiting behind.)
