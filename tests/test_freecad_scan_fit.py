@@ -109,6 +109,34 @@ class TestFitToTarget(DocumentTestCase):
         self.assertFalse(report["met"])  # (held flat edges and line against a bump that is not)
         self.assertIn("worst near", report["message"])
 
+    def test_a_fit_held_edges_block_names_them_and_their_remedy(self):
+        """The issue's clamped patch (every edge held G1) and a scanned bump, 8 exp(-r^2/1500) mm over
+        100 x 100 mm with 0.02 mm of noise: the fit falls short because the held tangent planes keep
+        the bump's skirt out of reach (free, the same net fits it all), and the report says that,
+        side by side, instead of a reason about the net; freeing them (the remedy) fits it."""
+        rng = np.random.default_rng(3)
+        x, y = np.meshgrid(np.linspace(-50, 50, 61), np.linspace(-50, 50, 61))
+        z = 8 * np.exp(-(x ** 2 + y ** 2) / 1500) + rng.normal(0, 0.02, x.shape)
+        sculpt = hs.make_sculpt(self.doc, material="clay", edges="held")
+        hs.set_target(sculpt, np.column_stack([x.ravel(), y.ravel(), z.ravel()]), tolerance=0.2)
+        report = hs.fit_to_target(sculpt, 0.1, max_controls=10)
+        self.assertFalse(report["met"])
+        self.assertAlmostEqual(float(sculpt.TargetTolerance), 0.1)  # (the tolerance asked for is the sculpt's)
+        self.assertEqual(hs.deviation_of(sculpt)["tolerance_mm"], 0.1)
+        self.assertTrue(report["message"].startswith("held edges keep"), report["message"])
+        self.assertEqual(sorted(e["edge"] for e in report["blocked_by"]), ["u0", "u1", "v0", "v1"])
+        self.assertTrue(all(e["kind"] == "G1" and e["share_pct"] > 5 for e in report["blocked_by"]), report["blocked_by"])
+        self.assertGreaterEqual(report["free_within_pct"], 95.0)
+        # what they block is what the free fit reaches and the held one does not
+        blocked = sum(e["share_pct"] for e in report["blocked_by"])
+        self.assertGreaterEqual(blocked, report["free_within_pct"] - report["within_pct"] - 1.0)
+        self.assertIs(sculpt.Proxy.live.last_fit, report)
+        self.doc.undo()  # the remedy it names (Free edges and fit): from where the fit began, edges free
+        hs.hold_boundary(sculpt, "free")
+        again = hs.fit_to_target(sculpt, 0.1, max_controls=10)
+        self.assertTrue(again["met"], again["message"])
+        self.assertEqual(again["blocked_by"], [])
+
     def test_stops_at_max_controls_and_says_where(self):
         truth = truth_surface()
         points, _ = scan_of(truth, seed=2, outliers=0.0)

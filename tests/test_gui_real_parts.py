@@ -77,7 +77,9 @@ def test_a_rounded_blocks_top_refused_kept_tangent_and_held_g2_edge_by_edge(tmp_
         assert not s["docs"][s["active"]]["solids"], "nothing was made"
         d.shot("parts_refused")
         # the top alone: its four edges held G1 (tangent to the rounds, as the part has them)
-        d.xdo("mousemove", "60", "600", "click", "1")  # (in the empty view: nothing selected)
+        size = next(v for v in d.state()["views"] if v["active"])["size"]
+        empty = d.to_screen([20, size[1] // 2])  # (the view's left edge, beside the part: nothing there)
+        d.xdo("mousemove", str(empty[0]), str(empty[1]), "click", "1")
         d.wait(lambda s: s["selection"] == [], "nothing selected")
         click_on(d, top, "Block", part["top"])
         s = d.press_button("SculptFace", lambda s: s["docs"][s["active"]]["solids"], "the SculptedSolid")

@@ -133,6 +133,8 @@ def test_a_scan_set_as_target_shows_its_deviation_and_a_stroke_reduces_it(tmp_pa
         s = d.press_button("FitToTarget", lambda s: undo(s)[0] == "Fit to target", "the fit")
         fitted = sculpt(s)["deviation"]
         assert fitted["within_pct"] >= 95.0, fitted
+        s = d.wait(lambda s: "HapticSculpt: fitted: " in (s.get("report") or ""), "the report view saying it fitted")
+        assert "not fitted" not in s["report"], s["report"][-1500:]
         fitted_picture = colours_shown(d, "scan_fitted", pulled, lambda p: share(p, within) > 2 * share(pulled, within))
         assert share(fitted_picture, within) > 2 * share(pulled, within), "the fit did not turn the patch green"
         # the display off: the scan's mesh shows again
@@ -194,5 +196,56 @@ def test_a_session_beside_a_deviation_display_shows_one_hud(tmp_path):
         d.wait(lambda s: not of(s, "Sculpt001")["session"] and "legend_band" in hud(s, "Sculpt")
                and not hud(s, "Sculpt001"), "the deviation's HUD back")
         d.shot_showing("two_huds_after", legend_blue, "the deviation's legend drawn again")
+    finally:
+        d.close()
+
+
+#: The issue's case: a clamped patch and a broad scanned bump (8 exp(-r^2/1500) mm over 100 mm) set
+#: as its target; the held tangent planes keep the bump's skirt out of reach.
+BLOCKED = """
+import json, os
+import numpy as np
+import FreeCAD, FreeCADGui
+import HapticSculpt as hs
+doc = FreeCAD.newDocument("Blocked")
+sculpt = hs.make_sculpt(doc, material="clay", edges="held")
+rng = np.random.default_rng(3)
+x, y = np.meshgrid(np.linspace(-50, 50, 61), np.linspace(-50, 50, 61))
+z = 8 * np.exp(-(x ** 2 + y ** 2) / 1500) + rng.normal(0, 0.02, x.shape)
+hs.set_target(sculpt, np.column_stack([x.ravel(), y.ravel(), z.ravel()]), tolerance=0.1)
+doc.recompute()
+doc.saveAs(PATH)
+json.dump({}, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_a_fit_its_held_edges_block_is_a_warning_with_its_remedy_one_click_away(tmp_path):
+    os.makedirs(SHOTS, exist_ok=True)
+    path = str(tmp_path / "blocked.FCStd")
+    run_freecad_gui(f"PATH = {path!r}\n" + BLOCKED, str(tmp_path))
+    d = Desktop(str(tmp_path), "CAD", open_file=path)
+    try:
+        s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["sculpts"], "the file")
+        d.xdo("mousemove", "640", "450", "key", "0")  # isometric
+        d.xdo("key", "--delay", "150", "v", "f")  # fit all
+        # (one click each, once the command is enabled: a fit takes seconds, and a second click queued
+        # meanwhile would fit again)
+        d.wait(lambda s: s["toolbars"]["menu_enabled"].get("HapticSculpt_FitToTarget"), "Fit to scan enabled")
+        d.click_button("FitToTarget")
+        s = d.wait(lambda s: "not fitted to its tolerance" in (s.get("report") or ""), "the fit's warning", 120)
+        line = next(x for x in s["report"].splitlines() if "not fitted to its tolerance" in x)
+        assert "held edges keep" in line and "Free edges and fit" in line, line
+        assert "HapticSculpt: fitted:" not in s["report"], s["report"][-1500:]
+        d.shot("scan_blocked")
+        # the remedy, one click: the fit taken back, the edges let go, fitted again
+        d.wait(lambda s: s["toolbars"]["menu_enabled"].get("HapticSculpt_FreeEdgesAndFit"), "the remedy enabled")
+        d.click_button("FreeEdgesAndFit")
+        s = d.wait(lambda s: "HapticSculpt: fitted:" in (s.get("report") or ""), "the fit with the edges free", 120)
+        assert sculpt(s)["deviation"]["within_pct"] >= 95.0, sculpt(s)["deviation"]
+        assert undo(s) == ["Free edges and fit"], undo(s)  # (the short fit taken back: one step for the remedy)
+        assert "Traceback" not in s["report"], s["report"][-1500:]
+        d.shot("scan_freed_and_fitted")
     finally:
         d.close()

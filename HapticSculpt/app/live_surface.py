@@ -77,6 +77,8 @@ class LiveSurface:
         self.writing = False
         #: What the last Fair changed (api.fair's report), for the GUI's report line
         self.last_fair: dict[str, float] | None = None
+        #: The last fit's report (scan_api.fit_to_target), for the GUI's line and its remedy
+        self.last_fit: dict[str, Any] | None = None
 
     # --- who owns the surface ---------------------------------------------------------------------
     @property

@@ -323,6 +323,34 @@ def _fit_holding(work: Any, points: np.ndarray, tolerance: float, frozen: list[i
         work.hold_poles(held, links)
 
 
+def _blockers(sculpt: Any, work: Any, points: np.ndarray, tolerance: float, held: dict[str, Any],
+              within_pct: float) -> dict[str, Any] | None:
+    """What keeps the fit of ``work`` (its projection ``held``) out of the tolerance when its holds
+    do (fit_blockers): ``message``, ``edges`` (the held edges, each with its share of the scan) and
+    ``free_within_pct``; None when the holds are not what blocks it."""
+    from . import fit_blockers, sculpt_state
+    from .api import held_boundary
+    from .scan_fit import fit_net_unfolded
+    found = fit_blockers.diagnose(sculpt_state.restore(sculpt.Proxy.live.stored()), points, tolerance, held,
+                                  within_pct, lambda trial: fit_net_unfolded(trial, points, tolerance))
+    if found is None:
+        return None
+    solid = solid_of(sculpt)
+    if solid is None:  # (a sheet: its sides, each with the share blocked beside it)
+        surface = work.surface
+        (p, q), ku, kv = surface.degree, np.asarray(surface.knots_u), np.asarray(surface.knots_v)
+        bounds = (float(ku[p]), float(ku[-p - 1]), float(kv[q]), float(kv[-q - 1]))
+        edges = fit_blockers.by_edge(found, held_boundary(sculpt), bounds)
+        message = fit_blockers.sentence(found, edges, "its held edges", tolerance,
+                                        "Free edges and fit: hold_boundary(obj, 'free'), then fit again")
+    else:  # (a solid's edges cannot be free: held G0 they still meet their neighbours)
+        from .sculpted_solid import boundary_of
+        edges = [{"edge": e, "kind": k, "share_pct": None} for e, k in boundary_of(solid).items() if k not in ("free", "G0")]
+        message = fit_blockers.sentence(found, [], ", ".join(f"{e['edge']} ({e['kind']})" for e in edges), tolerance,
+                                        "Free edges and fit: those edges held G0, then fit again")
+    return {"message": message, "edges": edges, "free_within_pct": found["free_within_pct"]}
+
+
 def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[str, Any]:
     """Relaxes the surface of ``obj`` (a Sculpt or SculptedSolid) onto its target (``set_target``)
     until at least 95 % of the target's points over the surface lie within ``tolerance`` (mm).
@@ -376,7 +404,9 @@ def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[
             summary, r = _fit_holding(work, points, tolerance, _uncovered_poles(sculpt, work.surface, u_over))
         except ValueError as exc:  # (a net that folds: never written)
             if coarser is None:
-                raise ValueError(f"{sculpt.Label}: not fitted, {exc} (nothing changed)") from None
+                blocked = _blockers(sculpt, work, points, tolerance, first, 0.0)
+                raise ValueError(f"{sculpt.Label}: not fitted, {blocked['message'] if blocked else exc} "
+                                 f"(nothing changed)") from None
             work, summary, r = coarser
             report.within_pct, report.controls = summary.within_pct, summary.controls
             where = (f"worst near (u, v) = ({summary.worst_uv[0]:.3f}, {summary.worst_uv[1]:.3f}), "
@@ -419,6 +449,11 @@ def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[
             report.message = f"no span left to refine: {where}"
             break
         coarser, work = (work, summary, r), finer
+    if not report.met:  # (what keeps it out of reach: the holds, said so, rather than a reason about the net)
+        blocked = _blockers(sculpt, work, points, tolerance, r, report.within_pct)
+        if blocked is not None:
+            report.message = blocked["message"] + (f"; {report.message}" if report.message else "")
+            report.blocked_by, report.free_within_pct = blocked["edges"], blocked["free_within_pct"]
     over = ~r["beyond_edge"]
     report.points = int(np.count_nonzero(over[: len(target.points)]))
     report.beyond_edge = int(len(target.points) - report.points)
@@ -429,7 +464,10 @@ def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[
         if solid is not None and tuple(work.surface.controls) != tuple(start.controls):
             from .solid_api import record_refinement
             record_refinement(solid, start, work.surface)
+        if float(sculpt.TargetTolerance) != tolerance:  # (the tolerance asked for is the one judged against)
+            sculpt.TargetTolerance = tolerance
         live.write(state)
         live.document_changed()  # (the cached surface is not the fitted one: read it again)
         scan_deviation.refresh_property(sculpt)
-    return report.as_dict()
+    live.last_fit = report.as_dict()
+    return live.last_fit

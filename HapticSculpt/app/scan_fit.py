@@ -85,12 +85,15 @@ class FitReport:
     points: int = 0
     outliers: int = 0
     beyond_edge: int = 0
+    blocked_by: list[dict[str, Any]] = field(default_factory=list)  # held edges that keep the scan out of reach
+    free_within_pct: float | None = None  # the share within the tolerance with them let go
 
     def as_dict(self) -> dict[str, Any]:
         """The report as plain numbers (for JSON and for scripts)."""
         return {"tolerance_mm": self.tolerance_mm, "within_pct": self.within_pct, "met": self.met,
                 "controls": list(self.controls), "message": self.message, "points": self.points,
                 "outliers": self.outliers, "beyond_edge": self.beyond_edge,
+                "blocked_by": list(self.blocked_by), "free_within_pct": self.free_within_pct,
                 "rounds": [r.__dict__ | {"controls": list(r.controls), "worst_uv": list(r.worst_uv)}
                            for r in self.rounds]}
 

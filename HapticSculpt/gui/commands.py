@@ -50,7 +50,8 @@ GROUPS = {
                                    "HapticSculpt_CombDensity", "HapticSculpt_CombScale", "HapticSculpt_Zebra",
                                    "HapticSculpt_ZebraMode", "HapticSculpt_ZebraStripes",
                                    "HapticSculpt_ZebraDirection", "HapticSculpt_DisplaysOff", "HapticSculpt_SetTarget",
-                                   "HapticSculpt_ShowDeviation", "HapticSculpt_FitToTarget", "HapticSculpt_PullToTarget"], 0),
+                                   "HapticSculpt_ShowDeviation", "HapticSculpt_FitToTarget", "HapticSculpt_FreeEdgesAndFit",
+                                   "HapticSculpt_PullToTarget"], 0),
 }
 #: The toolbars: few buttons, so that all show at 1280 px beside FreeCAD's own. Output is a toolbar
 #: of its own: a toolbar squeezed by a narrow window keeps its first button, so Export STEP never
@@ -588,12 +589,61 @@ class FitToTarget(_SculptCommand):
         sculpt = _with_target()
         if sculpt is None:
             return
-        run_echoed(f"report = HapticSculpt.fit_to_target({ref(sculpt)}, {float(sculpt.TargetTolerance)!r})")
-        _ctl().refresh(sculpt_for(sculpt))
-        report = json.loads(sculpt_for(sculpt).Deviation or "{}")
-        if "p95_mm" in report:
-            FreeCAD.Console.PrintMessage(f"HapticSculpt: fitted: {report['within_pct']:.1f} % of the scan within "
-                                         f"{report['tolerance_mm']:g} mm (p95 {report['p95_mm']:.3g} mm)\n")
+        _fit_and_say(sculpt, sculpt_for, ref, run_echoed)
+
+
+def _fit_and_say(sculpt: Any, sculpt_for: Any, ref: Any, run_echoed: Any) -> None:
+    """Fits the sculpt to its scan (echoed) and says how it went: "fitted" where it met its
+    tolerance, else a warning with what kept it short (the held edges: Free edges and fit)."""
+    sculpt.Proxy.live.last_fit = None
+    run_echoed(f"report = HapticSculpt.fit_to_target({ref(sculpt)}, {float(sculpt.TargetTolerance)!r})")
+    _ctl().refresh(sculpt_for(sculpt))
+    fit = sculpt.Proxy.live.last_fit or {}
+    report = json.loads(sculpt_for(sculpt).Deviation or "{}")
+    if "p95_mm" not in report:
+        return
+    said = (f"{report['within_pct']:.1f} % of the scan within {report['tolerance_mm']:g} mm "
+            f"(p95 {report['p95_mm']:.3g} mm)")
+    if fit.get("met", True):
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: fitted: {said}\n")
+    else:
+        FreeCAD.Console.PrintWarning(f"HapticSculpt: {sculpt.Label} not fitted to its tolerance: {said}; "
+                                     f"{fit.get('message', '')}\n")
+
+
+class FreeEdgesAndFit(_SculptCommand):
+    icon_name, menu = "FreeEdgesAndFit", "Free edges and fit"
+    needs = NEEDS_TARGET[:-1] + ", after a fit its held edges kept short, with no session running."
+    tip = ("The remedy a fit names when held edges keep part of the scan out of reach: takes that fit back, lets "
+           "those edges go (a sheet's free, a solid's held G0 only: still on their neighbours) and fits again, as "
+           "the fit's report measured it; one undo step")
+
+    def IsActive(self) -> bool:
+        sculpt = _with_target()
+        return (sculpt is not None and _ctl().session is None
+                and bool((sculpt.Proxy.live.last_fit or {}).get("blocked_by")))
+
+    def Activated(self) -> None:
+        from ..app.sculpted_solid import solid_of, sculpt_for
+        from .echo import ref, run_echoed
+        sculpt = _with_target()
+        if sculpt is None:
+            return
+        solid = solid_of(sculpt)
+        doc = f"App.getDocument({sculpt.Document.Name!r})"
+        blocked = sculpt.Proxy.live.last_fit["blocked_by"]
+        if sculpt.Document.UndoNames and sculpt.Document.UndoNames[0] == "Fit to target":
+            run_echoed(f"{doc}.undo()", modules=())  # (the fit that fell short: from where it began)
+        # one undo step: FreeCAD joins the calls' own steps into the one a command opens
+        run_echoed(f"{doc}.openTransaction('Free edges and fit')", modules=())
+        try:
+            if solid is None:
+                run_echoed(f"HapticSculpt.hold_boundary({ref(sculpt)}, 'free')")
+            else:
+                run_echoed(f"HapticSculpt.set_boundary({ref(solid)}, {dict((e['edge'], 'G0') for e in blocked)!r})")
+            _fit_and_say(sculpt, sculpt_for, ref, run_echoed)
+        finally:
+            run_echoed(f"{doc}.commitTransaction()", modules=())
 
 
 class PullToTarget(_SculptCommand):
@@ -915,6 +965,7 @@ COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_NewClampedPatch": N
             "HapticSculpt_PaintPull": PaintPull,
             "HapticSculpt_ShowMap": ShowMap, "HapticSculpt_SetTarget": SetTarget,
             "HapticSculpt_ShowDeviation": ShowDeviation, "HapticSculpt_FitToTarget": FitToTarget,
+            "HapticSculpt_FreeEdgesAndFit": FreeEdgesAndFit,
             "HapticSculpt_PullToTarget": PullToTarget,
             "HapticSculpt_ShowCurvature": ShowCurvature, "HapticSculpt_Combs": Combs, "HapticSculpt_ContinuityCheck": ContinuityCheck, "HapticSculpt_Zebra": Zebra, "HapticSculpt_DisplaysOff": DisplaysOff,
             "HapticSculpt_ZebraMode": ZebraMode, "HapticSculpt_ZebraStripes": ZebraStripes,
