@@ -584,17 +584,16 @@ class FitToTarget(_SculptCommand):
         return _with_target() is not None and _ctl().session is None
 
     def Activated(self) -> None:
-        from ..app.sculpted_solid import sculpt_for
-        from .echo import ref, run_echoed
         sculpt = _with_target()
-        if sculpt is None:
-            return
-        _fit_and_say(sculpt, sculpt_for, ref, run_echoed)
+        if sculpt is not None:
+            _fit_and_say(sculpt)
 
 
-def _fit_and_say(sculpt: Any, sculpt_for: Any, ref: Any, run_echoed: Any) -> None:
+def _fit_and_say(sculpt: Any) -> None:
     """Fits the sculpt to its scan (echoed) and says how it went: "fitted" where it met its
     tolerance, else a warning with what kept it short (the held edges: Free edges and fit)."""
+    from ..app.sculpted_solid import sculpt_for
+    from .echo import ref, run_echoed
     sculpt.Proxy.live.last_fit = None
     run_echoed(f"report = HapticSculpt.fit_to_target({ref(sculpt)}, {float(sculpt.TargetTolerance)!r})")
     _ctl().refresh(sculpt_for(sculpt))
@@ -624,7 +623,7 @@ class FreeEdgesAndFit(_SculptCommand):
                 and bool((sculpt.Proxy.live.last_fit or {}).get("blocked_by")))
 
     def Activated(self) -> None:
-        from ..app.sculpted_solid import solid_of, sculpt_for
+        from ..app.sculpted_solid import solid_of
         from .echo import ref, run_echoed
         sculpt = _with_target()
         if sculpt is None:
@@ -641,7 +640,7 @@ class FreeEdgesAndFit(_SculptCommand):
                 run_echoed(f"HapticSculpt.hold_boundary({ref(sculpt)}, 'free')")
             else:
                 run_echoed(f"HapticSculpt.set_boundary({ref(solid)}, {dict((e['edge'], 'G0') for e in blocked)!r})")
-            _fit_and_say(sculpt, sculpt_for, ref, run_echoed)
+            _fit_and_say(sculpt)
         finally:
             run_echoed(f"{doc}.commitTransaction()", modules=())
 
