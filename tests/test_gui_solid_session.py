@@ -88,7 +88,9 @@ def test_a_cut_and_a_fillet_on_a_sculpted_solid_follow_each_stroke_of_a_session(
         picture = d.shot("solid_session_pulled")
         assert (abs(picture[100:900, 300:1250] - before[100:900, 300:1250]) > 0.1).mean() > 1e-3, "the view changed"
         d.click_button("Session")
-        s = d.wait(lambda s: not s["docs"][s["active"]]["sculpts"][0]["session"], "the session to stop")
-        assert settled(s), (solid(s), features(s))
+        # (the stop commits the held state and the features recompute from it: a state written between
+        # the two showed the Cut still touched on a loaded machine)
+        d.wait(lambda s: not s["docs"][s["active"]]["sculpts"][0]["session"] and settled(s),
+               "the session to stop, the solid and its features recomputed")
     finally:
         d.close()
