@@ -52,10 +52,13 @@ def click_in_view(d: Desktop, points: list[list[float]], name: str, add: bool = 
         for dx, dy in [(0, 0)] + [(dx, dy) for dy in range(-24, 25, 2) for dx in (0, 3)]:
             before = cursor(d.state())
             d.xdo("mousemove", str(x0 + dx), str(y0 + dy))
-            try:  # (a highlight the view showed for this point: on a loaded machine the state written
-                # last can still be the point before, and a click here then missed the patch)
-                d.wait(lambda s: cursor(s) != before and (s["preselection"] or [None])[0] == name,
-                       f"{name} highlighted", 0.4, shot=False)
+            try:  # (the view has seen this move: on a loaded machine the state written last can
+                # still be the point before, and a click trusted to its highlight missed the patch)
+                d.wait(lambda s: cursor(s) != before, "the view to see the mouse move", 5.0, shot=False)
+            except AssertionError:
+                pass  # (no move to see: the pointer was there already)
+            try:
+                d.wait(lambda s: (s["preselection"] or [None])[0] == name, f"{name} highlighted", 0.4, shot=False)
             except AssertionError:
                 continue
             d.xdo(*(["keydown", "ctrl", "click", "1", "keyup", "ctrl"] if add else ["click", "1"]))
