@@ -14,11 +14,6 @@ from .. import core
 #: The free fit must bring at least this share of the scan (percentage points) more within the
 #: tolerance for the holds to be named as what blocks the fit.
 MARGIN_PCT = 5.0
-#: A side of the net counts for a blocked point when the point is within this share of the
-#: parameter range of it (a sheet's held edge shapes the band beside it).
-BAND = 0.5
-
-
 def _side_distances(uv: np.ndarray, bounds: tuple[float, float, float, float]) -> dict[str, np.ndarray]:
     u0, u1, v0, v1 = bounds
     su, sv = (u1 - u0) or 1.0, (v1 - v0) or 1.0
@@ -61,9 +56,8 @@ def by_edge(found: dict[str, Any], kinds: dict[str, str], bounds: tuple[float, f
         return []
     distance = _side_distances(found["uv"][blocked], bounds)
     nearest = np.array(held)[np.argmin(np.stack([distance[s] for s in held]), axis=0)]
-    near = np.min(np.stack([distance[s] for s in held]), axis=0) <= BAND
-    total = found["blocked_pct"] / max(1, int(np.count_nonzero(blocked)))
-    out = [{"edge": side, "kind": kinds[side], "share_pct": float(total * np.count_nonzero(near & (nearest == side)))}
+    each = found["blocked_pct"] / int(np.count_nonzero(blocked))  # (one blocked point's share, percent)
+    out = [{"edge": side, "kind": kinds[side], "share_pct": float(each * np.count_nonzero(nearest == side))}
            for side in held]
     return sorted((e for e in out if e["share_pct"] > 0), key=lambda e: -e["share_pct"])
 

@@ -55,7 +55,8 @@ class Overlay:
         self.continuity = False  # the continuity check: combs across edges, seams and curves
         self.neighbours_drawn = 0  # faces next to the sculpted ones the last frame's display covered
         self.continuity_worst: dict[str, Any] = {}
-        self._continuity: tuple[bytes, list[Any], float, float] | None = None  # poles, profiles, when, cost
+        # poles, profiles, their samples' levels, when, cost
+        self._continuity: tuple[bytes, list[Any], list[np.ndarray], float, float] | None = None
         self.comb_every = 4  # a comb on every n-th iso-line of the mesh (density)
         self.comb_gain = 1.0  # the longest tooth is this many tenths of the patch size (scale)
         self.panel_visible = False
@@ -596,7 +597,7 @@ class Overlay:
         key = np.asarray(s.poles).tobytes()
         now = time.perf_counter()
         if self._continuity is None or (self._continuity[0] != key and
-                                        now - self._continuity[2] >= 2.0 * self._continuity[3]):
+                                        now - self._continuity[3] >= 2.0 * self._continuity[4]):
             state = sculpt_properties.read_state(self.obj)
             frame = sculpt_state.SculptState({**state.arrays, "Poles": np.asarray(s.poles, float).ravel()},
                                              state.settings)
@@ -604,21 +605,21 @@ class Overlay:
                 found = continuity_check.profiles(self.obj, frame)
             except (RuntimeError, ValueError):
                 found = []
-            self._continuity = (key, found, now, time.perf_counter() - now)
+            levels = [continuity_check.sample_levels(p) for p in found]  # (measured once, drawn each frame)
+            self._continuity = (key, found, levels, now, time.perf_counter() - now)
             self.continuity_worst = {**continuity_check.worst(found), "profiles": len(found),
                                      "levels": {p.edge: continuity_check.level(p) for p in found},
                                      "shares": continuity_check.shares(found, continuity_check.holds(self.obj))}
-        found = self._continuity[1]
+        found, levels_of = self._continuity[1], self._continuity[2]
         sep = coin.SoSeparator()
         kappa = max((float(np.nanmax(np.abs(k))) for p in found for _, k in p.sides if np.isfinite(k).any()),
                     default=0.0)
         flat = np.asarray(s.mesh).reshape(-1, 3)
         size = float(np.linalg.norm(flat.max(0) - flat.min(0))) or 1.0
         scale = 0.1 * size * self.comb_gain / kappa if kappa > 0 else 0.0
-        for p in found:
+        for p, levels in zip(found, levels_of):
             # coloured along its length by what holds at each point (a seam G2 in its middle and G1
             # toward its ends shows both), not by its worst point alone
-            levels = continuity_check.sample_levels(p)
             for k, (normals, curvature) in enumerate(p.sides):
                 ok = np.isfinite(curvature) & np.all(np.isfinite(normals), axis=1)
                 base, at = p.points[ok], levels[ok]
