@@ -317,9 +317,10 @@ class Desktop:
         self.wait(lambda s: s["toolbars"]["menu_enabled"].get(command), f"{command} to be offered")
         self.xdo("key", keys)
 
-    def drag(self, points: list[tuple[int, int]], seconds: float = 0.3) -> None:
+    def drag(self, points: list[tuple[int, int]], seconds: float = 0.3, release: bool = True) -> None:
         """A left drag through ``points`` taking ``seconds``, as a hand makes one (a drag of no
-        duration, which xdotool can send and no hand can, may lose its release under Xvfb)."""
+        duration, which xdotool can send and no hand can, may lose its release under Xvfb); with
+        ``release`` false the button stays down at the last point."""
         self.xdo("mousemove", str(points[0][0]), str(points[0][1]))
         time.sleep(0.2)
         self.xdo("mousedown", "1")
@@ -327,7 +328,8 @@ class Desktop:
             time.sleep(seconds / len(points))
             self.xdo("mousemove", str(x), str(y))
         time.sleep(seconds / len(points))
-        self.xdo("mouseup", "1")
+        if release:
+            self.xdo("mouseup", "1")
 
     def calibrate(self) -> None:
         """Maps the active 3D view's viewport pixels to screen pixels, from where the view itself

@@ -48,12 +48,19 @@ def view_part(d: Desktop, name: str) -> dict:
     return s
 
 
-def stroke_in_session(d: Desktop, start: tuple[int, int], rise: int, steps: int, seconds: float) -> dict:
-    """Starts a session, drags from ``start`` up the screen ``rise`` pixels a step, stops the
-    session (one click: stopping commits and rebuilds the solid, a second would start again);
-    the state once it has stopped."""
+def stroke_in_session(d: Desktop, start: tuple[int, int], rise: int, steps: int, seconds: float,
+                      hold: bool = False) -> dict:
+    """Starts a session, drags from ``start`` up the screen ``rise`` pixels a step (with ``hold``,
+    holds the button at the end until the live surface stops rising), stops the session (one
+    click: stopping commits and rebuilds the solid, a second would start again); the state once
+    it has stopped."""
     d.press_button("Session", lambda s: s["docs"][s["active"]]["sculpts"][0]["session"], "the session")
-    d.drag([start] + [(start[0], start[1] - rise * k) for k in range(1, steps + 1)], seconds=seconds)
+    d.drag([start] + [(start[0], start[1] - rise * k) for k in range(1, steps + 1)], seconds=seconds,
+           release=not hold)
+    if hold:
+        d.wait_still(lambda s: round(max(s["docs"][s["active"]]["sculpts"][0]["drawn_poles"][2::3]), 3),
+                     "the surface under the held pointer")
+        d.xdo("mouseup", "1")
     d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
     d.click_button("Session")
     return d.wait(lambda s: not s["docs"][s["active"]]["sculpts"][0]["session"], "the session to stop")
@@ -131,10 +138,13 @@ os._exit(0)
 
 @pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
 def test_a_small_part_rises_under_a_quick_drag(tmp_path):
-    """The top of a 10 mm cube, grabbed at its middle and dragged up the screen for half a second in
-    the isometric view, rises by a millimetre, as a 100 mm box's top by ten. (Before, the rope's
-    slack was the 100 mm patch's 5 mm, and during the grab the cursor went onto the surface under
-    the pointer, the solid all around it: the top rose half as far.)"""
+    """The top of a 10 mm cube, grabbed at its middle, dragged up the screen for half a second in
+    the isometric view and held there, rises by a millimetre, as a 100 mm box's top by ten. (Before,
+    the rope's slack was the 100 mm patch's 5 mm, and during the grab the cursor went onto the
+    surface under the pointer, the solid all around it: the top rose half as far.) The hold waits
+    for the surface to stop rising before the release: under make test's load the simulation may
+    lag the half second (0.72 mm at the release, seen on FreeCAD 1.1), and this test is about the
+    rope's slack, not the pace (the runtime's tests judge that)."""
     path = str(tmp_path / "cube.FCStd")
     run_freecad_gui(f"PATH = {path!r}\n" + CUBE, str(tmp_path))
     d = Desktop(str(tmp_path), "CAD", open_file=path)
@@ -150,7 +160,7 @@ def test_a_small_part_rises_under_a_quick_drag(tmp_path):
         name = solid(s)["name"]
         # up the screen by half the top's width on screen (about 2 mm), in half a second
         rise = max(2, int(abs(centre[0] - west[0])) // 6)
-        s = stroke_in_session(d, centre, rise, 6, 0.5)
+        s = stroke_in_session(d, centre, rise, 6, 0.5, hold=True)
         pulled = solid(s)
         assert pulled["valid"] and pulled["solids"] == 1 and pulled["closed"] and not pulled["error"], pulled
         bump = s["docs"][s["active"]]["features"][name]["zmax"] - 10.0
