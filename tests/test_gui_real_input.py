@@ -65,9 +65,11 @@ class Desktop:
             self.close()  # (a FreeCAD left running would load every test after this one)
             raise
 
-    def wait_window(self, title: str, timeout: float = 20.0) -> None:
+    def wait_window(self, title: str, timeout: float = 20.0, click_in: bool = False) -> None:
         """Waits until a window whose title contains ``title`` is shown (a dialog FreeCAD opened) and
-        has the keyboard (keys typed before that go elsewhere: a path lost its leading '/')."""
+        has the keyboard (keys typed before that go elsewhere: a path lost its leading '/'). With
+        ``click_in``, gives it the keyboard as clicking into it does (a dialog FreeCAD opens at its
+        start gets none without a window manager)."""
         end = time.monotonic() + timeout
         while time.monotonic() < end:
             found = subprocess.run(["xdotool", "search", "--onlyvisible", "--name", title], env=self.env,
@@ -76,6 +78,8 @@ class Desktop:
                                    text=True).stdout.strip()
             if found and focus in found:
                 return
+            if found and click_in:
+                subprocess.run(["xdotool", "windowfocus", "--sync", found[-1]], env=self.env, capture_output=True)
             time.sleep(0.05)
         self.shot("timeout")
         raise AssertionError(f"timed out waiting for the window {title!r} to have the keyboard")

@@ -52,10 +52,10 @@ CommitListener = Callable[..., None]
 _commit_listeners: list[CommitListener] = []
 
 
-def set_commit_listener(listener: CommitListener | None) -> None:
-    """Installs the listener told of every stroke, spray and edit a session commits (None: none, as
-    in console mode)."""
-    _commit_listeners[:] = [listener] if listener is not None else []
+def set_commit_listener(*listeners: CommitListener | None) -> None:
+    """Installs the listeners told of every stroke, spray and edit a session commits, in order
+    (None or none: none, as in console mode)."""
+    _commit_listeners[:] = [listener for listener in listeners if listener is not None]
 
 
 def set_frame_clock(clock: FrameClock) -> None:

@@ -425,6 +425,8 @@ def write(*_):
         state["painting"] = ctl.painting
         state["paint_dabs"] = len(ctl._paint_path) if ctl._paint_stroke is not None else 0  # (a held paint drag's)
         state["session"] = ctl.session is not None
+        import HapticSculpt.gui as hgui
+        state["recovery"] = {"pending": hgui.recovery.pending, "docs": hgui.recovery.written}
         state["inputs"] = len(ctl.inputs)
         state["mouse_point"] = None if ctl.mouse_point is None else [float(x) for x in ctl.mouse_point]
         state["overlays"] = [{"display": ov.display, "frames": ov.frames, "view_size": list(ov.view.getSize()),
