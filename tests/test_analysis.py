@@ -76,3 +76,15 @@ def test_map_colours_resample_a_painted_map():
     assert rgb[10, 10, 0] > rgb[0, 0, 0]  # hotter where painted
     rgb_u, _ = analysis.map_colours(np.array([5.0]), (4, 4))
     assert np.all(np.ptp(rgb_u, axis=(0, 1)) == 0)  # one colour
+
+
+def test_the_deviation_range_spans_the_largest_deviation_shown():
+    """A legend that ended at the 98th percentile left the worst points (a scan's crown, a few
+    outliers) unread: the range reaches the largest deviation, and at least twice the tolerance."""
+    signed = np.concatenate([np.linspace(-0.05, 0.05, 990), [0.8, -0.3, np.nan] * 3 + [1.2]])
+    lo, hi = analysis.deviation_range(signed, 0.1)
+    assert (lo, hi) == (-1.2, 1.2)
+    colours, rng = analysis.deviation_colours(signed, 0.1)
+    assert rng == (-1.2, 1.2) and np.allclose(colours[-1], analysis.deviation_colours(np.array([1.2]), 0.1, rng)[0][0])
+    assert analysis.deviation_range(np.full(5, 0.01), 0.1) == (-0.2, 0.2)
+    assert analysis.deviation_range(np.full(5, np.nan), 0.1) == (-0.2, 0.2)

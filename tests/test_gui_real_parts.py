@@ -1,5 +1,6 @@
 """A rounded block as a designer sculpts it in FreeCAD's GUI, with real X events: three faces that
-cannot be sculpted as one (a ring) are refused in one plain line (no traceback), the top alone keeps its
+cannot be sculpted as one (a ring) are refused before the click (the button greyed out) in one plain
+line (no traceback), the top alone keeps its
 rounds tangent through a mouse stroke, and Hold edges on one picked edge holds that edge alone G2
 and says so. Screenshots build/screenshots/real_parts_*.png."""
 from __future__ import annotations
@@ -69,10 +70,13 @@ def test_a_rounded_blocks_top_refused_kept_tangent_and_held_g2_edge_by_edge(tmp_
         click_on(d, top, "Block", part["top"])
         click_on(d, front, "Block", part["front"], add=True)
         click_on(d, right, "Block", part["right"], add=True)
-        d.click_button("SculptFace")
-        s = d.wait(lambda s: "HapticSculpt: Sculpt selected face: faces:" in report(s), "the refusal in the report view")
-        line = next(x for x in report(s).splitlines() if "Sculpt selected face: faces:" in x)
+        # (known before the click: the button greys out, and the report view says why at once)
+        s = d.wait(lambda s: "close into a ring" in report(s) and
+                   s["toolbars"]["menu_enabled"].get("HapticSculpt_SculptFace") is False,
+                   "the refusal in the report view, Sculpt selected face greyed out")
+        line = [x for x in report(s).splitlines() if "Sculpt selected face: faces:" in x][-1]
         assert "close into a ring" in line and part["top"] in line and "alone" in line, line
+        d.click_button("SculptFace")  # (clicked all the same, as a designer tries: nothing happens)
         assert "Traceback" not in report(s), report(s)[-2000:]
         assert not s["docs"][s["active"]]["solids"], "nothing was made"
         d.shot("parts_refused")

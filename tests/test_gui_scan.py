@@ -101,6 +101,9 @@ def test_a_scan_set_as_target_shows_its_deviation_and_a_stroke_reduces_it(tmp_pa
         before = sculpt(s)["deviation"]
         assert 7.5 < before["max_mm"] < 8.5 and before["within_pct"] < 90, before  # the bump is not there yet
         assert "legend_band" in overlay(s)["hud"], overlay(s)["hud"]  # the +-tolerance band labelled
+        # the legend spans the largest deviation shown (the scan's crown, 8 mm above the flat patch)
+        s = d.wait(lambda s: overlay(s)["legend"] and overlay(s)["legend"][0] == "deviation", "the legend drawn")
+        assert overlay(s)["legend"][1][1] >= 0.99 * before["max_mm"], (overlay(s)["legend"], before)
         assert "deviation:" in overlay(s)["status_text"], overlay(s)["status_text"]
         picture = colours_shown(d, "scan_deviation", before_picture, lambda p: share(p, warm) > 0.01 and
                                 share(p, within) > 0.005)

@@ -135,11 +135,11 @@ _BELOW = np.array([[0.0, 0.9, 1.0], [0.0, 0.0, 1.0]])  # just past -tolerance ..
 
 
 def deviation_range(signed: np.ndarray, tolerance: float) -> tuple[float, float]:
-    """A range centred on zero covering the 98th percentile of |deviation| (outliers saturate), at
-    least twice the tolerance, so the band within it is always seen."""
+    """A range centred on zero covering the largest |deviation| shown (a legend that ended below it
+    left the worst points unread), at least twice the tolerance, so the band within it is always seen."""
     finite = np.asarray(signed, float)
     finite = finite[np.isfinite(finite)]
-    a = float(np.percentile(np.abs(finite), 98)) if finite.size else 0.0
+    a = float(np.abs(finite).max()) if finite.size else 0.0
     a = max(a, 2.0 * tolerance)
     return -a, a
 

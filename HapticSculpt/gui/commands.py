@@ -1,6 +1,7 @@
 """Workbench commands (GUI only; registered from InitGui through FreeCADGui.addCommand)."""
 from __future__ import annotations
 
+import functools
 import json
 from typing import Any
 
@@ -159,20 +160,48 @@ def _face_selection() -> tuple[Any, list[str], Any] | None:
     return faces[0].Object, names, planes[0].Object if planes else None
 
 
+def _chain_refusal(picked: tuple[Any, list[str], Any]) -> str:
+    """Why Sculpt selected face would refuse the faces of a solid picked together (a ring, faces
+    not parameterised alike), '' if the faces make a row: the check sculpt_solid makes first, found
+    once per selection and said once in the report view (IsActive runs at every command update)."""
+    base, faces, _ = picked
+    shape = getattr(base, "Shape", None)
+    if len(faces) < 2 or shape is None or len(shape.Solids) != 1:
+        return ""
+    return _chain_verdict(base.Document.Name, base.Name, tuple(faces), shape.hashCode())
+
+
+@functools.lru_cache(maxsize=16)
+def _chain_verdict(doc: str, name: str, faces: tuple[str, ...], shape_hash: int) -> str:
+    """:func:`_chain_refusal` for one selection of one shape (the hash: the shape as it is now)."""
+    from ..app import face_chain
+    from ..app.sculpted_solid import base_solid
+    try:
+        face_chain.chain_of(base_solid(FreeCAD.getDocument(doc).getObject(name)), list(faces))
+    except ValueError as exc:
+        refuse(SculptFace.MENU_TEXT, exc)
+        return str(exc)
+    return ""
+
+
 class SculptFace:
     """Sculpt the selected faces in place: faces of a solid become a SculptedSolid (its edges held
     G0, its trims kept, several faces in a row joined into one surface, the solid rebuilt around
     them; with a plane selected too, mirrored in it); a face of anything else a separate patch."""
 
     def GetResources(self) -> dict[str, str]:
-        return {"Pixmap": icon("SculptFace"), "MenuText": "Sculpt selected face",
+        return {"Pixmap": icon("SculptFace"), "MenuText": self.MENU_TEXT,
                 "ToolTip": "Sculpt the selected faces: in place in their solid (each edge held as the part meets "
                            "its other face there: G1 where tangent, G2 where curvature-continuous, G0 at a crease; "
                            "holes kept, faces in a row sculpted as one; Hold edges changes the holds; select a "
                            "plane too for a mirror-symmetric sculpt), or one face as a separate B-spline patch"}
 
+    MENU_TEXT = "Sculpt selected face"
+
     def IsActive(self) -> bool:
-        return _face_selection() is not None
+        # (greyed out for faces it would refuse, which the report view then says why)
+        picked = _face_selection()
+        return picked is not None and not _chain_refusal(picked)
 
     def Activated(self) -> None:
         from ..app.sculpted_solid import boundary_of, chain_of_solid, held_by_kind

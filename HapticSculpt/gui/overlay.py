@@ -77,7 +77,8 @@ class Overlay:
         self.stripe_angle = 0.0  # reflection: the light strips' angle from the view's up direction (degrees)
         self.per_pixel = True  # zebra per pixel where the driver runs GLSL (False: per mesh vertex)
         self._sampled: tuple[bytes, np.ndarray, tuple[bytes, bytes], int] | None = None  # poles, points, texture, size
-        self._scan: tuple[bytes, float, Any] | None = None  # poles, when, the scan's coloured points
+        self._scan: tuple[bytes, float, Any, Any] | None = None  # poles, when, the scan's points, their deviations
+        self.legend: tuple[str, tuple[float, float]] | None = None  # the HUD legend's display and range
         self._live_deviation: str | None = None  # the HUD's line as the scan's points last measured it
         self._trims: dict[tuple[int, int], list[int] | None] = {}  # grid size -> cells on the trimmed face
         self._curve_rows: tuple[str, list[tuple[str, Any]]] = ("", [])  # CurveConstraints text -> (kind, rows)
@@ -332,6 +333,7 @@ class Overlay:
             return
         sliders = self.panel.values(self.obj) if self.panel_visible else []
         self.status_text = self._status(s)
+        self.legend = legend if legend is None else (legend[0], (float(legend[1][0]), float(legend[1][1])))
         self.hud.update(legend, sliders, self.status_text, zebra_bands=int(self.stripes), tolerance=self.tolerance())
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
@@ -525,29 +527,37 @@ class Overlay:
         # a point past the scan's edge by a spacing and a half shows no scan (grey), not the edge's colour
         signed = mesh_deviation(mesh, analysis.vertex_normals(mesh), target.tree, target.points,
                                 int(getattr(self.obj, "TargetSide", 0)), 1.5 * target.spacing + tol)
-        return analysis.deviation_colours(signed, tol)
+        # (the legend spans the largest deviation shown: the surface's and the scan points')
+        _, at_points = self._scan_measured(s)
+        return analysis.deviation_colours(signed, tol, analysis.deviation_range(np.concatenate(
+            [signed.ravel(), at_points]), tol))
 
-    def _scan_points(self, s: core.DynamicSurface, rng: tuple[float, float]) -> Any:
-        """The scan's points (up to SCAN_POINTS_SHOWN) coloured by their signed deviation from the
-        surface on the surface's scale; measured again when the poles moved or the tolerance changed,
-        at most every SCAN_REMEASURE_S during a session."""
+    def _scan_measured(self, s: core.DynamicSurface) -> tuple[Any, np.ndarray]:
+        """The scan's points (up to SCAN_POINTS_SHOWN) and their signed deviations from the surface
+        (NaN: past its edge); measured again when the poles moved or the tolerance changed, at most
+        every SCAN_REMEASURE_S during a session."""
         from ..app.scan_deviation import signed_distances, thinned
         key = (np.asarray(s.poles).tobytes(), self.tolerance())  # (a new tolerance colours them anew)
         now = time.monotonic()
         if self._scan is not None and (self._scan[0] == key or now - self._scan[1] < SCAN_REMEASURE_S):
-            return self._scan[2]
+            return self._scan[2], self._scan[3]
         target = self._target()
         points = thinned(target.points, SCAN_POINTS_SHOWN)
         distances, over = signed_distances(s.surface, points, float(int(getattr(self.obj, "TargetSide", 0)) or 1))
+        shown = np.where(over, distances, np.nan)
+        self._scan = (key, now, points, shown)
         tol = self.tolerance()
-        colours, _ = analysis.deviation_colours(np.where(over, distances, np.nan), tol, rng)
-        node = shapes.coloured_points(points, colours, 3.0)
-        self._scan = (key, now, node)
         d = np.abs(distances[over])
         self._live_deviation = (f"deviation: {100.0 * float(np.mean(d <= tol)):.1f} % within \u00b1{tol:g} mm, p95 "
                                 f"{float(np.percentile(d, 95)):.3g} mm, max {float(d.max()):.3g} mm (live, "
                                 f"{d.size} points)") if d.size else None
-        return node
+        return points, shown
+
+    def _scan_points(self, s: core.DynamicSurface, rng: tuple[float, float]) -> Any:
+        """The scan's points coloured by their signed deviation from the surface on the legend's scale."""
+        points, shown = self._scan_measured(s)
+        colours, _ = analysis.deviation_colours(shown, self.tolerance(), rng)
+        return shapes.coloured_points(points, colours, 3.0)
 
     def _colours(self, s: core.DynamicSurface, mesh: np.ndarray) -> tuple[np.ndarray, tuple[float, float]]:
         g, h = mesh.shape[:2]

@@ -393,9 +393,9 @@ class Controller:
                 self.toggle_constraint(KEYS[key])
             else:
                 self.toggle_map()
-        except RuntimeError as exc:
-            import FreeCAD
-            FreeCAD.Console.PrintWarning(f"HapticSculpt: {exc}\n")
+        except (ValueError, TypeError, RuntimeError) as exc:  # (what the API refused, said plainly)
+            from .commands import refuse
+            refuse(f"key {key.upper()} ({KEYS.get(key, 'map')})", exc)
         cb.setHandled()
 
     def holds_stroke(self, doc: Any = None) -> bool:

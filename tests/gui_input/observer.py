@@ -440,6 +440,8 @@ def write(*_):
                               "neighbours_drawn": ov.neighbours_drawn,
                               "trimmed": any(v is not None for v in ov._trims.values()),
                               "continuity_worst": ov.continuity_worst,
+                              "legend": [ov.legend[0], [float(x) for x in ov.legend[1]]]
+                              if getattr(ov, "legend", None) else None,
                               "drawn": ov._root.getNumChildren() > 0}
                              for ov in ctl.overlays.values()]
     except Exception as exc:  # noqa: BLE001 - the workbench not loaded yet
