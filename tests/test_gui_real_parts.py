@@ -1,6 +1,6 @@
 """A rounded block as a designer sculpts it in FreeCAD's GUI, with real X events: three faces that
 cannot be sculpted as one (a ring) are refused before the click (the button greyed out) in one plain
-line (no traceback), the top alone keeps its
+line (no traceback), as are the top and one round, which are not parameterised alike, the top alone keeps its
 rounds tangent through a mouse stroke, and Hold edges on one picked edge holds that edge alone G2
 and says so. Screenshots build/screenshots/real_parts_*.png."""
 from __future__ import annotations
@@ -69,6 +69,13 @@ def test_a_rounded_blocks_top_refused_kept_tangent_and_held_g2_edge_by_edge(tmp_
         # ring of faces, not a row; refused in one line
         click_on(d, top, "Block", part["top"])
         click_on(d, front, "Block", part["front"], add=True)
+        # the top and one round: not parameterised alike along their edge (the fillet's ends are
+        # trimmed where the rounds meet): refused as well, before the click
+        s = d.wait(lambda s: "not parameterised alike" in report(s) and
+                   s["toolbars"]["menu_enabled"].get("HapticSculpt_SculptFace") is False,
+                   "the top and its round refused, Sculpt selected face greyed out")
+        line = [x for x in report(s).splitlines() if "Sculpt selected face: faces:" in x][-1]
+        assert part["top"] in line and part["front"] in line and "alone" in line, line
         click_on(d, right, "Block", part["right"], add=True)
         # (known before the click: the button greys out, and the report view says why at once)
         s = d.wait(lambda s: "close into a ring" in report(s) and
