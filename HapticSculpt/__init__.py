@@ -31,7 +31,8 @@ from .app.api import (
                       thicken,
                       to_cadquery,
 )
-from .app.curve_api import add_curve_constraint, curve_constraints_of
+from .app.curve_api import curve_constraints_of
+from .app.curve_follow import add_curve_constraint
 from .app.scan_api import clear_target, deviation_of, fit_to_target, pull_of, set_pull, set_target, target_object
 from .app.sculpted_solid import boundary_of, seam_report_of
 from .app.solid_api import sculpt_solid, set_boundary

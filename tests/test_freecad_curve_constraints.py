@@ -172,7 +172,9 @@ class TestCurveConstraints(SolidChecks):
         profile = [(x, 0.0, 8 * math.exp(-(x / 15) ** 2)) for x in np.linspace(-45, 45, 40)]
         cases = [
             (dict(curve=[(0, 0, 50), (10, 0, 50)]), ValueError, r"runs up to 50 mm from the surface, more than a quarter of the surface's size"),
-            (dict(curve=profile), ValueError, r"cannot follow 'points' G0: with 8 x 8 controls.*use more controls"),
+            (dict(curve=profile), ValueError, r"cannot follow 'points' G0: refined from 8 x 8 up to 12 x 12 controls, the "
+             r"most its 24 x 24 mesh takes \(half its points per direction\), it comes no closer than .* mm \(tolerance "
+             r"0.001 mm\); make the sculpt with a finer mesh"),
             (dict(curve=[(0, 0, 0), (10, 0, 0)], continuity="G2"), ValueError, r"continuity: one of G0, G1"),
             (dict(curve=[(0, 0, 0), (10, 0, 0)], continuity="G1", normal=(1, 0, 0)), ValueError,
              r"normal: the curve leaves the plane perpendicular to it by 90 degrees"),

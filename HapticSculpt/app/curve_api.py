@@ -47,45 +47,6 @@ def _not_in_session(sculpt: Any, what: str) -> Any:
     return live
 
 
-def add_curve_constraint(obj: Any, curve: Any, continuity: str = "G0", normal: Any = None,
-                         replace: int | None = None) -> int:
-    """Makes the sculpt (a Sculpt or a SculptedSolid) follow ``curve`` exactly: "G0" passes
-    through it (within 1e-6 of the surface's size), "G1" also keeps the surface's normal along it
-    at ``normal`` (a vector; None keeps the normal the surface has there now) within 0.01 degrees.
-    ``curve`` is a document object with one edge or wire (a Sketch, a Part feature, a Draft wire),
-    a ``Part.Edge`` or ``Part.Wire``, or a list of points (the natural cubic spline through them, by
-    chord length).
-
-    A curve off the surface (up to a quarter of its size away) pulls it onto itself, the poles
-    moving as little as possible; the pulled shape is the new rest shape. The constraint is hard:
-    exact linear conditions on the poles, kept by every stroke and session. One undo step (not
-    during a session: RuntimeError), which also removes curve constraint ``replace`` if given (the
-    GUI's Follow curve turns a G0 curve into G1 so). Returns its id (for :func:`remove_constraint`).
-    ValueError saying why where the surface cannot follow the curve (too far, too few controls
-    there, poles there held already, a normal the curve is not perpendicular to)."""
-    sculpt = _sculpt(obj)
-    live = _not_in_session(sculpt, "adding a curve constraint")
-    surface = live.surface
-    records = records_of(sculpt)
-    cid = max([r.id for r in records], default=cc.FIRST_ID - 1) + 1
-    held, links = list(surface.held_poles), base_links(sculpt, surface)
-    if replace is not None:
-        if replace not in [r.id for r in records]:
-            raise ValueError(f"replace: {sculpt.Label} has no curve constraint {replace}")
-        records = [r for r in records if r.id != replace]
-    record, moved, all_links = cc.make(surface, curve, continuity, normal, cid, held, links, records)
-    before = np.asarray(surface.poles, float).reshape(-1, 3)
-    pulled = not np.array_equal(moved, before)
-    shape = np.asarray(surface.poles).shape
-
-    def change(s: Any) -> None:
-        if pulled:
-            s.set_poles(moved.reshape(shape))
-        s.hold_poles(held, all_links)
-    live.edit(change, "Follow curve", keep_shape=pulled, inside=_writer(sculpt, records + [record]))
-    return cid
-
-
 def curve_constraints_of(obj: Any) -> list[dict[str, Any]]:
     """The curve constraints of a Sculpt or SculptedSolid, with how well each holds now: id,
     continuity, label, samples, normal (G1 asked for, or None), distance_mm (largest distance of

@@ -52,6 +52,16 @@ G1_DEGREES = 0.01
 _WEIGHT_FLOOR = 1e-12
 
 
+class NetTooCoarse(ValueError):
+    """The net cannot follow a curve within its tolerance where it runs (``uv``: the curve's
+    preimage): knots inserted there give it the freedom (:func:`refinement_knots`)."""
+
+    def __init__(self, curve: str, why: str, advice: str, uv: np.ndarray) -> None:
+        super().__init__(f"curve: the surface cannot follow {curve}: {why}; {advice}")
+        #: The curve named (its label and continuity), what keeps the net from it, its preimage.
+        self.curve, self.why, self.uv = curve, why, uv
+
+
 @dataclass
 class CurveConstraint:
     """One curve constraint as the document stores it (JSON): its conditions and the poles that
@@ -67,11 +77,14 @@ class CurveConstraint:
     derivatives: np.ndarray | None = None  # (K, 3) G1: the derivative held in it
     normal: list[float] | None = None      # G1: the normal asked for (None: the surface's own)
     slaves: list[int] = field(default_factory=list)
+    tolerance: float | None = None         # mm, G0, asked for (None: G0_SHARE of the size, as before it was asked)
 
     def to_json(self) -> dict[str, Any]:
         """The JSON form (floats round-trip exactly)."""
         out: dict[str, Any] = {"id": self.id, "continuity": self.continuity, "label": self.label,
                                "uv": self.uv.tolist(), "points": self.points.tolist(), "slaves": list(self.slaves)}
+        if self.tolerance is not None:
+            out["tolerance"] = self.tolerance
         if self.continuity == "G1":
             out.update(tangents=self.tangents.tolist(), across=self.across.tolist(),
                        derivatives=self.derivatives.tolist(), normal=self.normal)
@@ -82,7 +95,8 @@ class CurveConstraint:
         """From :meth:`to_json`'s form; ValueError naming what is malformed."""
         try:
             made = cls(int(item["id"]), str(item["continuity"]), str(item.get("label", "")),
-                       _array(item["uv"], 2), _array(item["points"], 3), slaves=[int(i) for i in item["slaves"]])
+                       _array(item["uv"], 2), _array(item["points"], 3), slaves=[int(i) for i in item["slaves"]],
+                       tolerance=None if item.get("tolerance") is None else float(item["tolerance"]))
             if made.continuity == "G1":
                 made.tangents, made.across = _array(item["tangents"], 3), _array(item["across"], 2)
                 made.derivatives = _array(item["derivatives"], 3)
@@ -462,9 +476,9 @@ def fit(dynamic: core.DynamicSurface, records: list[CurveConstraint], held: list
     eligible = np.array([i for i, pole in enumerate(free) if int(pole) not in masters], dtype=int)
     chosen = eligible[_pivots(basis[:, eligible], 1e-6)] if eligible.size else eligible
     if len(chosen) < rank:
-        raise ValueError(f"curve: the surface cannot follow '{records[-1].label}' there: {rank} conditions need {rank} "
-                         f"free poles near it and only {len(chosen)} are not held or linked already "
-                         "(free the edges near it, or use more controls)")
+        raise NetTooCoarse(f"'{records[-1].label}' there", f"{rank} conditions need {rank} free poles near it and only "
+                           f"{len(chosen)} are not held or linked already", "free the edges near it, or use more controls",
+                           records[-1].uv)
     chosen = chosen[:rank]
     rest = np.setdiff1d(np.arange(len(free)), chosen)
     # the slaves from the masters: Q_S P_S = c - Q_M P_M
@@ -524,11 +538,13 @@ def relink(dynamic: core.DynamicSurface, records: list[CurveConstraint], held: l
 
 
 def make(dynamic: core.DynamicSurface, curve: Any, continuity: str, normal: Any, cid: int, held: list[int],
-         links: list[tuple[Any, ...]], records: list[CurveConstraint] = ()
+         links: list[tuple[Any, ...]], records: list[CurveConstraint] = (), tolerance: float | None = None
          ) -> tuple[CurveConstraint, np.ndarray, list[tuple[Any, ...]]]:
     """A new curve constraint on ``dynamic``, on top of ``held``, ``links`` (those that are not the
     curves') and the curves ``records`` it holds already: the record, the poles moved onto the curve
-    and all links. ValueError saying why where it cannot hold."""
+    and all links. ``tolerance``: how near the surface must pass the curve, everywhere along it (mm;
+    None: G0_SHARE of the size). ValueError saying why where it cannot hold; NetTooCoarse where
+    the net has too little freedom along the curve (a finer net may follow it)."""
     if continuity not in CONTINUITIES:
         raise ValueError(f"continuity: one of {', '.join(CONTINUITIES)}, not {continuity!r}")
     if normal is not None:
@@ -558,7 +574,9 @@ def make(dynamic: core.DynamicSurface, curve: Any, continuity: str, normal: Any,
     points, along, _ = curve_samples(curve, count)
     uv, _ = closest_parameters(surface, poles, points, nearest_mesh_parameters(dynamic, points))
     dense, _ = curve_points(curve, 3 * count)  # (the check's points, between the conditions' samples too)
-    record = CurveConstraint(cid, continuity, label, uv, points, normal=None if normal is None else normal.tolist())
+    record = CurveConstraint(cid, continuity, label, uv, points, normal=None if normal is None else normal.tolist(),
+                             tolerance=tolerance)
+    tolerance = G0_SHARE * size if tolerance is None else tolerance
     if continuity == "G1":
         record.tangents = along
         record.across, record.derivatives = _held_derivatives(surface, poles, uv, points, along, normal)
@@ -575,13 +593,31 @@ def make(dynamic: core.DynamicSurface, curve: Any, continuity: str, normal: Any,
         if d > G0_SHARE * size or g > G1_DEGREES:
             raise ValueError(f"curve: '{label}' and '{other.label}' (constraint {other.id}) cannot both hold: where they "
                              f"meet they ask the surface for different places or normals")
-    if distance > G0_SHARE * size or degrees > G1_DEGREES:
+    if distance > tolerance or degrees > G1_DEGREES:
         nu, nv = surface.controls
-        raise ValueError(f"curve: the surface cannot follow '{label}' {continuity}: with {nu} x {nv} controls it comes "
-                         f"no closer than {distance:.3g} mm (tolerance {G0_SHARE * size:.3g} mm)"
-                         + (f" and {degrees:.3g} degrees off the normal" if continuity == "G1" else "")
-                         + "; use more controls, or a curve nearer the surface or smoother")
+        raise NetTooCoarse(f"'{label}' {continuity}", f"with {nu} x {nv} controls it comes no closer than {distance:.3g} mm "
+                           f"(tolerance {tolerance:.3g} mm)" + (f" and {degrees:.3g} degrees off the normal"
+                                                                 if continuity == "G1" else ""),
+                           "use more controls, or a curve nearer the surface or smoother", uv)
     return record, moved, list(links) + made
+
+
+def refinement_knots(surface: Any, uv: np.ndarray, room: tuple[int, int]) -> tuple[list[float], list[float]]:
+    """Knots (u, v) that give the net freedom along a curve whose preimage is ``uv``: the midpoints
+    of the spans it crosses (those with the most of its samples first) and then of their
+    neighbours, at most ``room`` per direction."""
+    out: tuple[list[float], list[float]] = ([], [])
+    for d, knots in enumerate((surface.knots_u, surface.knots_v)):
+        breaks = np.unique(np.asarray(knots, float))
+        if room[d] <= 0 or len(breaks) < 2:
+            continue
+        spans = np.clip(np.searchsorted(breaks, uv[:, d], side="right") - 1, 0, len(breaks) - 2)
+        count = np.bincount(spans, minlength=len(breaks) - 1)
+        crossed = [int(k) for k in np.argsort(-count, kind="stable") if count[k] > 0]
+        near = sorted({k + j for k in crossed for j in (-1, 1)} - set(crossed))
+        chosen = [k for k in crossed + near if 0 <= k < len(breaks) - 1][: room[d]]
+        out[d].extend(float(0.5 * (breaks[k] + breaks[k + 1])) for k in sorted(chosen))
+    return out
 
 
 def _held_derivatives(surface: Any, poles: np.ndarray, uv: np.ndarray, points: np.ndarray, t: np.ndarray,

@@ -79,6 +79,9 @@ class LiveSurface:
         self.last_fair: dict[str, float] | None = None
         #: The last fit's report (scan_api.fit_to_target), for the GUI's line and its remedy
         self.last_fit: dict[str, Any] | None = None
+        #: The last curve followed (curve_follow.add_curve_constraint): its id, label, tolerance and
+        #: the net before and after it was refined for it, for the GUI's line
+        self.last_curve: dict[str, Any] | None = None
 
     # --- who owns the surface ---------------------------------------------------------------------
     @property

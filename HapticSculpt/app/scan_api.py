@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from . import scan_deviation, scan_target
+from .net_refinement import refined_sculpt
 from .api import _sculpt as api_sculpt
 from .sculpt_properties import read_state
 from .sculpted_solid import chain_of_solid, solid_of
@@ -240,46 +241,6 @@ def _refine_knots(surface: Any, r: dict[str, Any], tolerance: float, room: tuple
     return out
 
 
-def _refined(sculpt: Any, work: Any, extra: tuple[list[float], list[float]]) -> Any:
-    """A new working surface on ``work``'s net with knots ``extra`` inserted (exactly: the shape is
-    kept), held as before: a sheet's edges, or a sculpted solid's edges, trims and seams (held poles,
-    seam links and walls found again on the finer net); its curves held again. None where the
-    holds could not be carried to the finer net: a sheet's held poles that are not its edges', a
-    symmetric sculpt, a mesh with no room for more poles."""
-    from . import api, curve_api, sculpt_state
-    from .solid_api import refined_net
-    from .source_surface import refined
-    controls = tuple(work.surface.controls)
-    solid = solid_of(sculpt)
-    if work.symmetry is not None:
-        return None
-    if solid is None:
-        kinds = api.held_boundary(sculpt)
-        if sorted(work.held_poles) != sorted(set(api.boundary_poles(controls, kinds))):
-            return None
-        finer, links, walls = refined(work.surface, extra), [], []
-        held = api.boundary_poles(tuple(finer.controls), kinds)
-    else:
-        finer, held, links, walls = refined_net(solid, work.surface, extra)
-    state = sculpt_state.capture(work)
-    new_controls = tuple(finer.controls)
-    mesh = tuple(state.settings["mesh"])
-    if mesh[0] < new_controls[0] or mesh[1] < new_controls[1]:
-        return None
-    state.settings.update(controls=list(new_controls), held_poles=[], linked_poles=[], walls=[])
-    state.arrays.update(Poles=np.asarray(finer.poles, float).ravel(), Velocities=np.zeros(finer.poles.size),
-                        KnotsU=np.asarray(finer.knots_u, float), KnotsV=np.asarray(finer.knots_v, float),
-                        Weights=np.zeros(0) if finer.weights is None else np.asarray(finer.weights, float).ravel())
-    made = sculpt_state.restore(state)
-    poles_now = np.asarray(made.poles, float).reshape(-1, 3)
-    moved, links, _ = curve_api.rehold(sculpt, made, held, links, poles_now)
-    made.set_poles(moved.reshape(new_controls[0], new_controls[1], 3))
-    made.hold_poles(held, links)
-    if walls:
-        made.set_walls(walls)
-    return made
-
-
 #: A face of a solid's faces sculpted as one surface that holds less than this share of the scan's
 #: points over the surface is one the scan does not reach: it keeps its shape through the fit.
 UNCOVERED_SHARE = 0.002
@@ -440,7 +401,7 @@ def fit_to_target(obj: Any, tolerance: float, max_controls: Any = None) -> dict[
             report.message = (f"what is left out of the tolerance is the scan's noise (no span's points are off by "
                               f"more than {SYSTEMATIC:g} of it in root mean square; p95 {summary.p95_mm:.3g} mm): {where}")
             break
-        finer = _refined(sculpt, work, knots)
+        finer = refined_sculpt(sculpt, work, knots)
         if finer is None:
             report.message = (f"not refined (its held poles are not its edges', it is symmetric, or its mesh has no "
                               f"room for more poles): fitted on its net as it is; {where}")

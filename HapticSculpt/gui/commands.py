@@ -954,14 +954,9 @@ class Group:
 
 
 def refuse(what: str, exc: BaseException) -> None:
-    """A refusal as a designer reads it: one plain line in the report view, and in the HUD of a
-    running session (never a traceback: the message says what to do)."""
-    text = f"{what}: {exc}"
-    FreeCAD.Console.PrintWarning(f"HapticSculpt: {text}\n")
-    ctl = _ctl()
-    if ctl.session is not None:
-        for overlay in ctl.overlays_of(ctl.session.obj):
-            overlay.refusal(text)
+    """A refusal as a designer reads it (see workbench.refuse)."""
+    from .workbench import refuse as say
+    say(what, exc)
 
 
 def _refusals_said_plainly(command: type) -> type:

@@ -394,7 +394,6 @@ class Controller:
             else:
                 self.toggle_map()
         except (ValueError, TypeError, RuntimeError) as exc:  # (what the API refused, said plainly)
-            from .commands import refuse
             refuse(f"key {key.upper()} ({KEYS.get(key, 'map')})", exc)
         cb.setHandled()
 
@@ -846,6 +845,18 @@ def _alive_document(doc: Any) -> bool:
 
 
 _CONTROLLER: list[Controller] = []
+
+
+def refuse(what: str, exc: BaseException) -> None:
+    """A refusal as a designer reads it: one plain line in the report view, and in the HUD of a
+    running session (never a traceback: the message says what to do)."""
+    import FreeCAD
+    text = f"{what}: {exc}"
+    FreeCAD.Console.PrintWarning(f"HapticSculpt: {text}\n")
+    ctl = controller()
+    if ctl.session is not None:
+        for overlay in ctl.overlays_of(ctl.session.obj):
+            overlay.refusal(text)
 
 
 def controller() -> Controller:
