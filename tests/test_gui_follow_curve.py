@@ -148,3 +148,71 @@ def test_follow_curve_pulls_the_patch_onto_a_sketch_keeps_it_through_a_stroke_g1
         d.shot("follow_off")
     finally:
         d.close()
+
+
+#: A 10 x 10 clay patch and the issue's arc in a sketch standing across it at x = -35 (a cubic
+#: through 9 points, 8 mm high in the middle), which its net cannot follow within 0.001 mm.
+ARC_SCENE = """
+import json, os
+import numpy as np
+import FreeCAD, FreeCADGui, Part
+import HapticSculpt as hs
+V = FreeCAD.Vector
+doc = FreeCAD.newDocument("Arc")
+obj = hs.make_sculpt(doc, controls=(10, 10), material="clay")
+sketch = doc.addObject("Sketcher::SketchObject", "Arc")
+sketch.Placement = FreeCAD.Placement(V(-35, 0, 0), FreeCAD.Rotation(V(1, 1, 1), 120))  # (its x, y: y, z)
+arc = Part.BSplineCurve()
+arc.interpolate([V(y, 8 * np.cos(np.pi * y / 90), 0) for y in np.linspace(-45, 45, 9)])
+sketch.addGeometry(arc, False)
+doc.recompute()
+doc.saveAs(PATH)
+json.dump({"controls": list(obj.Proxy.surface.surface.controls)}, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_follow_curve_refines_a_coarse_net_says_so_and_holds_through_a_stroke_beside_it(tmp_path):
+    path = str(tmp_path / "arc.FCStd")
+    assert run_freecad_gui(f"PATH = {path!r}\n" + ARC_SCENE, str(tmp_path))["controls"] == [10, 10]
+    d = Desktop(str(tmp_path), "CAD", open_file=path)
+    try:
+        s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["sculpts"] and sculpt(s)["screen"], "the file")
+        d.xdo("mousemove", "640", "500", "key", "0")  # isometric
+        d.xdo("key", "--delay", "150", "v", "f")  # fit all
+        d.calibrate()
+        s = d.state()
+        click_in_view(d, [sculpt(s)["screen"][3]], "Sculpt")
+        d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sculpt"], "the patch selected")
+        click_in_view(d, s["docs"][s["active"]]["edge_points"]["Arc"], "Arc", add=True)
+        d.wait(lambda s: sorted(o for o, _ in s["selection"]) == ["Arc", "Sculpt"], "the arc selected too")
+        s = d.press_button("FollowCurve", lambda s: curves(s), "the sculpt following the arc")
+        [(kind, distance, _)] = curves(s)
+        assert kind == "G0" and distance <= 0.001, curves(s)
+        assert undo(s)[0] == "Follow curve", undo(s)[:3]
+        assert len(sculpt(s)["poles"]) > 3 * 10 * 10, "the net was refined"
+        said = "refined to 13 x 17 controls to follow Arc within 0.001 mm"
+        s = d.wait(lambda s: any(said in o["status_text"] for o in s["overlays"]) and said in (s.get("report") or ""),
+                   "the refinement said in the HUD and the report view")
+        assert "Traceback" not in s["report"], s["report"][-2000:]
+        d.shot("follow_refined")
+        # a mouse stroke 10 mm beside the arc: the surface still passes through it
+        beside = d.points_to_screen([(-25.0, 0.0, 6.0)])[0]
+        poles = np.array(sculpt(s)["poles"])
+        d.press_button("Session", lambda s: sculpt(s)["session"], "the session")
+        d.drag([beside] + [(beside[0], beside[1] - 8 * k) for k in range(1, 7)], seconds=0.6)
+        d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
+        d.click_button("Session")
+        s = d.wait(lambda s: not sculpt(s)["session"], "the session to stop")
+        assert np.abs(np.array(sculpt(s)["poles"]) - poles).max() > 1.0, "the stroke moved the patch"
+        [(kind, distance, _)] = curves(s)
+        assert kind == "G0" and distance <= 0.001, curves(s)
+        d.shot("follow_refined_stroked")
+        # Undo twice: the stroke, then the curve and its refinement (the 10 x 10 net back)
+        d.shortcut("ctrl+z", "Std_Undo")
+        d.wait(lambda s: undo(s)[0] == "Follow curve", "Undo of the stroke")
+        d.shortcut("ctrl+z", "Std_Undo")
+        d.wait(lambda s: not curves(s) and len(sculpt(s)["poles"]) == 3 * 10 * 10, "Undo of Follow curve: 10 x 10 again")
+    finally:
+        d.close()

@@ -525,7 +525,17 @@ class FollowCurve:
         except Exception as exc:  # noqa: BLE001 - doCommand raises what the call raised, as its own type
             FreeCAD.Console.PrintWarning(f"HapticSculpt: {target.Label} cannot follow it: {exc}\n")
             return
-        _ctl().refresh(sculpt_for(target))  # (the curve drawn on the surface)
+        sculpt = sculpt_for(target)
+        _ctl().refresh(sculpt)  # (the curve drawn on the surface)
+        done = sculpt.Proxy.live.last_curve if now is None or now["continuity"] == "G0" else None
+        if done is not None and done["refined_to"] != done["refined_from"]:
+            # (a finer net is no change the designer sees: said in the report view and the HUD)
+            text = (f"refined to {done['refined_to'][0]} x {done['refined_to'][1]} controls to follow {label} within "
+                    f"{done['tolerance_mm']:g} mm")
+            FreeCAD.Console.PrintMessage(f"HapticSculpt: {target.Label}: {text}\n")
+            for overlay in _ctl().overlays_of(sculpt):
+                overlay.notice(text)
+            _ctl().refresh(sculpt)
         after = constraint_along(target, curve)
         FreeCAD.Console.PrintMessage(f"HapticSculpt: {target.Label} follows {label} {after['continuity']} "
                                      f"(within {after['distance_mm']:.2g} mm)\n" if after else

@@ -39,7 +39,7 @@ JACK_COLOURS = {"point": (1.0, 0.0, 0.0), "tangent": (1.0, 0.5, 0.0), "normal": 
 #: Curves the surface follows, drawn on it: G0 (through) and G1 (with its normal).
 CURVE_COLOURS = {"G0": (0.0, 0.9, 1.0), "G1": (1.0, 0.6, 0.0)}
 #: How long the HUD shows what a command refused (s).
-REFUSAL_SHOWN_S = 8.0
+NOTICE_SHOWN_S = 8.0
 #: The continuity check's combs, by what holds across the edge.
 CONTINUITY_COLOURS = {"G2": (0.1, 0.85, 0.2), "G1": (1.0, 0.9, 0.0), "G0": (1.0, 0.45, 0.0), "none": (1.0, 0.0, 0.0)}
 
@@ -72,7 +72,7 @@ class Overlay:
         self.stripe_mode = "reflection"  # zebra: "reflection" (view-dependent) or "isophote" (world-fixed)
         self.stripes = 12.0  # zebra: bands over a half turn
         self.status_text = ""  # the HUD's status line, as last drawn
-        self._refusal: tuple[str, float] | None = None  # (what was refused, when): shown a while
+        self._notice: tuple[str, float] | None = None  # (what a command refused or did, when): shown a while
         self.stripe_direction = (0.0, 0.0, 1.0)  # isophote: the direction the bands' angle is taken to
         self.stripe_angle = 0.0  # reflection: the light strips' angle from the view's up direction (degrees)
         self.per_pixel = True  # zebra per pixel where the driver runs GLSL (False: per mesh vertex)
@@ -102,9 +102,10 @@ class Overlay:
     # --- life cycle -------------------------------------------------------------------------------
     @property
     def needed(self) -> bool:
-        """True while anything is to be drawn each frame."""
+        """True while anything is to be drawn each frame (a notice too, until it is taken away)."""
         return bool((self._session() is not None and self.live) or self.panel_visible
-                    or ((self.display != "shading" or self.combs or self.continuity) and self.visible()))
+                    or ((self.display != "shading" or self.combs or self.continuity) and self.visible())
+                    or (self._notice is not None and self.visible()))
 
     @property
     def shown(self) -> bool:
@@ -170,9 +171,14 @@ class Overlay:
             self.hud.clear()
 
     def refusal(self, text: str) -> None:
-        """Shows what a command refused in the HUD's status line for REFUSAL_SHOWN_S (a session's
+        """Shows what a command refused in the HUD's status line for NOTICE_SHOWN_S (a session's
         designer has the device in hand, not the report view in sight)."""
-        self._refusal = (text, time.monotonic())  # (a session draws each frame: no redraw to ask for)
+        self.notice(f"refused: {text}")
+
+    def notice(self, text: str) -> None:
+        """Shows ``text`` (what a command did that the designer did not see happen: a net refined)
+        in the HUD's status line for NOTICE_SHOWN_S, from its next frame."""
+        self._notice = (text, time.monotonic())  # (a session draws each frame; else the caller refreshes)
 
     def alive(self) -> bool:
         """False once its view is closed or its object deleted."""
@@ -486,11 +492,11 @@ class Overlay:
             parts.append(continuity_text(self.continuity_worst))
         if self.mode:
             parts.append(self.mode)
-        if self._refusal is not None:
-            if time.monotonic() - self._refusal[1] <= REFUSAL_SHOWN_S:
-                parts.append(f"refused: {self._refusal[0]}")
+        if self._notice is not None:
+            if time.monotonic() - self._notice[1] <= NOTICE_SHOWN_S:
+                parts.append(self._notice[0])
             else:
-                self._refusal = None
+                self._notice = None
         return "  |  ".join(parts)
 
     def _deviation_text(self) -> str:
