@@ -305,9 +305,11 @@ def test_overlay_commands_keys_and_pictures(tmp_path):
     painted = load("map")  # (lit: the view's light shades the colours)
     assert colour_fraction(painted, lambda r, g, b: (r > 0.5) & (r > 2 * g) & (r > 2 * b)) > 1e-3  # hot where painted
     assert colour_fraction(painted, lambda r, g, b: (b > 0.4) & (b > 2 * r) & (b > 2 * g)) > 1e-2  # cold elsewhere
-    # the shape shows through a map: the cold part is shaded, not one flat blue
+    # the shape shows through a map: the cold part is shaded, not one flat blue (an unlit map's
+    # spread is 0; lit, 0.09 to 0.2 measured, as far as the session's strokes bent the patch, which
+    # under load is less: 0.09 on FreeCAD 1.1 in make test-gui-repeat-all)
     cold = painted[(painted[..., 2] > 0.4) & (painted[..., 2] > 2 * painted[..., 0]) & (painted[..., 2] > 2 * painted[..., 1])]
-    assert np.percentile(cold[:, 2], 95) - np.percentile(cold[:, 2], 5) > 0.1
+    assert np.percentile(cold[:, 2], 95) - np.percentile(cold[:, 2], 5) > 0.05
     zebra = load("zebra")
     assert colour_fraction(zebra, lambda r, g, b: (r > 0.9) & (g > 0.9) & (b > 0.9)) > 1e-2  # white bands
     # Per-pixel stripes against per-vertex colours: the share of the surface in soft or stepped
