@@ -16,6 +16,10 @@ import pytest
 from freecad_support import NO_SPLASH, ROOT, SCREENSHOTS, VirtualDisplay, make_addon_home, run_freecadcmd
 
 SHOTS = SCREENSHOTS
+#: How far a clay sheet may still coast from a state committed at a release (mm): 0.1 to 0.31
+#: measured (the most under make test's load, the commit then catching the sheet faster); a drop
+#: of a held drag that lifted it 2 mm is told from no drop by far less.
+COAST_MM = 0.5
 RECORD_BUTTON = (536, 552)  # the Record button of FreeCAD's macro recording dialog
 #: That dialog's title (a regular expression for xdotool): "Macro recording" up to FreeCAD 1.0,
 #: "Record Macro" in 1.1.
@@ -903,8 +907,9 @@ def test_esc_or_ctrl_z_during_a_drag_drops_the_stroke_in_hand_only(tmp_path):
                 d.xdo("mousemove", str(at[0]), str(at[1] - 8 * k))
             d.wait(lambda s: off(s) > 2.0, "the held drag to lift the patch")
             d.xdo("key", key)
-            # (within what a sheet coasts after a release: see test_a_clay_stroke_stays_where_it_was_left)
-            d.wait(lambda s: off(s) < 0.3, f"{key}: the surface from before the drag, the button still held")
+            # (within what a sheet coasts after a release, see test_a_clay_stroke_stays_where_it_was_left:
+            # 0.1 to 0.31 mm measured, the most under load; a quarter of the lift dropped)
+            d.wait(lambda s: off(s) < COAST_MM, f"{key}: the surface from before the drag, the button still held")
             for k in range(11, 16):
                 d.xdo("mousemove", str(at[0]), str(at[1] - 8 * k))
             d.xdo("mouseup", "1")
@@ -928,9 +933,9 @@ def test_esc_or_ctrl_z_during_a_drag_drops_the_stroke_in_hand_only(tmp_path):
         s = d.state()
         assert np.array_equal(np.array(sculpt(s)["poles"]), kept), "the kept stroke changed"
         drawn = np.array(sculpt(s)["drawn_poles"])
-        # (the kept stroke's state, taken back at rest: it settles by what a sheet coasts after a
-        # release, a tenth of a millimetre; see test_a_clay_stroke_stays_where_it_was_left)
-        assert np.abs(drawn - kept).max() < 0.3, f"the session shows {np.abs(drawn - kept).max():.3f} mm off the kept stroke"
+        # (the kept stroke's state, committed at its release while the sheet still moved: it settles
+        # by what a sheet coasts after a release, see COAST_MM; the drag dropped had lifted it 2 mm)
+        assert np.abs(drawn - kept).max() < COAST_MM, f"the session shows {np.abs(drawn - kept).max():.3f} mm off the kept stroke"
         assert sculpt(s)["strokes"] == 1, sculpt(s)["strokes"]
         d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
         s = d.state()  # (Stop keeps what was shown, in the kept stroke's step)
