@@ -357,13 +357,18 @@ class Desktop:
     def points_to_screen(self, points: list[tuple[float, float, float]]) -> list[tuple[int, int]]:
         """Screen pixels of 3D points (model coordinates) in the active 3D view, as the observer
         projects them (after :meth:`calibrate`)."""
+        return [self.to_screen(p) for p in self.points_in_view(points)]
+
+    def points_in_view(self, points: list[tuple[float, float, float]]) -> list[list[float]]:
+        """Viewport pixels of 3D points (model coordinates) in the active 3D view, as the observer
+        projects them."""
         self._probe = getattr(self, "_probe", 0) + 1
         tmp = self.state_file + ".points.tmp"
         with open(tmp, "w") as f:
             json.dump({"id": self._probe, "points": [list(map(float, p)) for p in points]}, f)
         os.replace(tmp, self.state_file + ".points")
         s = self.wait(lambda s: (s.get("points") or [None])[0] == self._probe, "the points projected")
-        return [self.to_screen(p) for p in s["points"][1]]
+        return s["points"][1]
 
     def to_screen(self, viewport: list[float]) -> tuple[int, int]:
         """Screen pixel of a viewport pixel of the active 3D view (see :meth:`calibrate`)."""
