@@ -153,3 +153,20 @@ def obj_seams(obj):
     """The sculpted solid's seam report (its edges with the base's faces)."""
     import json
     return json.loads(obj.SeamReport or "[]")
+
+
+class TestCurveRefusals(SolidChecks):
+    def test_a_curve_off_the_face_is_refused_and_changes_nothing(self):
+        """A line 35 mm past a 100 mm patch's edge is within a quarter of its size, and was followed
+        by dragging the edge out to it; a curve to follow lies over the face."""
+        obj = hs.make_sculpt(self.doc, controls=(10, 10))
+        n, poles = self.doc.UndoCount, np.array(obj.Poles)
+        with self.assertRaisesRegex(ValueError, r"runs off the face, 35 mm past its edge at \(.*, 85, 0\)"):
+            hs.add_curve_constraint(obj, Part.LineSegment(V(-30, 85, 0), V(30, 85, 0)).toShape())
+        with self.assertRaisesRegex(ValueError, r"runs off the face"):  # (partly over it, partly past)
+            hs.add_curve_constraint(obj, Part.LineSegment(V(0, 20, 0), V(0, 70, 0)).toShape())
+        self.assertEqual(self.doc.UndoCount, n)
+        self.assertTrue(np.array_equal(np.array(obj.Poles), poles))
+        # its edge itself is on the face: followed
+        hs.add_curve_constraint(obj, Part.LineSegment(V(-30, 50, 0), V(30, 50, 0)).toShape())
+        self.assertLessEqual(hs.curve_constraints_of(obj)[0]["distance_mm"], TOLERANCE)

@@ -44,6 +44,9 @@ FIRST_ID = 1_000_000
 SAMPLES = 200
 #: A curve farther than this share of the surface's size is refused rather than pulled onto.
 MAX_DISTANCE_SHARE = 0.25
+#: A curve that runs past the face's edge by more than this share of its size is off the face
+#: (refused: following it would drag the edge out to it).
+OFF_FACE_SHARE = 1e-4
 #: G0 holds when the surface passes within this share of its size of the curve.
 G0_SHARE = 1e-6
 #: G1 holds when the normal along the curve is within this angle of the one asked for (degrees).
@@ -567,6 +570,7 @@ def make(dynamic: core.DynamicSurface, curve: Any, continuity: str, normal: Any,
     if distance.max() > MAX_DISTANCE_SHARE * size:
         raise ValueError(f"curve: '{label}' runs up to {distance.max():.3g} mm from the surface, more than a quarter "
                          f"of the surface's size ({size:.3g} mm); move it closer, or sculpt toward it first")
+    _on_the_face(surface, poles, points, uv, label, OFF_FACE_SHARE * size)
     p, q = surface.degree
     cells = len({(a, b) for a, b in zip(_basis(np.asarray(surface.knots_u, float), p, uv[:, 0])[0],
                                         _basis(np.asarray(surface.knots_v, float), q, uv[:, 1])[0])})
@@ -600,6 +604,29 @@ def make(dynamic: core.DynamicSurface, curve: Any, continuity: str, normal: Any,
                                                                  if continuity == "G1" else ""),
                            "use more controls, or a curve nearer the surface or smoother", uv)
     return record, moved, list(links) + made
+
+
+def _on_the_face(surface: Any, poles: np.ndarray, points: np.ndarray, uv: np.ndarray, label: str,
+                 tolerance: float) -> None:
+    """ValueError where the curve runs off the face: its closest points lie on the face's edge and
+    it is away from them along the surface (past the edge), not across it (off the surface, where
+    the surface is pulled onto it), by more than ``tolerance``."""
+    (u0, u1), (v0, v1) = surface.domain
+    eps = 1e-12 * max(u1 - u0, v1 - v0)
+    edge = (np.abs(uv[:, 0] - u0) <= eps) | (np.abs(uv[:, 0] - u1) <= eps) | \
+        (np.abs(uv[:, 1] - v0) <= eps) | (np.abs(uv[:, 1] - v1) <= eps)
+    if not edge.any():
+        return
+    r = rows(surface, uv[edge])
+    gap = points[edge] - r.apply(r.s, poles)
+    n = normals(surface, poles, uv[edge])
+    past = np.linalg.norm(gap - (gap * n).sum(axis=1, keepdims=True) * n, axis=1)
+    if past.max() > tolerance:
+        k = int(np.argmax(past))
+        at = points[edge][k]
+        raise ValueError(f"curve: '{label}' runs off the face, {past[k]:.3g} mm past its edge at "
+                         f"({', '.join(f'{x:.4g}' for x in at)}); a curve to follow lies over the face (shorten it, "
+                         "or sculpt a larger face)")
 
 
 def refinement_knots(surface: Any, uv: np.ndarray, room: tuple[int, int]) -> tuple[list[float], list[float]]:

@@ -45,8 +45,10 @@ class SculptViewProvider(_Stateless):
                 ov.refresh()
 
     def updateData(self, obj: Any, prop: str) -> None:
-        if prop == "CurveConstraints" and not obj.Document.Restoring:  # the curves it follows show at once
-            from .workbench import controller  # (a document being read: its views draw it once it is)
+        # the curves it follows show at once; not while a document is read or undone / redone: its
+        # views draw it once it is (mid-Undo the net of a refining Follow curve was half restored)
+        if prop == "CurveConstraints" and not obj.Document.Restoring and not getattr(obj.Document, "Transacting", False):
+            from .workbench import controller
             ctl = controller()
             if ctl.inputs:
                 ctl.refresh(obj)
