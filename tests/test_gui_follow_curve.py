@@ -209,7 +209,9 @@ def test_follow_curve_refines_a_coarse_net_says_so_and_holds_through_a_stroke_be
         d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke")
         d.click_button("Session")
         s = d.wait(lambda s: not sculpt(s)["session"], "the session to stop")
-        assert np.abs(np.array(sculpt(s)["poles"]) - poles).max() > 1.0, "the stroke moved the patch"
+        # (it moved the patch: 3.9 mm on an idle machine, 0.9 under test-gui-repeat-all's load on
+        # FreeCAD 1.1; a hundred times the tolerance the curve is then checked against)
+        assert np.abs(np.array(sculpt(s)["poles"]) - poles).max() > 0.1, "the stroke moved the patch"
         [(kind, distance, _)] = curves(s)
         assert kind == "G0" and distance <= 0.001, curves(s)
         d.shot("follow_refined_stroked")
