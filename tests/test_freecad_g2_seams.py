@@ -221,6 +221,11 @@ class TestG2Seams(SolidChecks):
         self.assertTrue(0.5 < share["share"] < 1.0, share)
         text = continuity_text({**continuity_check.worst(found), "shares": continuity_check.shares(found, hs.boundary_of(obj))})
         self.assertIn(f"{seam} G2 over {100 * share['share']:.0f} %", text)
+        # the SeamReport says it too: worst point and share within G2
+        [row] = [r for r in hs.seam_report_of(obj) if r["edge"] == seam]
+        self.assertAlmostEqual(row["g2_within_pct"], 100.0 * share["share"], delta=5.0)
+        self.assertEqual(row["g1_within_pct"], 100.0)
+        self.assertGreater(row["g2_pct"], 1.0)
         levels = continuity_check.sample_levels(profile)  # (what the combs are coloured by, point by point)
         self.assertEqual(levels[len(levels) // 2], continuity_check.LEVELS.index("G2"))
         self.assertEqual(min(levels[0], levels[-1]), continuity_check.LEVELS.index("G1"))

@@ -22,7 +22,7 @@ from .api import BOUNDARIES, held_boundary
 from .sculpt_properties import read_state, surface_of
 from .sculpted_solid import _pieces, base_solid, boundary_of, solid_of
 
-G0_MM, G1_DEG, G2_PCT = 1e-7, 0.01, 1.0
+G0_MM, G1_DEG, G2_PCT = face_in_solid.G0_MM, face_in_solid.G1_DEG, face_in_solid.G2_PCT
 #: Samples along a held edge of a sculpt on its own, and at most along a curve.
 SAMPLES = 50
 
@@ -55,12 +55,7 @@ def sample_levels(profile: face_in_solid.EdgeProfile) -> np.ndarray:
         return np.full(n, LEVELS.index(level(profile)), int)
     if profile.g0_mm > G0_MM:
         return np.zeros(n, int)
-    (na, ka), (nb, kb) = profile.sides
-    cosine = np.clip(np.einsum("ij,ij->i", na, nb), -1.0, 1.0)
-    tangent = np.degrees(np.arccos(cosine)) <= G1_DEG
-    scale = np.maximum(np.maximum(np.abs(ka), np.abs(kb)), profile.floor)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        curvature = 100.0 * np.abs(ka - kb) / scale <= G2_PCT
+    tangent, curvature = face_in_solid.sample_tolerances(profile)
     return np.where(tangent, np.where(curvature, 3, 2), 1)
 
 

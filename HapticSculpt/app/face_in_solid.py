@@ -417,6 +417,33 @@ def _angle_between(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.degrees(np.arccos(np.clip(cosine.min(), -1.0, 1.0)))) if cosine.size else 0.0
 
 
+#: What an edge meets at a point: G0 within G0_MM (mm), G1 within G1_DEG (degrees between the
+#: sides' normals), G2 with a jump of the normal curvature across it within G2_PCT (percent).
+G0_MM, G1_DEG, G2_PCT = 1e-7, 0.01, 1.0
+
+
+def sample_tolerances(profile: EdgeProfile) -> tuple[np.ndarray, np.ndarray] | None:
+    """Per sample of an edge with two sides: whether their normals agree within G1_DEG, and
+    whether the normal curvature jumps across it by at most G2_PCT; None for an edge with one side."""
+    if len(profile.sides) < 2:
+        return None
+    (na, ka), (nb, kb) = profile.sides
+    cosine = np.clip(np.einsum("ij,ij->i", na, nb), -1.0, 1.0)
+    scale = np.maximum(np.maximum(np.abs(ka), np.abs(kb)), profile.floor)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.degrees(np.arccos(cosine)) <= G1_DEG, 100.0 * np.abs(ka - kb) / scale <= G2_PCT
+
+
+def _with_shares(report: dict[str, Any], profile: EdgeProfile) -> dict[str, Any]:
+    """``report`` with the share of the edge's samples (percent) within G1 and within G2
+    (``g1_within_pct``, ``g2_within_pct``; None for an edge with one side): a seam whose worst
+    point says 100 % at its ends can be G2 over most of its length."""
+    within = sample_tolerances(profile)
+    g1, g2 = (None, None) if within is None else (100.0 * float(np.mean(within[0])),
+                                                  100.0 * float(np.mean(within[0] & within[1])))
+    return {**report, "g1_within_pct": g1, "g2_within_pct": g2}
+
+
 def seam_report(surface: Any, shape: Any, face_name: str, kinds: dict[str, str],
                 skip: frozenset[str] = frozenset()) -> list[dict[str, Any]]:
     """For each edge of ``shape``'s face ``face_name`` sculpted to ``surface``: the largest distance
@@ -426,9 +453,10 @@ def seam_report(surface: Any, shape: Any, face_name: str, kinds: dict[str, str],
     the largest jump of the normal curvature across it between the sculpted face and the face on
     its other side as the base has it (``g2_pct``: percent of the larger |kappa|, see
     :func:`curvature_jump_pct`; the face's own seam: the sculpted surface on both sides; None on a
-    degenerate edge), at SEAM_SAMPLES points per edge (per side of a seam). Edges in ``skip``
-    (seams between sculpted faces, see :func:`seam_between`) are left out."""
-    return [{"edge": p.edge, "g0_mm": p.g0_mm, "g1_deg": p.g1_deg, "g2_pct": p.g2_pct}
+    degenerate edge), and the share of its samples within G1 and G2 (:func:`_with_shares`), at
+    SEAM_SAMPLES points per edge (per side of a seam). Edges in ``skip`` (seams between sculpted
+    faces, see :func:`seam_between`) are left out."""
+    return [_with_shares({"edge": p.edge, "g0_mm": p.g0_mm, "g1_deg": p.g1_deg, "g2_pct": p.g2_pct}, p)
             for p in edge_profiles(surface, shape, face_name, kinds, skip)]
 
 
@@ -485,9 +513,10 @@ def seam_between(surfaces: dict[str, Any], shape: Any, faces: tuple[str, str], e
     in its own parameters): the largest distance between the two surfaces along it (``g0_mm``),
     for G1 the largest angle (degrees) between their normals there (``g1_deg``), and the largest
     jump of the normal curvature across it between them (``g2_pct``, see :func:`curvature_jump_pct`),
-    at SEAM_SAMPLES points (the edge's pcurves on both faces share its parameter)."""
+    at SEAM_SAMPLES points (the edge's pcurves on both faces share its parameter), and the share of
+    them within G1 and G2 (:func:`_with_shares`)."""
     p = seam_profile(surfaces, shape, faces, edge, kind)
-    return {"edge": p.edge, "g0_mm": p.g0_mm, "g1_deg": p.g1_deg, "g2_pct": p.g2_pct}
+    return _with_shares({"edge": p.edge, "g0_mm": p.g0_mm, "g1_deg": p.g1_deg, "g2_pct": p.g2_pct}, p)
 
 
 def seam_profile(surfaces: dict[str, Any], shape: Any, faces: tuple[str, str], edge: str, kind: str) -> EdgeProfile:
