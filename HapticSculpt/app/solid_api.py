@@ -14,6 +14,7 @@ from .api import _add_sculpt, _checked_resolution, _document, _material, _sculpt
 from .source_surface import SourceSurface
 from .face_net import TRIM_SPANS, Mirror, face_held, face_source, g2_net, mirror_of, seam_kinds, seam_links
 from .face_walls import face_walls
+from .sculpt_properties import read_state
 from .sculpted_solid import (
     SculptedSolidFeature,
     attach_view_provider,
@@ -207,6 +208,10 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "bas
         # span no mass point sees leaves the mass matrix singular)
         mesh = (max(mesh[0], 2 * controls[0]), max(mesh[1], 2 * controls[1]))
     kinds = net_kinds
+    made, ends = _g2_ends_refined(made, kinds, seams)
+    if ends:  # (a G2 seam: G2 over all but a short span at each end)
+        made, held, links = _holds(made, chain, edges, kinds, mirror, ", ".join(faces))
+        mesh = (mesh[0], max(mesh[1], 2 * made.surface.controls[1]))
     walls = face_walls(shape, faces, edges, kinds, made.surface.poles, held + [link[0] for link in links])
     state = _sculpt_state(made, mesh, material, held, mirror.settings() if mirror else None, links, walls)
     if doc.UndoMode == 0:
@@ -221,12 +226,51 @@ def sculpt_solid(doc: Any, base: Any, faces: Sequence[str], boundary: Any = "bas
         obj.Sculpts = [sculpt]
         obj.Symmetry = json.dumps(mirror.settings() if mirror else None)
         obj.Layout = chain.dumps() if len(faces) > 1 else ""
-        obj.Resolution = json.dumps({"controls": list(controls), "degree": list(degree), "trim_spans": TRIM_SPANS})
+        obj.Resolution = json.dumps({"controls": list(controls), "degree": list(degree), "trim_spans": TRIM_SPANS,
+                                     **({"fit_knots": [[], ends]} if ends else {})})
         obj.SourcePoles = np.asarray(made.surface.poles, float).ravel().tolist()
         rebuild(obj)
         obj.purgeTouched()  # (built from its base just now: nothing to recompute)
         attach_view_provider(obj)
     return obj
+
+
+#: A G2 seam's end spans along it are refined to at most this share of its parameter range: where
+#: it ends on an edge held to a face that is not sculpted, the end span cannot be G2 (the edge's
+#: rows and the seam's conditions meet there), and the seam fades over it: a third of a 100 mm
+#: seam on 8 controls (67 % G2), 6 % once refined so (94 %).
+G2_END_SHARE = 1.0 / 32.0
+
+
+def g2_end_knots(surface: core.BSplineSurface, kinds: dict[str, str], seams: set[str]) -> list[float]:
+    """The knots along the seams (v: faces are joined along u) that bring the net's end spans to
+    G2_END_SHARE of the range, halving each end span, when a seam in ``seams`` is held G2 or G3;
+    none otherwise."""
+    if not any(kinds.get(e) in ("G2", "G3") for e in seams):
+        return []
+    breaks = sorted(set(float(k) for k in surface.knots_v))
+    lo, hi = breaks[0], breaks[-1]
+    limit = G2_END_SHARE * (hi - lo) * (1.0 + 1e-9)
+    out: list[float] = []
+    first, last = breaks[1], breaks[-2]
+    while first - lo > limit:
+        first = 0.5 * (lo + first)
+        out.append(first)
+    while hi - last > limit:
+        last = 0.5 * (last + hi)
+        out.append(last)
+    return sorted(out)
+
+
+def _g2_ends_refined(made: Any, kinds: dict[str, str], seams: set[str], most: int | None = None) -> tuple[Any, list[float]]:
+    """``made`` with :func:`g2_end_knots` inserted (exactly: the shape is kept), and those knots;
+    as it is where that would make more than ``most`` controls along v (a mesh sculpted already
+    has two mass points per span at least)."""
+    from .source_surface import refined
+    ends = g2_end_knots(made.surface, kinds, seams)
+    if not ends or (most is not None and made.surface.controls[1] + len(ends) > most):
+        return made, []
+    return SourceSurface(refined(made.surface, ([], ends)), made.method, made.error, made.description), ends
 
 
 def _rehold_as_base(obj: Any, made: Any, edges: list[face_in_solid.FaceEdge], kinds: dict[str, str]) -> Any:
@@ -266,6 +310,8 @@ def _boundary_plan(obj: Any, boundary: Any) -> tuple[dict[str, str], Any, list[i
     made = _rehold_as_base(obj, _made_of(sculpt_of(obj)), edges, kinds)
     if isinstance(boundary, str):  # (a seam is as tangent as its faces let it be)
         kinds = seam_kinds(made, chain, kinds, set())
+    mesh = read_state(sculpt_of(obj)).settings["mesh"]
+    made, _ = _g2_ends_refined(made, kinds, chain.seam_edges(), mesh[1] // 2)
     made, held, links = _holds(made, chain, edges, kinds, mirror_of(obj), ", ".join(faces))
     walls = face_walls(shape, faces, edges, kinds, made.surface.poles, held + [link[0] for link in links])
     return kinds, made, held, links, walls
@@ -328,6 +374,9 @@ def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
     if live.session is not None:
         raise RuntimeError(f"{obj.Label}: stop the sculpting session before changing how its edges are held")
     surface = live.surface
+    before = surface.surface
+    if tuple(made.surface.controls) != tuple(before.controls):  # (refined toward a G2 seam's ends)
+        surface = _on_net(surface, made.surface)
     shape = np.asarray(made.surface.poles).shape
     # (a G2 seam made so: the least move; the curves it follows held again on top: ValueError first)
     poles, links, write_curves = curve_api.rehold(sculpt, surface, held, links,
@@ -336,11 +385,27 @@ def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
         surface.set_poles(poles.reshape(shape))
         surface.hold_poles(held, links)
         surface.set_walls(walls)
+        if surface is not live.surface:
+            record_refinement(obj, before, surface.surface)
         live.write(sculpt_state.capture(surface))
+        if surface is not live.surface:
+            live.document_changed()  # (the cached surface is the coarser one: read it again)
         write_curves()
         obj.Boundary = json.dumps(kinds)
         rebuild(obj)
     return kinds
+
+
+def _on_net(surface: Any, net: core.BSplineSurface) -> Any:
+    """A working copy of ``surface`` (its material, mesh and tool) on the finer ``net`` (its knots
+    inserted: the same shape), at rest; held as before nothing (the caller holds it)."""
+    state = sculpt_state.capture(surface)
+    controls = tuple(net.controls)
+    state.settings.update(controls=list(controls), held_poles=[], linked_poles=[], walls=[])
+    state.arrays.update(Poles=np.asarray(net.poles, float).ravel(), Velocities=np.zeros(np.asarray(net.poles).size),
+                        KnotsU=np.asarray(net.knots_u, float), KnotsV=np.asarray(net.knots_v, float),
+                        Weights=np.zeros(0) if net.weights is None else np.asarray(net.weights, float).ravel())
+    return sculpt_state.restore(state)
 
 
 def next_holds(obj: Any, edges: Sequence[str] = ()) -> dict[str, str]:
