@@ -4,6 +4,8 @@ links that keep it so, a block's top and its round made G2 across their seam and
 strokes, undo and a saved file, the default G2 for faces that meet so already, and the refusals."""
 from __future__ import annotations
 
+import json
+
 import FreeCAD
 import numpy as np
 import Part
@@ -197,10 +199,13 @@ class TestG2Seams(SolidChecks):
         # leaves 1.6e-3 here, the same open question below)
         obj = hs.sculpt_solid(self.doc, part, [top, round_], boundary="G0")
         pull(obj, (50, 6, 29), (0, -3, 5))
-        steps = self.doc.UndoCount
+        steps, net = self.doc.UndoCount, np.array(obj.Sculpts[0].Poles)
         hs.set_boundary(obj, {seam: "G2"})
         self.assertEqual(self.doc.UndoCount, steps + 1)
         self.assertEqual(hs.boundary_of(obj)[seam], "G2")
+        # (refined toward the seam's ends in the same step: 16 x 8 controls became 16 x 13)
+        self.assertEqual(tuple(obj.Sculpts[0].Proxy.surface.surface.controls), (16, 13))
+        self.assertEqual(json.loads(obj.Resolution)["fit_knots"][1], [3.125, 6.25, 87.5, 93.75, 96.875])
         # (measured 3-5e-4 all along the seam here since clay keeps the whole pull beside it, 9e-5 when
         # it sprang back. The conditions hold at each column of poles (to 1e-13), not between them:
         # there the surface's jump is sum_j m_j(v) beta_j S_u,j, which leaves the tangent plane where
@@ -213,6 +218,10 @@ class TestG2Seams(SolidChecks):
         self.assertEqual(hs.boundary_of(obj)[seam], "G1")
         self.doc.undo()
         self.assertEqual(hs.boundary_of(obj)[seam], "G2")
+        self.doc.undo()
+        self.doc.undo()  # (the pull, then Hold edges: the net as it was)
+        self.assertTrue(np.array_equal(np.array(obj.Sculpts[0].Poles), net))
+        self.assertNotIn("fit_knots", json.loads(obj.Resolution))
 
     def test_the_check_says_over_how_much_of_its_length_a_seam_is_g2(self):
         """A G2 seam ending on edges held to faces that are not sculpted is G2 in its middle and
