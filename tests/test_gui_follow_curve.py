@@ -166,8 +166,6 @@ sketch.Placement = FreeCAD.Placement(V(-35, 0, 0), FreeCAD.Rotation(V(1, 1, 1), 
 arc = Part.BSplineCurve()
 arc.interpolate([V(y, 8 * np.cos(np.pi * y / 90), 0) for y in np.linspace(-45, 45, 9)])
 sketch.addGeometry(arc, False)
-far = doc.addObject("Sketcher::SketchObject", "Far")  # (35 mm past its edge: off the face)
-far.addGeometry(Part.LineSegment(V(-30, 85, 0), V(30, 85, 0)), False)
 doc.recompute()
 doc.saveAs(PATH)
 json.dump({"controls": list(obj.Proxy.surface.surface.controls)}, open({answer}, "w"))
@@ -219,21 +217,6 @@ def test_follow_curve_refines_a_coarse_net_says_so_and_holds_through_a_stroke_be
         d.shortcut("ctrl+z", "Std_Undo")
         d.wait(lambda s: undo(s)[0] == "Follow curve", "Undo of the stroke")
         d.shortcut("ctrl+z", "Std_Undo")
-        s = d.wait(lambda s: not curves(s) and len(sculpt(s)["poles"]) == 3 * 10 * 10, "Undo of Follow curve: 10 x 10 again")
-        # a sketch off the face (35 mm past the patch's edge): refused in one line, nothing changed
-        size = next(v for v in s["views"] if v["active"])["size"]
-        empty = d.to_screen([20, size[1] // 2])  # (the view's left edge, beside the patch: nothing there)
-        d.xdo("mousemove", str(empty[0]), str(empty[1]), "click", "1")
-        d.wait(lambda s: s["selection"] == [], "nothing selected")
-        click_in_view(d, [sculpt(s)["screen"][3]], "Sculpt")
-        d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sculpt"], "the patch selected")
-        click_in_view(d, d.points_in_view([(x, 85.0, 0.0) for x in (0.0, -10.0, 10.0)]), "Far", add=True)
-        d.wait(lambda s: sorted(o for o, _ in s["selection"]) == ["Far", "Sculpt"], "the far sketch selected too")
-        d.click_button("FollowCurve")
-        s = d.wait(lambda s: "runs off the face, 35 mm past its edge" in (s.get("report") or ""),
-                   "the refusal in the report view")
-        assert "Traceback" not in s["report"], s["report"][-2000:]
-        assert not curves(s) and undo(s) == [], undo(s)  # (nothing changed)
-        d.shot("follow_refused")
+        d.wait(lambda s: not curves(s) and len(sculpt(s)["poles"]) == 3 * 10 * 10, "Undo of Follow curve: 10 x 10 again")
     finally:
         d.close()
