@@ -33,6 +33,7 @@ from .app.api import (
 )
 from .app.curve_api import curve_constraints_of
 from .app.curve_follow import add_curve_constraint
+from .app.curve_network import make_sculpt_from_curves
 from .app.scan_api import clear_target, deviation_of, fit_to_target, pull_of, set_pull, set_target, target_object
 from .app.sculpted_solid import boundary_of, seam_report_of
 from .app.solid_api import sculpt_solid, set_boundary
@@ -43,6 +44,7 @@ from .version import __version__
 legacy_paths.install()
 
 __all__ = ["make_sculpt", "fair", "sculpt_solid", "set_boundary", "boundary_of", "seam_report_of", "run", "add_constraint", "add_curve_constraint",
+           "make_sculpt_from_curves",
            "curve_constraints_of", "remove_constraint", "hold_boundary", "held_boundary",
            "set_material", "material_of", "keep_shape", "set_regional",
            "set_tool", "set_uniform", "scale_map", "set_curvature_target", "paint", "record_state", "replay_stroke",

@@ -541,13 +541,15 @@ def relink(dynamic: core.DynamicSurface, records: list[CurveConstraint], held: l
 
 
 def make(dynamic: core.DynamicSurface, curve: Any, continuity: str, normal: Any, cid: int, held: list[int],
-         links: list[tuple[Any, ...]], records: list[CurveConstraint] = (), tolerance: float | None = None
-         ) -> tuple[CurveConstraint, np.ndarray, list[tuple[Any, ...]]]:
+         links: list[tuple[Any, ...]], records: list[CurveConstraint] = (), tolerance: float | None = None,
+         edge: bool = False) -> tuple[CurveConstraint, np.ndarray, list[tuple[Any, ...]]]:
     """A new curve constraint on ``dynamic``, on top of ``held``, ``links`` (those that are not the
     curves') and the curves ``records`` it holds already: the record, the poles moved onto the curve
     and all links. ``tolerance``: how near the surface must pass the curve, everywhere along it (mm;
-    None: G0_SHARE of the size). ValueError saying why where it cannot hold; NetTooCoarse where
-    the net has too little freedom along the curve (a finer net may follow it)."""
+    None: G0_SHARE of the size). ``edge``: the curve is meant to be an edge of the surface (a
+    patch made through a curve network pulls its edge onto it), so it may run past the face's edge.
+    ValueError saying why where it cannot hold; NetTooCoarse where the net has too little freedom
+    along the curve (a finer net may follow it)."""
     if continuity not in CONTINUITIES:
         raise ValueError(f"continuity: one of {', '.join(CONTINUITIES)}, not {continuity!r}")
     if normal is not None:
@@ -570,7 +572,8 @@ def make(dynamic: core.DynamicSurface, curve: Any, continuity: str, normal: Any,
     if distance.max() > MAX_DISTANCE_SHARE * size:
         raise ValueError(f"curve: '{label}' runs up to {distance.max():.3g} mm from the surface, more than a quarter "
                          f"of the surface's size ({size:.3g} mm); move it closer, or sculpt toward it first")
-    _on_the_face(surface, poles, points, uv, label, OFF_FACE_SHARE * size)
+    if not edge:
+        _on_the_face(surface, poles, points, uv, label, OFF_FACE_SHARE * size)
     p, q = surface.degree
     cells = len({(a, b) for a, b in zip(_basis(np.asarray(surface.knots_u, float), p, uv[:, 0])[0],
                                         _basis(np.asarray(surface.knots_v, float), q, uv[:, 1])[0])})
