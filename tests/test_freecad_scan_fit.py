@@ -324,7 +324,7 @@ class TestFitAcrossSeams(SolidChecks):
         self.assertEqual(hs.boundary_of(solid)[seam], "G2")
         surface = sculpted_surface(sculpt)
         jumps, vs = seam_jumps(surface, seam_knot(surface))
-        self.assertLessEqual(float(jumps[interior(surface, vs)].max()), 0.01)
+        self.assertLessEqual(float(jumps[interior(sculpt, vs)].max()), 0.01)
         front = solid.Shape.BoundBox
         self.assertAlmostEqual(front.YMin, 0.0, delta=1e-6)  # (the round swelled 2-20 mm out of the part)
         self.assertTrue(solid.Shape.isValid())
