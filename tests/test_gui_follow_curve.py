@@ -57,8 +57,8 @@ def click_in_view(d: Desktop, points: list[list[float]], name: str, add: bool = 
                 d.wait(lambda s: cursor(s) != before, "the view to see the mouse move", 5.0, shot=False)
             except AssertionError:
                 pass  # (no move to see: the pointer was there already)
-            try:
-                d.wait(lambda s: (s["preselection"] or [None])[0] == name, f"{name} highlighted", 0.4, shot=False)
+            try:  # (the highlight took over 0.4 s with three FreeCADs running: 1 s)
+                d.wait(lambda s: (s["preselection"] or [None])[0] == name, f"{name} highlighted", 1.0, shot=False)
             except AssertionError:
                 continue
             d.xdo(*(["keydown", "ctrl", "click", "1", "keyup", "ctrl"] if add else ["click", "1"]))
@@ -93,7 +93,7 @@ def test_follow_curve_pulls_the_patch_onto_a_sketch_keeps_it_through_a_stroke_g1
         before = d.shot("follow_before")
         # the patch clicked, then the sketch's line ctrl+clicked (5 mm above the patch)
         s = d.state()
-        click_in_view(d, [sculpt(s)["screen"][3]], "Sculpt")
+        click_in_view(d, [sculpt(s)["screen"][0], sculpt(s)["screen"][3]], "Sculpt")
         d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sculpt"], "the patch selected")
         click_in_view(d, s["docs"][s["active"]]["edge_points"]["Sketch"], "Sketch", add=True)
         d.wait(lambda s: sorted(o for o, _ in s["selection"]) == ["Sculpt", "Sketch"], "the sketch selected too")
@@ -187,7 +187,7 @@ def test_follow_curve_refines_a_coarse_net_says_so_and_holds_through_a_stroke_be
         d.calibrate()
         d.wait_still(lambda s: sculpt(s)["screen"], "the patch on screen after the fit")  # (the keys take a while)
         s = d.state()
-        click_in_view(d, [sculpt(s)["screen"][3]], "Sculpt")
+        click_in_view(d, [sculpt(s)["screen"][0], sculpt(s)["screen"][3]], "Sculpt")
         d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sculpt"], "the patch selected")
         click_in_view(d, s["docs"][s["active"]]["edge_points"]["Arc"], "Arc", add=True)
         d.wait(lambda s: sorted(o for o, _ in s["selection"]) == ["Arc", "Sculpt"], "the arc selected too")
@@ -227,7 +227,7 @@ def test_follow_curve_refines_a_coarse_net_says_so_and_holds_through_a_stroke_be
         empty = d.to_screen([20, size[1] // 2])  # (the view's left edge, beside the patch: nothing there)
         d.xdo("mousemove", str(empty[0]), str(empty[1]), "click", "1")
         d.wait(lambda s: s["selection"] == [], "nothing selected")
-        click_in_view(d, [sculpt(s)["screen"][3]], "Sculpt")
+        click_in_view(d, [sculpt(s)["screen"][0], sculpt(s)["screen"][3]], "Sculpt")
         d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sculpt"], "the patch selected")
         click_in_view(d, d.points_in_view([(0.0, y, 0.0) for y in (55.0, 52.0, 58.0)]), "Off", add=True)
         d.wait(lambda s: sorted(o for o, _ in s["selection"]) == ["Off", "Sculpt"], "the sketch selected too")
