@@ -948,7 +948,8 @@ def test_esc_or_ctrl_z_during_a_drag_drops_the_stroke_in_hand_only(tmp_path):
         d.press_button("Session", lambda s: not sculpt(s)["session"], "the session to stop")
         s = d.state()  # (Stop keeps what was shown, in the kept stroke's step)
         assert undo(s) == ["Sculpt stroke"] + steps, undo(s)
-        assert np.abs(np.array(sculpt(s)["poles"]) - kept).max() < 0.3, "Stop kept another surface"
+        # (what was shown: the kept stroke and what the sheet coasted after it, COAST_MM; 0.33 mm on 1.1 in make test)
+        assert np.abs(np.array(sculpt(s)["poles"]) - kept).max() < COAST_MM, "Stop kept another surface"
         d.shot("dropped_drags_kept_stroke")
         # the airbrush outside a session: Esc in a paint drag takes its dabs back, no step
         steps, plain = undo(s), sculpt(s)["stiffness_values"]
