@@ -66,6 +66,24 @@ def click_in_view(d: Desktop, points: list[list[float]], name: str, add: bool = 
     raise AssertionError(f"the mouse found no point of {name} to click")
 
 
+def isometric_fit(d: Desktop) -> None:
+    """The file's view made isometric and fitted by its keys, as a designer does, and calibrated."""
+    d.wait(lambda s: s["active"] and s["docs"][s["active"]]["sculpts"] and sculpt(s)["screen"], "the file")
+    d.xdo("mousemove", "640", "500", "key", "0")  # isometric
+    d.xdo("key", "--delay", "150", "v", "f")  # fit all
+    d.calibrate()
+    d.wait_still(lambda s: sculpt(s)["screen"], "the patch on screen after the fit")  # (the keys take a while)
+
+
+def pick_patch_and(d: Desktop, curve: str) -> None:
+    """The patch clicked in the view, then the curve object ``curve`` ctrl+clicked: both selected."""
+    s = d.state()
+    click_in_view(d, [sculpt(s)["screen"][0], sculpt(s)["screen"][3]], "Sculpt")
+    d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sculpt"], "the patch selected")
+    click_in_view(d, s["docs"][s["active"]]["edge_points"][curve], curve, add=True)
+    d.wait(lambda s: sorted(o for o, _ in s["selection"]) == sorted(["Sculpt", curve]), f"{curve} selected too")
+
+
 def wait_for_colour(d: Desktop, name: str, colour: tuple[float, float, float], what: str, timeout: float = 10.0) -> None:
     """Screenshots until a curve's worth of pixels (0.05 % of the screen) has ``colour``."""
     end = time.monotonic() + timeout
@@ -85,18 +103,10 @@ def test_follow_curve_pulls_the_patch_onto_a_sketch_keeps_it_through_a_stroke_g1
     tolerance = 1e-6 * size
     d = Desktop(str(tmp_path), "CAD", open_file=path)
     try:
-        s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["sculpts"] and sculpt(s)["screen"], "the file")
-        d.xdo("mousemove", "640", "500", "key", "0")  # isometric
-        d.xdo("key", "--delay", "150", "v", "f")  # fit all
-        d.calibrate()
-        d.wait_still(lambda s: sculpt(s)["screen"], "the patch on screen after the fit")  # (the keys take a while)
+        isometric_fit(d)
         before = d.shot("follow_before")
         # the patch clicked, then the sketch's line ctrl+clicked (5 mm above the patch)
-        s = d.state()
-        click_in_view(d, [sculpt(s)["screen"][0], sculpt(s)["screen"][3]], "Sculpt")
-        d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sculpt"], "the patch selected")
-        click_in_view(d, s["docs"][s["active"]]["edge_points"]["Sketch"], "Sketch", add=True)
-        d.wait(lambda s: sorted(o for o, _ in s["selection"]) == ["Sculpt", "Sketch"], "the sketch selected too")
+        pick_patch_and(d, "Sketch")
         s = d.press_button("FollowCurve", lambda s: curves(s), "the sculpt following the sketch")
         [(kind, distance, _)] = curves(s)
         assert kind == "G0" and distance <= tolerance, curves(s)
@@ -181,16 +191,8 @@ def test_follow_curve_refines_a_coarse_net_says_so_and_holds_through_a_stroke_be
     assert run_freecad_gui(f"PATH = {path!r}\n" + ARC_SCENE, str(tmp_path))["controls"] == [10, 10]
     d = Desktop(str(tmp_path), "CAD", open_file=path)
     try:
-        s = d.wait(lambda s: s["active"] and s["docs"][s["active"]]["sculpts"] and sculpt(s)["screen"], "the file")
-        d.xdo("mousemove", "640", "500", "key", "0")  # isometric
-        d.xdo("key", "--delay", "150", "v", "f")  # fit all
-        d.calibrate()
-        d.wait_still(lambda s: sculpt(s)["screen"], "the patch on screen after the fit")  # (the keys take a while)
-        s = d.state()
-        click_in_view(d, [sculpt(s)["screen"][0], sculpt(s)["screen"][3]], "Sculpt")
-        d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sculpt"], "the patch selected")
-        click_in_view(d, s["docs"][s["active"]]["edge_points"]["Arc"], "Arc", add=True)
-        d.wait(lambda s: sorted(o for o, _ in s["selection"]) == ["Arc", "Sculpt"], "the arc selected too")
+        isometric_fit(d)
+        pick_patch_and(d, "Arc")
         s = d.press_button("FollowCurve", lambda s: curves(s), "the sculpt following the arc")
         [(kind, distance, _)] = curves(s)
         assert kind == "G0" and distance <= 0.001, curves(s)

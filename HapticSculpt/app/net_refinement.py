@@ -36,16 +36,10 @@ def refined_work(sculpt: Any, work: Any, extra: tuple[list[float], list[float]]
         held = boundary_poles(tuple(finer.controls), kinds)
     else:
         finer, held, links, walls = refined_net(solid, work.surface, extra)
-    state = sculpt_state.capture(work)
-    new_controls = tuple(finer.controls)
-    mesh = tuple(state.settings["mesh"])
-    if mesh[0] < new_controls[0] or mesh[1] < new_controls[1]:
+    mesh = tuple(sculpt_state.capture(work).settings["mesh"])
+    if mesh[0] < finer.controls[0] or mesh[1] < finer.controls[1]:
         return None
-    state.settings.update(controls=list(new_controls), held_poles=[], linked_poles=[], walls=[])
-    state.arrays.update(Poles=np.asarray(finer.poles, float).ravel(), Velocities=np.zeros(finer.poles.size),
-                        KnotsU=np.asarray(finer.knots_u, float), KnotsV=np.asarray(finer.knots_v, float),
-                        Weights=np.zeros(0) if finer.weights is None else np.asarray(finer.weights, float).ravel())
-    return sculpt_state.restore(state), list(held), list(links), list(walls)
+    return sculpt_state.on_net(work, finer), list(held), list(links), list(walls)
 
 
 def refined_sculpt(sculpt: Any, work: Any, extra: tuple[list[float], list[float]]) -> Any:

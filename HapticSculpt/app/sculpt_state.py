@@ -315,3 +315,14 @@ def _apply_settings(surface: core.DynamicSurface, s: dict[str, Any]) -> None:
             apply_tool(surface, s["tool"])
     except (TypeError, ValueError) as exc:
         raise ValueError(f"SculptSettings: {exc}") from exc
+
+
+def on_net(surface: core.DynamicSurface, net: core.BSplineSurface) -> core.DynamicSurface:
+    """A working copy of ``surface`` (its material, mesh, maps and tool) on ``net`` (its knots
+    inserted: the same shape on a finer net), at rest and holding nothing (the caller holds it)."""
+    state = capture(surface)
+    state.settings.update(controls=list(net.controls), held_poles=[], linked_poles=[], walls=[])
+    state.arrays.update(Poles=np.asarray(net.poles, float).ravel(), Velocities=np.zeros(np.asarray(net.poles).size),
+                        KnotsU=np.asarray(net.knots_u, float), KnotsV=np.asarray(net.knots_v, float),
+                        Weights=np.zeros(0) if net.weights is None else np.asarray(net.weights, float).ravel())
+    return restore(state)

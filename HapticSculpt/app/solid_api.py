@@ -376,7 +376,7 @@ def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
     surface = live.surface
     before = surface.surface
     if tuple(made.surface.controls) != tuple(before.controls):  # (refined toward a G2 seam's ends)
-        surface = _on_net(surface, made.surface)
+        surface = sculpt_state.on_net(surface, made.surface)
     shape = np.asarray(made.surface.poles).shape
     # (a G2 seam made so: the least move; the curves it follows held again on top: ValueError first)
     poles, links, write_curves = curve_api.rehold(sculpt, surface, held, links,
@@ -395,17 +395,6 @@ def set_boundary(obj: Any, boundary: Any) -> dict[str, str]:
         rebuild(obj)
     return kinds
 
-
-def _on_net(surface: Any, net: core.BSplineSurface) -> Any:
-    """A working copy of ``surface`` (its material, mesh and tool) on the finer ``net`` (its knots
-    inserted: the same shape), at rest; held as before nothing (the caller holds it)."""
-    state = sculpt_state.capture(surface)
-    controls = tuple(net.controls)
-    state.settings.update(controls=list(controls), held_poles=[], linked_poles=[], walls=[])
-    state.arrays.update(Poles=np.asarray(net.poles, float).ravel(), Velocities=np.zeros(np.asarray(net.poles).size),
-                        KnotsU=np.asarray(net.knots_u, float), KnotsV=np.asarray(net.knots_v, float),
-                        Weights=np.zeros(0) if net.weights is None else np.asarray(net.weights, float).ravel())
-    return sculpt_state.restore(state)
 
 
 def next_holds(obj: Any, edges: Sequence[str] = ()) -> dict[str, str]:
