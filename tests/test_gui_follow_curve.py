@@ -46,6 +46,7 @@ def click_in_view(d: Desktop, points: list[list[float]], name: str, add: bool = 
     def cursor(s: dict) -> list | None:  # (where the view's last mouse event was)
         return next((v["pixel"] for v in s["views"] if v["active"]), None)
 
+    seen = set()  # (what the mouse highlighted instead, said when nothing was found)
     for at in points:
         x0, y0 = d.to_screen(at)
         # (FreeCAD 0.20's getPointOnScreen is some pixels off the view's own event coordinates)
@@ -60,10 +61,12 @@ def click_in_view(d: Desktop, points: list[list[float]], name: str, add: bool = 
             try:  # (the highlight took over 0.4 s with three FreeCADs running: 1 s)
                 d.wait(lambda s: (s["preselection"] or [None])[0] == name, f"{name} highlighted", 1.0, shot=False)
             except AssertionError:
+                seen.add(str((d.state()["preselection"] or [None])[0]))
                 continue
             d.xdo(*(["keydown", "ctrl", "click", "1", "keyup", "ctrl"] if add else ["click", "1"]))
             return
-    raise AssertionError(f"the mouse found no point of {name} to click")
+    d.shot(f"missed_{name}")
+    raise AssertionError(f"the mouse found no point of {name} to click (it highlighted {sorted(seen)})")
 
 
 def isometric_fit(d: Desktop) -> None:
@@ -79,7 +82,7 @@ def pick_patch_and(d: Desktop, curve: str) -> None:
     """The patch clicked in the view, then the curve object ``curve`` ctrl+clicked: both selected."""
     s = d.state()
     click_in_view(d, [sculpt(s)["screen"][0], sculpt(s)["screen"][3]], "Sculpt")
-    d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sculpt"], "the patch selected")
+    s = d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sculpt"], "the patch selected")
     click_in_view(d, s["docs"][s["active"]]["edge_points"][curve], curve, add=True)
     d.wait(lambda s: sorted(o for o, _ in s["selection"]) == sorted(["Sculpt", curve]), f"{curve} selected too")
 

@@ -211,14 +211,15 @@ def _preselection():
 
 
 def _edge_points(o):
-    """Where the middle of each edge of a curve object (a sketch, a wire: edges and no faces) is in
-    the active 3D view's viewport, to click it."""
+    """Where points of a curve object's edges (a sketch, a wire: edges and no faces) are in the
+    active 3D view's viewport, to click it: each edge's middle first, then its thirds (a point a
+    click misses has others to try)."""
     try:
         if o.Shape.Faces or not o.Shape.Edges:
             return []
         view = Gui.ActiveDocument.ActiveView
-        return [list(view.getPointOnScreen(e.valueAt(0.5 * (e.FirstParameter + e.LastParameter))))
-                for e in o.Shape.Edges]
+        return [list(view.getPointOnScreen(e.valueAt(e.FirstParameter + t * (e.LastParameter - e.FirstParameter))))
+                for t in (0.5, 1 / 3, 2 / 3) for e in o.Shape.Edges]
     except Exception:  # noqa: BLE001 - no active 3D view
         return []
 
