@@ -100,3 +100,30 @@ class TestCurveNetwork(SolidChecks):
             with self.assertRaisesRegex(ValueError, text, msg=str(kwargs)[:60]):
                 hs.make_sculpt_from_curves(self.doc, **kwargs)
         self.assertEqual([o.Name for o in self.doc.Objects], names)
+
+    def test_curves_selected_in_any_order_are_split_into_boundary_and_inside(self):
+        """As New patch from curves takes a selection: which close into the loop, which lie inside."""
+        from HapticSculpt.app.curve_network import split_network
+        sides, middle = self.dome()
+        self.assertEqual(split_network([middle, sides[1], sides[3], sides[0], sides[2]]), ([1, 2, 3, 4], [0]))
+        tri = [Part.LineSegment(V(-50, -40, 0), V(50, -40, 0)).toShape(), arc(V(50, -40, 0), V(0, 45, 0), 8.0),
+               arc(V(0, 45, 0), V(-50, -40, 0), 8.0)]
+        inside = Part.LineSegment(V(0, -40, 0), V(0, 20, 5)).toShape()  # (from the base's middle, no end)
+        self.assertEqual(split_network([tri[2], inside, tri[0], tri[1]]), ([0, 2, 3], [1]))
+        with self.assertRaisesRegex(ValueError, "no 3 or 4 of the 3 curves close into a loop"):
+            split_network(sides[:3])
+        with self.assertRaisesRegex(ValueError, "3 to 16 curves"):
+            split_network(sides[:2])
+
+    def test_a_picked_edge_is_named_as_freecad_names_it(self):
+        """(the object, "Edge2"): a curve as a picked edge, named so in what is said about it."""
+        from HapticSculpt.app.curve_constraint import curve_points
+        box = self.doc.addObject("Part::Feature", "Box")
+        box.Shape = Part.makeBox(10, 20, 30)
+        points, label = curve_points((box, "Edge2"), 10)
+        self.assertEqual(label, "Box Edge2")
+        self.assertAlmostEqual(float(np.linalg.norm(points[-1] - points[0])), box.Shape.Edge2.Length)
+        self.assertEqual(curve_points((box, "Wire1"), 10)[1], "Box Wire1")
+        for bad in ("Edge13", "Face1", "Edge"):
+            with self.assertRaisesRegex(ValueError, f"Box has no '{bad}' \\(it has 12 edges in 6 wires"):
+                curve_points((box, bad), 10)

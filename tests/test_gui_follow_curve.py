@@ -40,24 +40,49 @@ def curves(s: dict) -> list:
 
 
 def click_in_view(d: Desktop, points: list[list[float]], name: str, add: bool = False) -> None:
-    """Moves the mouse over object ``name`` in the 3D view, trying viewport pixels ``points`` and
-    a few pixels around each until FreeCAD highlights it, and clicks (ctrl+click: adds to the
+    """Moves the mouse over object ``name`` in the 3D view, trying viewport pixels ``points``, then
+    a few pixels around each, until FreeCAD highlights it, and clicks (ctrl+click: adds to the
     selection), as a designer hovers until the line lights up."""
     def cursor(s: dict) -> list | None:  # (where the view's last mouse event was)
         return next((v["pixel"] for v in s["views"] if v["active"]), None)
 
+    at_last = [None]  # (the screen pixel moved to last)
+
+    def move(x: int, y: int) -> list | None:  # (the view has seen the move: on a loaded machine the
+        # state written last can still be the point before, and a click trusted to its highlight
+        # missed the patch)
+        before = cursor(d.state())
+        if at_last[0] == (x, y):
+            return before
+        at_last[0] = (x, y)
+        d.xdo("mousemove", str(x), str(y))
+        try:
+            return cursor(d.wait(lambda s: cursor(s) != before, "the view to see the mouse move", 5.0, shot=False))
+        except AssertionError:
+            return before  # (no move to see: the pointer was there already)
+
+    def aim(at: list[float]) -> tuple[int, int]:
+        """The screen pixel where the view's events put the mouse at viewport pixel ``at``: the
+        calibrated guess corrected by where the view then saw the mouse (FreeCAD 0.20's calibration
+        is 4 % off the pixels its events and getPointOnScreen use: 30 px near the view's top)."""
+        x, y = d.to_screen(at)
+        for _ in range(2):
+            got = move(x, y)
+            if got is None or max(abs(at[0] - got[0]), abs(at[1] - got[1])) < 1:
+                break
+            x += round((at[0] - got[0]) * np.sign(d._map[0][2]))
+            y += round((at[1] - got[1]) * np.sign(d._map[1][2]))
+        return x, y
+
     seen = set()  # (what the mouse highlighted instead, said when nothing was found)
-    for at in points:
-        x0, y0 = d.to_screen(at)
-        # (FreeCAD 0.20's getPointOnScreen is some pixels off the view's own event coordinates)
-        for dx, dy in [(0, 0)] + [(dx, dy) for dy in range(-24, 25, 2) for dx in (0, 3)]:
-            before = cursor(d.state())
-            d.xdo("mousemove", str(x0 + dx), str(y0 + dy))
-            try:  # (the view has seen this move: on a loaded machine the state written last can
-                # still be the point before, and a click trusted to its highlight missed the patch)
-                d.wait(lambda s: cursor(s) != before, "the view to see the mouse move", 5.0, shot=False)
-            except AssertionError:
-                pass  # (no move to see: the pointer was there already)
+    aimed: dict[int, tuple[int, int]] = {}
+    # (each point at once, then a few pixels around each in turn: a point another object covers,
+    # as an edge's middle where a curve ends on it, costs one try, not a search)
+    for dx, dy in [(0, 0)] + [(dx, dy) for dy in range(-24, 25, 2) for dx in (0, 3)]:
+        for k, at in enumerate(points):
+            if k not in aimed:
+                aimed[k] = aim(at)
+            move(aimed[k][0] + dx, aimed[k][1] + dy)
             try:  # (the highlight took over 0.4 s with three FreeCADs running: 1 s)
                 d.wait(lambda s: (s["preselection"] or [None])[0] == name, f"{name} highlighted", 1.0, shot=False)
             except AssertionError:

@@ -266,7 +266,7 @@ def test_overlay_commands_keys_and_pictures(tmp_path):
     assert out["inactive"].pop("HapticSculpt_NewPatch") and out["inactive"].pop("HapticSculpt_NewClampedPatch")
     assert not any(v for k, v in out["inactive"].items()), out["inactive"]
     selection_based = {"HapticSculpt_SculptFace", "HapticSculpt_Thicken", "HapticSculpt_ExportStep",
-                       "HapticSculpt_FollowCurve", "HapticSculpt_SetTarget"}
+                       "HapticSculpt_FollowCurve", "HapticSculpt_SetTarget", "HapticSculpt_NewFromCurves"}
     target_based = {"HapticSculpt_ShowDeviation", "HapticSculpt_FitToTarget", "HapticSculpt_FreeEdgesAndFit",
                     "HapticSculpt_PullToTarget"}  # (a sculpt with a scan target; a fit its edges kept short)
     assert all(v for k, v in out["active"].items() if k not in selection_based | target_based), out["active"]

@@ -152,9 +152,18 @@ def curve_points(curve: Any, count: int) -> tuple[np.ndarray, str]:
 def curve_samples(curve: Any, count: int) -> tuple[np.ndarray, np.ndarray, str]:
     """About ``count`` points along ``curve`` (by length), its unit tangents there (exact: from the
     curve, not from the points) and a label for it. ``curve`` is a document object with one edge or
-    one wire (a Sketch, a Part feature, a Draft wire), a ``Part.Edge`` or ``Part.Wire``, or a list
+    one wire (a Sketch, a Part feature, a Draft wire), one edge or wire of one as (the object,
+    "Edge3" or "Wire2", as FreeCAD names a picked edge), a ``Part.Edge`` or ``Part.Wire``, or a list
     of points (the smooth curve through them)."""
     label = ""
+    if isinstance(curve, tuple) and len(curve) == 2 and hasattr(curve[0], "Shape") and isinstance(curve[1], str):
+        obj, name = curve
+        kind, number = name.rstrip("0123456789"), name[len(name.rstrip("0123456789")):]
+        elements = {"Edge": obj.Shape.Edges, "Wire": obj.Shape.Wires}.get(kind, [])
+        if not number or not 1 <= int(number) <= len(elements):
+            raise ValueError(f"curve: {obj.Label} has no {name!r} (it has {len(obj.Shape.Edges)} edges in "
+                             f"{len(obj.Shape.Wires)} wires: give 'Edge1' to 'Edge{len(obj.Shape.Edges)}' or a wire)")
+        label, curve = f"{obj.Label} {name}", elements[int(number) - 1]
     if hasattr(curve, "Shape") and hasattr(curve, "Document"):
         label = str(curve.Label)
         curve = curve.Shape

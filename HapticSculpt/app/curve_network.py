@@ -13,6 +13,7 @@ sculpted afterwards: the boundary as its edges (held G0), the others as curve co
 """
 from __future__ import annotations
 
+import itertools
 from typing import Any, Sequence
 
 import numpy as np
@@ -32,6 +33,8 @@ CLOSE_SHARE = 1e-3
 ROOM_PASSES = 1
 #: Samples per curve for the loop, the Coons patch and its fit.
 SAMPLES = 200
+#: The most curves :func:`split_network` sorts (its search tries every 4 and 3 of them).
+MOST_CURVES = 16
 
 
 def _loop(curves: list[tuple[np.ndarray, str]]) -> list[tuple[np.ndarray, str]]:
@@ -60,6 +63,25 @@ def _loop(curves: list[tuple[np.ndarray, str]]) -> list[tuple[np.ndarray, str]]:
         raise ValueError(f"boundary: the curves do not close: '{loop[-1][1]}' ends {closing:.3g} mm from where "
                          f"'{loop[0][1]}' starts (at most {gap:.3g})")
     return loop
+
+
+def split_network(curves: Sequence[Any]) -> tuple[list[int], list[int]]:
+    """Which of ``curves`` (in any order, as a designer selects them) close into the boundary loop
+    and which lie inside it: (the boundary's indices, the others'), four curves that close taken
+    before three. ValueError when no 3 or 4 of them close (saying how many curves there were)."""
+    if isinstance(curves, (str, bytes)) or not 3 <= len(curves) <= MOST_CURVES:
+        raise ValueError(f"curves: 3 to {MOST_CURVES} curves, 3 or 4 of them closing into a loop, got "
+                         f"{len(curves) if hasattr(curves, '__len__') else curves!r}")
+    samples = [cc.curve_points(c, SAMPLES) for c in curves]
+    for n in (4, 3):
+        for subset in itertools.combinations(range(len(curves)), n):
+            try:
+                _loop([samples[k] for k in subset])
+            except ValueError:
+                continue
+            return list(subset), [k for k in range(len(curves)) if k not in subset]
+    raise ValueError(f"no 3 or 4 of the {len(curves)} curves close into a loop: a boundary is 3 or 4 curves "
+                     "meeting end to end")
 
 
 def _sides(loop: list[tuple[np.ndarray, str]]) -> list[np.ndarray]:

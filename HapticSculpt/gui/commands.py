@@ -24,8 +24,9 @@ NEEDS_CURSOR = "Needs a sculpt and the mouse over it (or a session's cursor)."
 GROUPS = {
     # (clamped first: a free sheet pulled at its middle lifts whole, and a designer's first stroke
     # on the button's patch made no bump)
-    "HapticSculpt_NewGroup": ("New patch", "A new flat sculpt patch: held edges (a clamped sheet: a pull makes a "
-                              "bump) or free edges (a free sheet)", ["HapticSculpt_NewPatch", "HapticSculpt_NewClampedPatch"], 1),
+    "HapticSculpt_NewGroup": ("New patch", "A new sculpt patch: flat with held edges (a clamped sheet: a pull makes a "
+                              "bump) or free edges (a free sheet), or through selected curves",
+                              ["HapticSculpt_NewPatch", "HapticSculpt_NewClampedPatch", "HapticSculpt_NewFromCurves"], 1),
     "HapticSculpt_OutputGroup": ("Output", "Export STEP, or thicken the selected sculpt into a solid",
                                  ["HapticSculpt_ExportStep", "HapticSculpt_Thicken"], 0),
     "HapticSculpt_ToolGroup": ("Tools", f"Choose the sculpting tool: {', '.join(core.TOOLS)}; and the falloff of "
@@ -65,7 +66,7 @@ TOOLBARS = {
     "HapticSculpt analysis": ["HapticSculpt_DisplayGroup"],
 }
 #: The menu: every command, in sections.
-MENU = ["HapticSculpt_NewPatch", "HapticSculpt_NewClampedPatch", "HapticSculpt_SculptFace", "Separator", "HapticSculpt_Session", "Separator",
+MENU = ["HapticSculpt_NewPatch", "HapticSculpt_NewClampedPatch", "HapticSculpt_NewFromCurves", "HapticSculpt_SculptFace", "Separator", "HapticSculpt_Session", "Separator",
         *[name for group in ("HapticSculpt_ToolGroup", "HapticSculpt_MaterialGroup", "HapticSculpt_ConstraintGroup",
                              "HapticSculpt_DisplayGroup", "HapticSculpt_OutputGroup")
           for name in [*GROUPS[group][2], "Separator"]]][:-1]
@@ -140,6 +141,79 @@ class NewClampedPatch(NewPatch):
                 "ToolTip": "Create a flat 100 x 100 mm B-spline patch (8 x 8 poles, degree 3) whose edges and "
                            "tangent planes are held (a clamped sheet: strokes raise bumps inside it; Hold edges "
                            "frees them)"}
+
+
+def _network_selection() -> list[tuple[str, Any]] | None:
+    """The selected curves as (how a script names one, the curve) when the selection is curves only
+    (sketches, wires, edges of parts; no sculpt, no face) and holds three or more: a sketch or wire
+    picked whole is one curve, or its edges when they close into a loop of 3 or 4 (a boundary drawn
+    in one sketch), or its wires when it has several; an edge picked in the view is that edge."""
+    from ..app.sculpt_feature import is_sculpt
+    from ..app.sculpted_solid import is_sculpted_solid
+    from .echo import ref
+    curves: list[tuple[str, Any]] = []
+    for pick in Gui.Selection.getSelectionEx():
+        obj, shape = pick.Object, getattr(pick.Object, "Shape", None)
+        if is_sculpt(obj) or is_sculpted_solid(obj) or shape is None or shape.isNull() or not shape.Edges:
+            return None
+        if pick.SubElementNames:
+            if not all(n.startswith("Edge") for n in pick.SubElementNames):
+                return None
+            curves += [(f"({ref(obj)}, {n!r})", (obj, n)) for n in pick.SubElementNames]
+        elif shape.Faces:
+            return None
+        elif len(shape.Wires) == 1 and len(shape.Wires[0].Edges) == len(shape.Edges):
+            wire = shape.Wires[0]
+            if wire.isClosed() and len(shape.Edges) in (3, 4):  # (the boundary, drawn as one sketch)
+                curves += [(f"({ref(obj)}, 'Edge{k + 1}')", (obj, f"Edge{k + 1}")) for k in range(len(shape.Edges))]
+            else:
+                curves.append((ref(obj), obj))
+        elif len(shape.Edges) == 1:
+            curves.append((ref(obj), obj))
+        else:
+            curves += [(f"({ref(obj)}, 'Wire{k + 1}')", (obj, f"Wire{k + 1}")) for k in range(len(shape.Wires))]
+    return curves if len(curves) >= 3 else None
+
+
+class NewFromCurves:
+    """A new patch through the selected curves: 3 or 4 of them closing into its boundary, the
+    others inside it (make_sculpt_from_curves: the least bending between them, the curves held
+    while it is sculpted)."""
+
+    MENU_TEXT = "New patch from curves"
+
+    def GetResources(self) -> dict[str, str]:
+        return {"Pixmap": icon("NewFromCurves"), "MenuText": self.MENU_TEXT,
+                "ToolTip": "Select 3 or 4 curves that close into a loop (sketches, wires, edges of parts; or one "
+                           "sketch drawing the loop) and any curves inside it: a fair patch whose edges follow the "
+                           "loop and which passes through every curve inside within 0.001 mm, each held while it "
+                           "is sculpted"}
+
+    def IsActive(self) -> bool:
+        return _network_selection() is not None
+
+    def Activated(self) -> None:
+        from ..app.curve_api import curve_constraints_of
+        from ..app.curve_network import split_network
+        from .echo import run_echoed
+        picked = _network_selection()
+        if picked is None:
+            return
+        doc = Gui.Selection.getSelection()[0].Document
+        boundary, interior = split_network([curve for _, curve in picked])
+        listed = [", ".join(picked[k][0] for k in ks) for ks in (boundary, interior)]
+        inside = f", [{listed[1]}]" if interior else ""
+        run_echoed(f"HapticSculpt.make_sculpt_from_curves(App.getDocument({doc.Name!r}), [{listed[0]}]{inside})")
+        obj = doc.Objects[-1]
+        doc.recompute()
+        Gui.Selection.clearSelection()
+        Gui.Selection.addSelection(obj)
+        controls = obj.Proxy.surface.surface.controls
+        held = curve_constraints_of(obj)
+        within = f", each within {max(c['distance_mm'] for c in held):.2g} mm" if held else ""
+        FreeCAD.Console.PrintMessage(
+            f"HapticSculpt: {obj.Label}: a patch on {len(boundary)} boundary curves through {len(interior)} inside"
+            f"{within} ({controls[0]} x {controls[1]} controls)\n")
 
 
 def _face_selection() -> tuple[Any, list[str], Any] | None:
@@ -988,6 +1062,7 @@ def _refusals_said_plainly(command: type) -> type:
 
 
 COMMANDS = {"HapticSculpt_NewPatch": NewPatch, "HapticSculpt_NewClampedPatch": NewClampedPatch,
+            "HapticSculpt_NewFromCurves": NewFromCurves,
             "HapticSculpt_SculptFace": SculptFace, "HapticSculpt_Session": Session,
             "HapticSculpt_Material": Material, "HapticSculpt_KeepShape": KeepShape,
             "HapticSculpt_HoldEdges": HoldEdges, "HapticSculpt_FollowCurve": FollowCurve, "HapticSculpt_Fair": Fair,
