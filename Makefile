@@ -384,6 +384,7 @@ bench: build wheel
 	$(PY) bench/scan_fit.py
 	$(PY) bench/scan_pull.py
 	$(PY) bench/stroke_reach.py
+	$(PY) bench/roofline.py --big
 
 # Peers run in their own virtual environment (optional benchmark dependencies, not test ones).
 BENCH_VENV := $(BUILD)/bench-venv

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "dynamics/energy_guard.hpp"
@@ -170,6 +171,12 @@ public:
     /// accelerations are dropped and the energy guard starts a new ceiling.
     void wake() { touch(); guard_.reset(); region_.wholeNext(); }
     std::uint64_t stepCount() const { return steps_; }
+    /// The system matrix the last implicit step solved by: (its unknowns, the entries one solve
+    /// reads, whether it keeps the dense inverse); unknowns 0 before such a step.
+    std::tuple<int, Eigen::Index, bool> systemSolveSize() const {
+        const PrefactoredSolver& s = systems_.current().solver;
+        return s.ready() ? std::make_tuple(s.size(), s.entriesRead(), s.dense()) : std::make_tuple(0, Eigen::Index{0}, false);
+    }
     double time() const { return time_; }
     double workDone() const { return work_; }  ///< work of external and tool forces so far
     /// The energy guard's current ceiling (0 while the guard is not running for this scene).

@@ -24,6 +24,9 @@ public:
 
     static constexpr int kDenseLimit = 600;
     bool dense() const { return inverse_.size() != 0; }
+    /// The matrix entries one solve reads: the inverse's n^2 on the dense path, else the strictly
+    /// lower factor's (read twice, forward and back, with D between). What bench/roofline.py counts.
+    Eigen::Index entriesRead() const { return dense() ? inverse_.size() : L_.nonZeros(); }
 
 private:
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
