@@ -59,8 +59,13 @@ MESH_PASSES = [
     ("A v from the new mesh and x^", 2, 1),
     ("history: the mesh the step started from", 1, 1),
     ("work of the applied forces (DynamicSurface::step)", 3, 0),
+    ("clay: each spring's rest length creeps toward its length (SpringMesh::applyPlasticity)", 4, 0),
 ]
-#: Arithmetic per spring (difference, length, projection onto the rest length, both ends' terms).
+#: Bytes per spring and step: its rest length read by the projections; clay's creep reads its
+#: endpoints' indices and first rest length and reads and writes its rest length.
+SPRING_BYTES = 8 + 8 + 8 + 16
+#: Arithmetic per spring (difference, length, projection onto the rest length, both ends' terms),
+#: counted twice with clay (its creep takes the length again).
 SPRING_FLOPS = 28
 #: Arithmetic per mesh point in the bending stencil (13 points, three coordinates, multiply-add).
 BENDING_FLOPS = 78
@@ -78,10 +83,10 @@ def counts(m: int, springs: int, solve: tuple[int, int, bool]) -> dict:
     solve_bytes += 4 * 24 * unknowns  # (right-hand side, solution, work, its permutation)
     solve_flops = 6 * entries if dense else 12 * entries
     tensor_flops = 2 * 2 * (n + m) * m * (DEGREE + 1) * 3  # (A and A^T: (n + g) h (p + 1) per coordinate)
-    mesh_bytes = (read + written) * array + 8 * springs
+    mesh_bytes = (read + written) * array + SPRING_BYTES * springs
     return {"mesh_bytes": mesh_bytes, "solve_bytes": solve_bytes, "bytes": mesh_bytes + solve_bytes,
-            "flops": 3 * read * points + SPRING_FLOPS * springs + BENDING_FLOPS * points + tensor_flops + solve_flops,
-            "solve_flops": solve_flops, "working_set": 20 * array + 8 * springs + solve_bytes / (1 if dense else 2),
+            "flops": 3 * read * points + 2 * SPRING_FLOPS * springs + BENDING_FLOPS * points + tensor_flops + solve_flops,
+            "solve_flops": solve_flops, "working_set": 20 * array + 24 * springs + solve_bytes / (1 if dense else 2),
             "mesh_passes": read + written}
 
 
