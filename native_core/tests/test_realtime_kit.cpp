@@ -4,8 +4,8 @@
 
 #include <string>
 
-#include "runtime/dbus_connection.hpp"
-#include "runtime/realtime_kit.hpp"
+#include "common/platform/dbus_connection.hpp"
+#include "common/platform/realtime_kit.hpp"
 
 using namespace hs;
 

@@ -1,15 +1,7 @@
 #include "runtime/haptic_runtime.hpp"
 
 #include "common/names.hpp"
-#include "runtime/dbus_connection.hpp"
-#include "runtime/realtime_kit.hpp"
-
-#include <pthread.h>
-#include <sched.h>
-#include <sys/prctl.h>
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
+#include "common/platform/thread_priority.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -281,36 +273,9 @@ void HapticRuntime::stop() {
 }
 
 void HapticRuntime::takeRealtimePriority() {
-    std::string how = "off";
-    bool ok = false;
-    if (settings_.realtime) {
-        // Below the top priority, and within the user's rtprio limit where one is set (a line in
-        // /etc/security/limits.d grants it without root): asking for more than the limit fails.
-        const int top = sched_get_priority_max(SCHED_FIFO) - 1;
-        int priority = top;
-        rlimit limit{};
-        if (geteuid() != 0 && getrlimit(RLIMIT_RTPRIO, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
-            priority = std::min(priority, static_cast<int>(limit.rlim_cur));
-        sched_param sp{};
-        sp.sched_priority = priority;
-        const int refused = priority >= 1 ? pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) : EPERM;
-        if (refused == 0) {
-            ok = true;
-            how = "SCHED_FIFO " + std::to_string(priority) + (geteuid() == 0 ? " (root)" : " (rtprio limit)");
-        } else {
-            // Where the limit does not allow it, RealtimeKit may (a desktop's audio runs so).
-            const std::string why = priority < 1 ? "the rtprio limit is 0" : std::string("SCHED_FIFO: ") + std::strerror(refused);
-            const RealtimeGrant g = askRealtimeKit(static_cast<long>(syscall(SYS_gettid)), top,
-                                                   DBusConnection::systemBusAddress(), 0.5);
-            int policy = SCHED_OTHER;
-            ok = g.granted && pthread_getschedparam(pthread_self(), &policy, &sp) == 0 &&
-                 (policy & ~SCHED_RESET_ON_FORK) == SCHED_FIFO;  // (rtkit sets that flag too)
-            how = ok ? "SCHED_FIFO " + std::to_string(sp.sched_priority) + " from RealtimeKit"
-                     : "none: " + why + "; RealtimeKit: " + (g.granted ? "granted, but the thread is not SCHED_FIFO" : g.why);
-        }
-    }
-    realtimeHow_ = how;
-    realtimeOk_.store(ok, std::memory_order_relaxed);
+    const PriorityGrant g = takeHapticPriority(settings_.realtime);
+    realtimeHow_ = g.how;
+    realtimeOk_.store(g.ok, std::memory_order_relaxed);
     realtimeKnown_.store(true, std::memory_order_release);
 }
 
@@ -320,8 +285,7 @@ std::string HapticRuntime::realtimeHow() const {
 
 void HapticRuntime::hapticLoop() {
     takeRealtimePriority();
-    // Wake-ups to the microsecond: a thread's timer slack (50 us by default) delays every one.
-    prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+    const PreciseWakeups wakeups;
     const auto spin = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(settings_.spin));
     const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / settings_.hapticRate));
     const auto idlePeriod = settings_.idleRate > 0
@@ -395,7 +359,7 @@ void HapticRuntime::hapticLoop() {
 }
 
 void HapticRuntime::simLoop() {
-    if (settings_.simNice > 0) setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), settings_.simNice);
+    lowerThreadPriority(settings_.simNice);
     const double dt = settings_.simDt;
     const double graphicsEvery = settings_.graphicsRate > 0 ? 1.0 / settings_.graphicsRate : INFINITY;
     double simTime = 0, nextGraphics = 0;

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "common/shared_library.hpp"
+#include "common/platform/shared_library.hpp"
 
 namespace hs::usb {
 

@@ -7,7 +7,7 @@
 #include <cstdint>
 
 #include "devices/device.hpp"
-#include "common/shared_library.hpp"
+#include "common/platform/shared_library.hpp"
 #include "devices/vendor/vendor_device_settings.hpp"
 
 namespace hs {

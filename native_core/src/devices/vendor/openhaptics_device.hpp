@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "devices/device.hpp"
-#include "common/shared_library.hpp"
+#include "common/platform/shared_library.hpp"
 #include "common/triple_buffer.hpp"
 #include "devices/vendor/vendor_device_settings.hpp"
 

@@ -1,6 +1,7 @@
-// A shared library opened at run time (dlopen), for what must never be linked at build time: the
-// vendors' haptic libraries (OpenHaptics, Force Dimension) and libusb for the Falcon. The first of
-// several names that loads wins; a missing library or symbol is an error that names it.
+// A shared library opened at run time (dlopen; LoadLibrary on Windows), for what must never be
+// linked at build time: the vendors' haptic libraries (OpenHaptics, Force Dimension) and libusb for
+// the Falcon. The first of several names that loads wins; a missing library or symbol is an error
+// that names it.
 #pragma once
 #include <memory>
 #include <string>
@@ -10,8 +11,8 @@ namespace hs {
 
 class SharedLibrary {
 public:
-    /// Opens the first of `names` that loads (a name with a '/' is a path, else the loader's search
-    /// path). std::runtime_error listing what was tried and why each failed.
+    /// Opens the first of `names` that loads (a name with a '/' (or '\\' on Windows) is a path, else
+    /// the loader's search path). std::runtime_error listing what was tried and why each failed.
     static SharedLibrary open(const std::vector<std::string>& names, const std::string& what);
     /// The library that loaded (its name as given).
     const std::string& name() const { return name_; }

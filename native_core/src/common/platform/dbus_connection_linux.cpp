@@ -1,4 +1,4 @@
-#include "runtime/dbus_connection.hpp"
+#include "common/platform/dbus_connection.hpp"
 
 #include <sys/socket.h>
 #include <sys/time.h>

@@ -1,4 +1,4 @@
-#include "common/shared_library.hpp"
+#include "common/platform/shared_library.hpp"
 
 #include <dlfcn.h>
 

@@ -1,4 +1,4 @@
-#include "runtime/realtime_kit.hpp"
+#include "common/platform/realtime_kit.hpp"
 
 #include <sys/resource.h>
 
@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <stdexcept>
 
-#include "runtime/dbus_connection.hpp"
+#include "common/platform/dbus_connection.hpp"
 
 namespace hs {
 
