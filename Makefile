@@ -7,11 +7,13 @@ APT_PACKAGES := build-essential cmake ninja-build pkg-config libeigen3-dev pybin
                 python3-dev python3-numpy python3-scipy python3-pytest python3-hypothesis python3-matplotlib \
                 python3-venv python3-distributed freecad-python3 freecad libhidapi-dev libusb-1.0-0 libwebsockets-dev libsimdjson-dev python3-websockets xvfb xauth xdotool imagemagick debootstrap \
                 ccache dbus-daemon python3-dbus python3-gi
+# The Windows build's (make test-windows, on this machine only: not in the Debian roots).
+WINDOWS_PACKAGES := g++-mingw-w64-x86-64-posix wine64 googletest
 SUDO        := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 PHONY_TSAN := build-tsan test-tsan
 PHONY_LONG := stress fuzz bench-peers batch-replay
-.PHONY: all deps build build-asan $(PHONY_TSAN) $(PHONY_LONG) test test-parts gui-lane test-gui-repeat test-gui-repeat-all test-cpp test-asan test-python \
+.PHONY: all deps build build-asan build-windows test-windows $(PHONY_TSAN) $(PHONY_LONG) test test-parts gui-lane test-gui-repeat test-gui-repeat-all test-cpp test-asan test-python \
         test-gui test-freecad test-addon wheel ocp-venv demo bench install install-udev install-realtime uninstall clean test-other-debians \
         wheels wheel-check check
 # What make keeps outside the checkout, so that a clean clone reuses it: the compiler cache, the
@@ -86,6 +88,18 @@ test-tsan: build-tsan
 
 test-cpp: build
 	$(TIMED) test-cpp ctest --test-dir $(BUILD)/release --output-on-failure -j $(JOBS)
+
+# The core for Windows x86-64, cross-built with MinGW-w64 (posix threads) from the same sources
+# (what differs is in native_core/src/common/platform/), its C++ tests and fuzz replays run under
+# Wine; tools/windows_tests.py names and counts what the Linux build has and Windows does not.
+build-windows: deps
+	@$(MAKE) --no-print-directory deps APT_PACKAGES="$(WINDOWS_PACKAGES)"
+	cmake -S native_core -B $(BUILD)/windows -G Ninja -DCMAKE_TOOLCHAIN_FILE=$(CURDIR)/native_core/cmake/mingw-w64.cmake \
+	  -DCMAKE_BUILD_TYPE=Release -DHS_PYTHON=OFF -DHS_NATIVE=OFF -DEigen3_DIR=/usr/share/eigen3/cmake
+	$(TIMED) build-windows cmake --build $(BUILD)/windows -j $(JOBS)
+
+test-windows: build-windows build
+	$(TIMED) test-windows $(PY) tools/windows_tests.py --build $(BUILD)/windows --linux $(BUILD)/release
 
 test-asan: build-asan
 	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
@@ -215,7 +229,7 @@ GUI_LANE   := $(HOST_SUITE) $(lastword $(SUITES))
 GUI_BESIDE := $(filter-out $(GUI_LANE),$(SUITES))
 test-parts: gui-lane $(foreach s,$(GUI_BESIDE),part-$(s)-gui) \
   $(foreach p,runner python,$(foreach s,$(SUITES),part-$(s)-$(p))) part-$(HOST_SUITE)-asan \
-  part-$(HOST_SUITE)-tsan $(foreach p,cpp demo,$(foreach s,$(SUITES),part-$(s)-$(p)))
+  part-$(HOST_SUITE)-tsan part-$(HOST_SUITE)-windows $(foreach p,cpp demo,$(foreach s,$(SUITES),part-$(s)-$(p)))
 
 # (one make slot throughout: make queues what is ready in turn, and the last root's GUI suite, ready
 # only when the host's ended, started behind every runner and pytest queued before it, and ended last)
@@ -231,6 +245,7 @@ PART_TARGET_gui    := test-addon-gui
 PART_TARGET_demo   := demo
 PART_TARGET_asan   := test-asan
 PART_TARGET_tsan   := test-tsan
+PART_TARGET_windows := test-windows
 part_suite = $(word 1,$(subst -, ,$(1)))
 part_name  = $(word 2,$(subst -, ,$(1)))
 # A prep that fails (or a root that cannot be made) marks its FreeCAD unprepared and passes, so that
@@ -254,7 +269,7 @@ ifndef PREPPED
 $(foreach s,$(SUITES),$(foreach p,cpp python runner gui demo,$(eval part-$(s)-$(p): part-$(s)-prep)))
 $(foreach s,$(OTHER_SUITES),$(eval part-$(s)-prep: root-$(s)))
 $(foreach s,$(SUITES),$(foreach p,cpp python runner demo,$(eval part-$(s)-$(p): | $(foreach t,$(SUITES),part-$(t)-prep))))
-part-$(HOST_SUITE)-asan part-$(HOST_SUITE)-tsan: | $(foreach t,$(SUITES),part-$(t)-prep)
+part-$(HOST_SUITE)-asan part-$(HOST_SUITE)-tsan part-$(HOST_SUITE)-windows: | $(foreach t,$(SUITES),part-$(t)-prep)
 endif
 
 # (root-% does not run deps again: make test did, and a phony prerequisite here would let the host's

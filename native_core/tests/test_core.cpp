@@ -3,6 +3,7 @@
 
 #include <atomic>
 #include <cstddef>
+#include <algorithm>
 #include <cstdlib>
 #include <new>
 
@@ -10,18 +11,26 @@
 #include "pulled_steps.hpp"
 
 // Counts heap allocations so a test can assert that stepping allocates nothing. Every form of
-// operator new and delete is replaced, all on malloc/free: a library that allocates with one form
+// operator new and delete is replaced, all on one allocator (malloc/free; Windows: _aligned_*): a library that allocates with one form
 // and frees with another (GCC 14's std::stable_sort: nothrow new, then sized delete) must meet a
 // matching pair, or AddressSanitizer reports an alloc-dealloc mismatch. GCC 12 with LTO inlines
 // these replacements and then mistakes the malloc/free pairing for a mismatch.
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 static std::atomic<long> g_allocations{0};
 namespace {
-void* counted(std::size_t n, std::size_t align = 0) noexcept {
-    ++g_allocations;
-    if (n == 0) n = 1;
+#ifdef _WIN32  // (no aligned_alloc on Windows: every block from _aligned_malloc, freed by _aligned_free)
+void* allocate(std::size_t n, std::size_t align) { return _aligned_malloc(n, std::max(align, alignof(std::max_align_t))); }
+void release(void* p) { _aligned_free(p); }
+#else
+void* allocate(std::size_t n, std::size_t align) {
     if (align <= alignof(std::max_align_t)) return std::malloc(n);
     return std::aligned_alloc(align, (n + align - 1) / align * align);  // (a multiple of the alignment)
+}
+void release(void* p) { std::free(p); }
+#endif
+void* counted(std::size_t n, std::size_t align = 0) noexcept {
+    ++g_allocations;
+    return allocate(n == 0 ? 1 : n, align);
 }
 void* countedOrThrow(std::size_t n, std::size_t align = 0) {
     if (void* p = counted(n, align)) return p;
@@ -40,18 +49,18 @@ void* operator new(std::size_t n, std::align_val_t a, const std::nothrow_t&) noe
 void* operator new[](std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
     return counted(n, static_cast<std::size_t>(a));
 }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete(void* p) noexcept { release(p); }
+void operator delete[](void* p) noexcept { release(p); }
+void operator delete(void* p, std::size_t) noexcept { release(p); }
+void operator delete[](void* p, std::size_t) noexcept { release(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { release(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { release(p); }
+void operator delete(void* p, std::align_val_t) noexcept { release(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { release(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { release(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { release(p); }
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { release(p); }
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { release(p); }
 long allocationCount() { return g_allocations.load(); }  // for the other test files
 
 using namespace hs;

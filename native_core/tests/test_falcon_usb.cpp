@@ -3,7 +3,6 @@
 // finding it, permissions, the firmware loaded from a file (handshake, echoed chunks, a bad echo,
 // a wrong image, no file), then the Falcon as a Device on that link: homing, a spring in a closed
 // loop, a rope stroke in a threaded session, unplugged.
-#include <dlfcn.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -15,26 +14,23 @@
 #include "device_session.hpp"
 #include "solvers/dynamic_surface.hpp"
 #include "devices/falcon/falcon_device.hpp"
+#include "common/platform/shared_library.hpp"
 #include "devices/falcon/falcon_usb.hpp"
 #include "runtime/haptic_runtime.hpp"
 
 using namespace hs;
 
 namespace {
-const std::string kUsb = std::string(HS_FAKE_VENDOR_DIR) + "/libusb-fake.so";
+const std::string kUsb = std::string(HS_FAKE_VENDOR_DIR) + "/libusb-fake" + HS_MODULE_SUFFIX;
 
 class FakeUsb {
 public:
-    explicit FakeUsb(bool firmwareRunning) : handle_(dlopen(kUsb.c_str(), RTLD_NOW | RTLD_LOCAL)) {
-        if (!handle_) throw std::runtime_error(dlerror());
+    explicit FakeUsb(bool firmwareRunning) : library_(SharedLibrary::open({kUsb}, "the fake libusb")) {
         call<void (*)(int)>("reset")(firmwareRunning ? 1 : 0);
     }
-    ~FakeUsb() { dlclose(handle_); }
     template <class F>
     F call(const char* what) const {
-        void* p = dlsym(handle_, (std::string("fake_usb_") + what).c_str());
-        if (!p) throw std::runtime_error(what);
-        return reinterpret_cast<F>(p);
+        return library_.function<F>((std::string("fake_usb_") + what).c_str());
     }
     struct Seen {
         Vec3 tipMm;
@@ -49,7 +45,7 @@ public:
     }
 
 private:
-    void* handle_;
+    SharedLibrary library_;
 };
 
 std::shared_ptr<usb::Library> fakeLibusb() { return usb::Library::load({kUsb}); }
@@ -86,7 +82,8 @@ TEST(FalconUsb, FindsTheFalconsAndSaysWhyOneCannotBeOpened) {
     EXPECT_NE(errorOf([&] { falcon::UsbTransport t(lib); }).find("in use by another program"), std::string::npos);
     fake.call<void (*)(int)>("devices")(0);
     EXPECT_NE(errorOf([&] { falcon::UsbTransport t(lib); }).find("none attached"), std::string::npos);
-    EXPECT_NE(errorOf([] { usb::Library::load({"/nonexistent/libusb.so"}); }).find("apt install libusb-1.0-0"), std::string::npos);
+    EXPECT_NE(errorOf([] { usb::Library::load({"/nonexistent/libusb.so"}); }).find(kWindows ? "libusb.info" : "apt install libusb-1.0-0"),
+              std::string::npos);
 }
 
 TEST(FalconUsb, LoadsTheFirmwareFromTheUsersFile) {

@@ -3,7 +3,6 @@
 // the tests (fake_vendor/): position in, force out, buttons, a spring held in a closed loop, a
 // replayed rope stroke in a threaded session, the device unplugged, malformed positions, a
 // missing library, a library without the calls, no device attached; no allocation per tick.
-#include <dlfcn.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -12,6 +11,7 @@
 #include <type_traits>
 
 #include "device_session.hpp"
+#include "common/platform/shared_library.hpp"
 #include "devices/device_limits.hpp"
 #include "devices/vendor/dhd_device.hpp"
 #include "solvers/dynamic_surface.hpp"
@@ -21,22 +21,18 @@
 using namespace hs;
 
 namespace {
-const std::string kHd = std::string(HS_FAKE_VENDOR_DIR) + "/libHD.so";
-const std::string kDhd = std::string(HS_FAKE_VENDOR_DIR) + "/libdhd.so";
+const std::string kHd = std::string(HS_FAKE_VENDOR_DIR) + "/libHD" + HS_MODULE_SUFFIX;
+const std::string kDhd = std::string(HS_FAKE_VENDOR_DIR) + "/libdhd" + HS_MODULE_SUFFIX;
 
 // The fake library's own handles (the same loaded copy the device uses: same path, same handle).
 class Fake {
 public:
-    Fake(const std::string& path, const char* prefix) : handle_(dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)), prefix_(prefix) {
-        if (!handle_) throw std::runtime_error(dlerror());
+    Fake(const std::string& path, const char* prefix) : library_(SharedLibrary::open({path}, "the fake library")), prefix_(prefix) {
         call<void (*)()>("reset")();
     }
-    ~Fake() { dlclose(handle_); }
     template <class F>
     F call(const char* what) const {
-        void* p = dlsym(handle_, (prefix_ + what).c_str());
-        if (!p) throw std::runtime_error(prefix_ + what);
-        return reinterpret_cast<F>(p);
+        return library_.function<F>((prefix_ + what).c_str());
     }
     void script(const std::vector<double>& rows) const {
         call<void (*)(const double*, int)>("script")(rows.data(), static_cast<int>(rows.size() / 5));
@@ -54,7 +50,7 @@ public:
     }
 
 private:
-    void* handle_;
+    SharedLibrary library_;
     std::string prefix_;
 };
 

@@ -9,6 +9,13 @@
 
 namespace hs {
 
+/// Built for Windows: a vendor's library has its Windows file name there (hd.dll, not libHD.so).
+#ifdef _WIN32
+inline constexpr bool kWindows = true;
+#else
+inline constexpr bool kWindows = false;
+#endif
+
 class SharedLibrary {
 public:
     /// Opens the first of `names` that loads (a name with a '/' (or '\\' on Windows) is a path, else

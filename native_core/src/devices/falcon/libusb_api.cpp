@@ -27,8 +27,11 @@ Library::Library(SharedLibrary lib) : lib_(std::move(lib)) {
 }
 
 std::shared_ptr<Library> Library::load(const std::vector<std::string>& names) {
-    SharedLibrary lib = SharedLibrary::open(names.empty() ? std::vector<std::string>{"libusb-1.0.so.0", "libusb-1.0.so"} : names,
-                                            "libusb-1.0 (Debian: apt install libusb-1.0-0)");
+    SharedLibrary lib = SharedLibrary::open(!names.empty() ? names
+                                            : kWindows ? std::vector<std::string>{"libusb-1.0.dll"}
+                                                       : std::vector<std::string>{"libusb-1.0.so.0", "libusb-1.0.so"},
+                                            kWindows ? "libusb-1.0 (libusb-1.0.dll from libusb.info, beside FreeCAD's bin folder)"
+                                                     : "libusb-1.0 (Debian: apt install libusb-1.0-0)");
     return std::shared_ptr<Library>(new Library(std::move(lib)));
 }
 

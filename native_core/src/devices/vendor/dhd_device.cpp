@@ -16,9 +16,9 @@ Vec3 toDevice(const Vec3& v) { return Vec3(-v.y(), v.x(), v.z()); }
 
 DhdDevice::DhdDevice(VendorDeviceSettings settings)
     : settings_((settings.validate(), std::move(settings))),
-      library_(SharedLibrary::open(settings_.library.empty()
-                                       ? std::vector<std::string>{"libdhd.so", "libdhd.so.3", "libdrd.so", "libdrd.so.3"}
-                                       : settings_.library,
+      library_(SharedLibrary::open(!settings_.library.empty() ? settings_.library
+                                   : kWindows ? std::vector<std::string>{"dhd64.dll", "drd64.dll"}
+                                              : std::vector<std::string>{"libdhd.so", "libdhd.so.3", "libdrd.so", "libdrd.so.3"},
                                    "Force Dimension DHD")) {
     const SharedLibrary& l = library_;
     api_.getDeviceCount = l.function<decltype(api_.getDeviceCount)>("dhdGetDeviceCount");

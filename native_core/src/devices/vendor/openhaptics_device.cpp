@@ -26,9 +26,9 @@ Vec3 toDevice(const Vec3& v) { return Vec3(v.x(), v.z(), -v.y()); }
 
 OpenHapticsDevice::OpenHapticsDevice(VendorDeviceSettings settings)
     : settings_((settings.validate(), std::move(settings))),
-      library_(SharedLibrary::open(settings_.library.empty()
-                                       ? std::vector<std::string>{"libHD.so", "libHD.so.3.4", "libHD.so.3"}
-                                       : settings_.library,
+      library_(SharedLibrary::open(!settings_.library.empty() ? settings_.library
+                                   : kWindows ? std::vector<std::string>{"hd.dll"}
+                                              : std::vector<std::string>{"libHD.so", "libHD.so.3.4", "libHD.so.3"},
                                    "OpenHaptics (3D Systems Touch, Phantom)")) {
     const SharedLibrary& l = library_;
     api_.initDevice = l.function<decltype(api_.initDevice)>("hdInitDevice");
