@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Runs the core's Windows build under Wine (make test-windows, issue 50): the GoogleTest suite and
-the fuzz replay drivers over the recorded fixtures, as ctest runs them on Linux. Then names every
+the fuzz replay drivers over the recorded fixtures, as ctest runs them on Linux, and measures the
+haptic loop's period there (loop_period.exe: the priority granted, p50 and p99). Then names every
 test the Linux build has and the Windows one does not, each with why (NOT_ON_WINDOWS), and counts
 them; a test missing on Windows with no reason here fails the run.
 
@@ -83,6 +84,12 @@ def main() -> int:
             print(r.stdout[-2000:], r.stderr[-2000:], sep="\n")
             failed.append(f"Fuzz.{harness}")
         windows.add(f"Fuzz.{harness}")
+    # The haptic loop's period there (a measurement, not a test: Wine is not Windows' scheduler).
+    period = subprocess.run([loader, str(build / "loop_period.exe"), "3"], env=env, cwd=build, timeout=120,
+                            capture_output=True, text=True)
+    print("haptic loop under Wine: " + " ".join(period.stdout.split("\n")).strip())
+    if period.returncode != 0:
+        failed.append("loop_period.exe")
     linux_tests = pathlib.Path(args.linux).resolve() / "hscore_tests"
     if linux_tests.is_file():
         linux = set(gtest_names([str(linux_tests)]))
