@@ -143,6 +143,7 @@ class Session:
         self._runtime, self._obj, self._device, self._error = runtime, obj, native, ""
         self._priority_said = False
         self.haptic_rate = float(haptic_rate)
+        self.sim_dt = float(sim_dt)
         self._latest_poles, self._latest_maps, self._edits, self.applied_edits = None, {}, {}, []
         self._previewed = False
         self._committed = False  # a stroke, spray or edit this run (else its end commits nothing)
@@ -310,6 +311,13 @@ class Session:
         if runtime is None:
             return {"running": False, "error": self._error}
         return runtime.status()
+
+    @property
+    def simulated_seconds(self) -> float:
+        """The material's time simulated so far (s): behind the clock where the simulation could
+        not keep pace (a loaded machine drops what it cannot catch up)."""
+        s = self.status()
+        return (s.get("sim_steps", 0) + s.get("doubled_steps", 0)) * self.sim_dt
 
     def poll(self) -> int:
         """Commits finished strokes (one undo transaction each); stops the session if a loop stopped

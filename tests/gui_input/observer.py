@@ -37,6 +37,8 @@ def _sculpts(doc):
                     if getattr(o.Proxy, "live", None) and o.Proxy.live.session else "",
                     "haptic_rate": o.Proxy.live.session.haptic_rate
                     if getattr(o.Proxy, "live", None) and o.Proxy.live.session else 0.0,
+                    "simulated_s": o.Proxy.live.session.simulated_seconds
+                    if getattr(o.Proxy, "live", None) and o.Proxy.live.session else 0.0,
                     "selected": o in Gui.Selection.getSelection(), "screen": _on_screen(o), "digest": digest(o),
                     "drawn_poles": _drawn_poles(o), "curves": _curves(o),
                     "target": o.Target.Name if getattr(o, "Target", None) is not None else None,
