@@ -110,8 +110,10 @@ class TestCurveNetwork(SolidChecks):
                arc(V(0, 45, 0), V(-50, -40, 0), 8.0)]
         inside = Part.LineSegment(V(0, -40, 0), V(0, 20, 5)).toShape()  # (from the base's middle, no end)
         self.assertEqual(split_network([tri[2], inside, tri[0], tri[1]]), ([0, 2, 3], [1]))
-        with self.assertRaisesRegex(ValueError, "no 3 or 4 of the 3 curves close into a loop"):
+        with self.assertRaisesRegex(ValueError, "do not close: 'Edge' ends 100 mm from where 'Edge' starts"):
             split_network(sides[:3])
+        with self.assertRaisesRegex(ValueError, "no 3 or 4 of the 5 curves close into a loop"):
+            split_network([sides[0], sides[2], middle, tri[0], tri[1]])
         with self.assertRaisesRegex(ValueError, "3 to 16 curves"):
             split_network(sides[:2])
 

@@ -68,7 +68,7 @@ def _loop(curves: list[tuple[np.ndarray, str]]) -> list[tuple[np.ndarray, str]]:
 def split_network(curves: Sequence[Any]) -> tuple[list[int], list[int]]:
     """Which of ``curves`` (in any order, as a designer selects them) close into the boundary loop
     and which lie inside it: (the boundary's indices, the others'), four curves that close taken
-    before three. ValueError when no 3 or 4 of them close (saying how many curves there were)."""
+    before three. ValueError when no 3 or 4 of them close (3 or 4 curves: which end meets no other)."""
     if isinstance(curves, (str, bytes)) or not 3 <= len(curves) <= MOST_CURVES:
         raise ValueError(f"curves: 3 to {MOST_CURVES} curves, 3 or 4 of them closing into a loop, got "
                          f"{len(curves) if hasattr(curves, '__len__') else curves!r}")
@@ -80,6 +80,8 @@ def split_network(curves: Sequence[Any]) -> tuple[list[int], list[int]]:
             except ValueError:
                 continue
             return list(subset), [k for k in range(len(curves)) if k not in subset]
+    if len(curves) <= 4:
+        _loop(samples)  # (raises, saying which end meets no other)
     raise ValueError(f"no 3 or 4 of the {len(curves)} curves close into a loop: a boundary is 3 or 4 curves "
                      "meeting end to end")
 
