@@ -84,7 +84,7 @@ build-tsan: deps
 	$(TIMED) build-tsan cmake --build $(BUILD)/tsan -j $(JOBS)
 
 test-tsan: build-tsan
-	TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 $(TIMED) test-tsan ctest --test-dir $(BUILD)/tsan --output-on-failure -R "Runtime|TripleBuffer|HapticEstimate|FalconDevice|FalconUsb|VendorDevices|HaplyDevice"
+	TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 $(TIMED) test-tsan ctest --test-dir $(BUILD)/tsan --output-on-failure -R "Runtime|CursorHistory|TripleBuffer|HapticEstimate|FalconDevice|FalconUsb|VendorDevices|HaplyDevice"
 
 test-cpp: build
 	$(TIMED) test-cpp ctest --test-dir $(BUILD)/release --output-on-failure -j $(JOBS)

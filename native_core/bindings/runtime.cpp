@@ -11,6 +11,7 @@
 #include "bindings.hpp"
 #include "convert.hpp"
 #include "runtime/haptic_runtime.hpp"
+#include "runtime/multirate_replay.hpp"
 #include "common/names.hpp"
 
 namespace py = pybind11;
@@ -46,6 +47,37 @@ void bindRuntime(py::module_& m) {
     defaults["realtime"] = kDefaults.realtime;
     m.attr("DEFAULTS") = defaults;
     m.attr("MAPS") = namesOf(kMapNames);
+    m.def("replay_multirate", [](DynamicSurface& surface, std::shared_ptr<Device> device, double seconds, double hapticRate,
+                                 double simDt, double stepCost, double maxLag, bool catchUp, double latency) {
+        if (!device) throw std::invalid_argument("device: required");
+        MultirateSettings s;
+        s.hapticRate = hapticRate;
+        s.simDt = simDt;
+        s.stepCost = stepCost;
+        s.maxLag = maxLag;
+        s.catchUp = catchUp;
+        s.latency = latency;
+        MultirateTicks r;
+        {
+            py::gil_scoped_release release;
+            r = replayMultirate(surface, *device, seconds, s);
+        }
+        py::dict d;
+        d["t"] = py::array_t<double>(static_cast<py::ssize_t>(r.t.size()), r.t.data());
+        d["state_time"] = py::array_t<double>(static_cast<py::ssize_t>(r.stateTime.size()), r.stateTime.data());
+        d["position"] = Eigen::MatrixXd(r.cursor);
+        d["estimated_force"] = Eigen::MatrixXd(r.force);
+        d["dropped_sim_time"] = r.droppedSimTime;
+        d["steps"] = r.steps;
+        d["doubled_steps"] = r.doubledSteps;
+        return d;
+    }, py::arg("surface"), py::arg("device"), py::arg("seconds"), py::arg("haptic_rate") = 1000.0, py::arg("sim_dt") = 1e-3,
+       py::arg("step_cost") = 0.0, py::arg("max_lag") = 0.01, py::arg("catch_up") = true, py::arg("latency") = 0.0,
+       "A session's two rates on a virtual clock (runtime/multirate_replay.hpp): the simulation's steps each cost "
+       "step_cost s, the haptic loop renders at haptic_rate from the newest state that reached it by then (latency s after "
+       "its step ended). Steps `surface` "
+       "in place. Returns the ticks (t, state_time, position, estimated_force) and dropped_sim_time, steps, "
+       "doubled_steps. step_cost=0 gives the force of a simulation at the haptic rate.");
     py::class_<HapticRuntime, std::shared_ptr<HapticRuntime>>(m, "HapticRuntime",
         "The simulation and haptic threads of one session over a surface and a device.")
         .def(py::init([](std::shared_ptr<DynamicSurface> surface, std::shared_ptr<Device> device, double hapticRate,
@@ -183,11 +215,12 @@ void bindRuntime(py::module_& m) {
         .def("ticks", [](const HapticRuntime& r) {
             const auto& ticks = r.ticks();
             const auto n = static_cast<py::ssize_t>(ticks.size());
-            py::array_t<double> t(n), cursor({n, py::ssize_t(3)}), est({n, py::ssize_t(3)}), ren({n, py::ssize_t(3)});
+            py::array_t<double> t(n), state(n), cursor({n, py::ssize_t(3)}), est({n, py::ssize_t(3)}), ren({n, py::ssize_t(3)});
             py::array_t<std::uint32_t> buttons(n);
             for (py::ssize_t i = 0; i < n; ++i) {
                 const HapticTick& k = ticks[static_cast<size_t>(i)];
                 t.mutable_at(i) = k.t;
+                state.mutable_at(i) = k.stateTime;
                 buttons.mutable_at(i) = k.cursor.buttons;
                 for (py::ssize_t c = 0; c < 3; ++c) {
                     cursor.mutable_at(i, c) = k.cursor.position[c];
@@ -202,9 +235,10 @@ void bindRuntime(py::module_& m) {
             }
             py::dict d;
             d["t"] = t; d["position"] = cursor; d["orientation"] = quat; d["buttons"] = buttons;
-            d["estimated_force"] = est; d["rendered_force"] = ren;
+            d["estimated_force"] = est; d["rendered_force"] = ren; d["state_time"] = state;
             return d;
-        }, "Logged haptic ticks (after stop, with log_seconds > 0): t, cursor, buttons, estimated and rendered force.")
+        }, "Logged haptic ticks (after stop, with log_seconds > 0): t, cursor, buttons, estimated and rendered force, "
+           "and the simulated time of the state the estimate came from.")
         .def("force_errors", [](const HapticRuntime& r, double floor) {
             std::vector<double> e;
             {

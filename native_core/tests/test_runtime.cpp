@@ -173,7 +173,7 @@ TEST(HapticRuntime, ReplayRunsToTheEndAndCommitsTheStroke) {
         // The simulation covered the 0.6 s pull in simulated time, as the runtime promises however
         // loaded the machine: behind real time it takes steps of twice simDt, past maxLag it drops
         // the backlog (on a machine running make test's other lanes: 978 steps, some doubled).
-        const double simulated = (st.simSteps + st.doubledSteps) * settings.simDt + st.droppedSimTime;
+        const double simulated = static_cast<double>(st.simSteps + st.doubledSteps) * settings.simDt + st.droppedSimTime;
         EXPECT_GT(simulated, 0.5) << st.simSteps << " steps, " << st.doubledSteps << " doubled";
     }
     EXPECT_EQ(st.strokes, 1u);

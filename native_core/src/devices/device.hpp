@@ -28,6 +28,12 @@ struct DeviceSample {
     bool valid = false;
 };
 
+/// The same reading (the simulation gives its surface a cursor only when the reading changed).
+inline bool sameSample(const DeviceSample& a, const DeviceSample& b) {
+    return a.valid == b.valid && a.buttons == b.buttons && a.position == b.position &&
+           a.orientation.coeffs() == b.orientation.coeffs();
+}
+
 class Device {
 public:
     virtual ~Device() = default;

@@ -324,7 +324,7 @@ void HapticRuntime::hapticLoop() {
                 fail("device lost");
                 break;
             }
-            if (finiteSample(sample)) cursor_.write(sample);
+            if (finiteSample(sample)) cursor_.push(t, sample);
             idle = settings_.idleRate > 0 && simIdle_.load(std::memory_order_relaxed) && !(sample.buttons & 1u);
             estimate_.update();
             const HapticEstimate& e = estimate_.front().sequence ? estimate_.front() : none;
@@ -335,7 +335,7 @@ void HapticRuntime::hapticLoop() {
             latencyBins_[std::min(kBins, static_cast<int>(latency / kBinWidth))].fetch_add(1, std::memory_order_relaxed);
             for (int i = 0; i < 3; ++i) force_[i].store(rendered[i], std::memory_order_relaxed);
             estimateAge_.store(t - e.time, std::memory_order_relaxed);
-            if (tickCount_ < ticks_.size()) ticks_[tickCount_++] = {t, sample, estimated, rendered};
+            if (tickCount_ < ticks_.size()) ticks_[tickCount_++] = {t, sample, estimated, rendered, e.time};
             if (finiteSample(sample)) {
                 ShownCursor shown;
                 shown.cursor = sample;
@@ -389,8 +389,13 @@ void HapticRuntime::simLoop() {
                 droppedSimTime_.store(droppedSimTime_.load(std::memory_order_relaxed) + drop, std::memory_order_relaxed);
                 simTime += drop;
             }
-            const bool fresh = cursor_.update();
-            if (fresh) button = (cursor_.front().buttons & 1u) != 0;
+            // The hand where it was at the step's end (cursor_history.hpp), not where it is now.
+            DeviceSample hand;
+            const bool fresh = cursor_.at(simTime + h, hand) && !sameSample(hand, taken_);
+            if (fresh) {
+                taken_ = hand;
+                button = (hand.buttons & 1u) != 0;
+            }
             const bool airbrushTaken = airbrushChanged_.exchange(false, std::memory_order_acq_rel);
             if (airbrushTaken) {
                 std::lock_guard<std::mutex> lock(airbrushMutex_);
@@ -411,7 +416,7 @@ void HapticRuntime::simLoop() {
             }
             simIdle_.store(false, std::memory_order_relaxed);
             if (fresh || airbrushTaken || edited) {
-                const DeviceSample& s = cursor_.front();
+                const DeviceSample& s = taken_;
                 Cursor c;
                 c.position = s.position;
                 c.orientation = s.orientation;
@@ -434,13 +439,7 @@ void HapticRuntime::simLoop() {
             if (!r.slept) reaction = r.reaction;
             // Publish the tool's local model, velocities by finite differences over this step.
             surface_->describeTool(reaction, current);
-            current.time = simTime;
-            current.sequence = ++sequence;
-            const bool sameGrab = previous.kind == current.kind && previous.points == current.points &&
-                                  current.kind != EstimateKind::None && previous.sequence + 1 == current.sequence &&
-                                  current.toolTime > previous.toolTime;
-            for (int k = 0; k < current.points; ++k) current.v[k] = sameGrab ? Vec3((current.x[k] - previous.x[k]) / taken) : Vec3::Zero();
-            current.offsetRate = sameGrab ? Vec3((current.offsetSum - previous.offsetSum) / taken) : Vec3::Zero();
+            followEstimate(previous, current, simTime, ++sequence, taken);
             estimate_.write(current);
             if (snapshotCount_ < snapshots_.size()) snapshots_[snapshotCount_++] = current;
             previous = current;

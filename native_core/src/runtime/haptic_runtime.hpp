@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "devices/device.hpp"
+#include "runtime/cursor_history.hpp"
 #include "solvers/dynamic_surface.hpp"
 #include "tools_and_constraints/haptic_estimate.hpp"
 #include "common/triple_buffer.hpp"
@@ -79,6 +80,7 @@ struct HapticTick {
     DeviceSample cursor;
     Vec3 estimated = Vec3::Zero();  ///< the estimate's force before the safety layer
     Vec3 rendered = Vec3::Zero();   ///< what was sent to the device
+    double stateTime = 0;           ///< simulated time of the state the estimate came from
 };
 
 /// The airbrush during a session. While it is on, the device's first button sprays the map
@@ -224,7 +226,7 @@ private:
     bool started_ = false, joined_ = false;
     std::atomic<bool> stopRequested_{false};
 
-    TripleBuffer<DeviceSample> cursor_;     // haptic -> simulation
+    CursorHistory cursor_;                  // haptic -> simulation
     TripleBuffer<HapticEstimate> estimate_; // simulation -> haptic
     TripleBuffer<Points> poles_;            // simulation -> GUI
     TripleBuffer<PaintedMap> painted_;      // simulation -> GUI, while spraying
@@ -242,6 +244,7 @@ private:
     std::atomic<const DynamicSurface*> liveSurface_{nullptr};  // which surface steps (postEdit refuses it)
     std::array<int, 3> sampling_{};  // g, h and the pole count every edit must keep
     // simulation thread only
+    DeviceSample taken_;  // the cursor the surface was last given
     AirbrushSettings airbrush_;
     AirbrushSettings::Map sprayMap_ = AirbrushSettings::Map::Off;  // the map of the spray under way
     double sprayTarget_ = 0, nextDab_ = 0;

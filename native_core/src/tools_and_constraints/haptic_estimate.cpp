@@ -44,6 +44,16 @@ Vec3 estimateForce(const HapticEstimate& e, const Vec3& c, const Eigen::Quaterni
     return -scale * f;
 }
 
+void followEstimate(const HapticEstimate& previous, HapticEstimate& current, double time, std::uint64_t sequence, double taken) {
+    current.time = time;
+    current.sequence = sequence;
+    const bool sameGrab = previous.kind == current.kind && previous.points == current.points &&
+                          current.kind != EstimateKind::None && previous.sequence + 1 == current.sequence &&
+                          current.toolTime > previous.toolTime;
+    for (int k = 0; k < current.points; ++k) current.v[k] = sameGrab ? Vec3((current.x[k] - previous.x[k]) / taken) : Vec3::Zero();
+    current.offsetRate = sameGrab ? Vec3((current.offsetSum - previous.offsetSum) / taken) : Vec3::Zero();
+}
+
 Vec3 limitForce(const HapticEstimate& e, const Vec3& f, double t, const ForceLimits& limits) {
     if (!f.allFinite()) return Vec3::Zero();
     double scale = 1.0;

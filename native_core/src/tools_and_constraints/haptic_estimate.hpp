@@ -48,6 +48,11 @@ struct HapticEstimate {
     double slope = 0;
 };
 
+/// Stamps `current` (as the tool describes the state a step of `taken` seconds left at `time`)
+/// with its time and sequence, and its velocities by finite differences from `previous` where that
+/// is the previous state of the same grab (else zero).
+void followEstimate(const HapticEstimate& previous, HapticEstimate& current, double time, std::uint64_t sequence, double taken);
+
 /// Reaction force on a cursor at (position, orientation) at simulation time t, from the estimate
 /// extrapolated to t. Allocation-free, no locks: safe on the haptic thread.
 Vec3 estimateForce(const HapticEstimate& e, const Vec3& position, const Eigen::Quaterniond& orientation, double t);

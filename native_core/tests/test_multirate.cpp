@@ -1,0 +1,144 @@
+// The simulation's view of the hand (CursorHistory: the cursor at the step's end, written by the
+// haptic thread, read by the simulation's) and the loops replayed on a virtual clock
+// (replayMultirate): states reaching the haptic loop late.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include "devices/replay_device.hpp"
+#include "runtime/cursor_history.hpp"
+#include "runtime/multirate_replay.hpp"
+#include "solvers/dynamic_surface.hpp"
+
+using namespace hs;
+
+namespace {
+DeviceSample sampleAt(double x, std::uint32_t buttons) {
+    DeviceSample s;
+    s.position = Vec3(x, 2 * x, 3 * x);
+    s.buttons = buttons;
+    s.valid = true;
+    return s;
+}
+
+// A rope stroke: the cursor rests on the patch, grabs, pulls up and around, lets go 0.2 s before
+// the end (bench/haptic_force.py's).
+std::shared_ptr<ReplayDevice> ropeStroke(double seconds) {
+    const int n = static_cast<int>(seconds * 1000) + 1;
+    std::vector<double> t(static_cast<size_t>(n));
+    Points xyz(n, 3);
+    Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> q(n, 4);
+    std::vector<std::uint32_t> buttons(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+        const double ti = i * 1e-3, tau = std::max(0.0, ti - 0.1);
+        t[static_cast<size_t>(i)] = ti;
+        xyz.row(i) << 12.3 + 8 * std::sin(1.3 * tau), -7.1 + 6 * std::sin(0.9 * tau), 14 * std::pow(std::sin(1.2 * tau), 2) + 4 * tau;
+        q.row(i) << 1, 0, 0, 0;
+        buttons[static_cast<size_t>(i)] = ti >= 0.05 && ti < seconds - 0.2 ? 1 : 0;
+    }
+    return std::make_shared<ReplayDevice>(t, xyz, q, buttons);
+}
+
+std::unique_ptr<DynamicSurface> scene(int mesh) {
+    auto s = std::make_unique<DynamicSurface>(BSplineSurface::plane(mesh / 4, mesh / 4, 3, 3, 100, 100), mesh, mesh);
+    s->dampingMap().setUniform(5.0);
+    return s;
+}
+
+// p99 over the grabbed ticks of |force - exact| / max(|exact|, 5 % of the largest |exact|).
+double forceErrorP99(const MultirateTicks& run, const MultirateTicks& exact, double from, double to) {
+    double largest = 0;
+    for (Eigen::Index i = 0; i < exact.force.rows(); ++i) largest = std::max(largest, exact.force.row(i).norm());
+    std::vector<double> e;
+    for (size_t i = 0; i < run.t.size(); ++i)
+        if (run.t[i] >= from && run.t[i] < to) {
+            const auto k = static_cast<Eigen::Index>(i);
+            e.push_back((run.force.row(k) - exact.force.row(k)).norm() / std::max(exact.force.row(k).norm(), 0.05 * largest));
+        }
+    std::sort(e.begin(), e.end());
+    return e[static_cast<size_t>(0.99 * static_cast<double>(e.size() - 1))];
+}
+}  // namespace
+
+TEST(CursorHistory, GivesTheHandAtATimeBetweenItsSamples) {
+    CursorHistory h;
+    DeviceSample out;
+    EXPECT_FALSE(h.at(0.0, out));  // nothing yet
+    h.push(1.0, sampleAt(10, 0));
+    h.push(2.0, sampleAt(20, 1));
+    h.push(3.0, sampleAt(30, 1));
+    ASSERT_TRUE(h.at(1.25, out));
+    EXPECT_NEAR(out.position.x(), 12.5, 1e-12);
+    EXPECT_NEAR(out.position.z(), 37.5, 1e-12);
+    EXPECT_EQ(out.buttons, 0u);  // the buttons of the sample before: pressed only from t = 2
+    ASSERT_TRUE(h.at(2.0, out));
+    EXPECT_EQ(out.buttons, 1u);
+    EXPECT_NEAR(out.position.y(), 40, 1e-12);
+    ASSERT_TRUE(h.at(9.0, out));  // after the newest: the newest
+    EXPECT_NEAR(out.position.x(), 30, 1e-12);
+    ASSERT_TRUE(h.at(0.0, out));  // before the oldest: the oldest
+    EXPECT_NEAR(out.position.x(), 10, 1e-12);
+}
+
+TEST(CursorHistory, KeepsTheLatestSamplesWhenItWrapsAround) {
+    CursorHistory h;
+    const auto n = static_cast<int>(3 * CursorHistory::kSlots + 7);
+    for (int i = 0; i < n; ++i) h.push(i, sampleAt(i, static_cast<std::uint32_t>(i % 2)));
+    DeviceSample out;
+    ASSERT_TRUE(h.at(n - 10.5, out));
+    EXPECT_NEAR(out.position.x(), n - 10.5, 1e-9);
+    EXPECT_EQ(out.buttons, static_cast<std::uint32_t>((n - 11) % 2));
+    ASSERT_TRUE(h.at(0, out));  // long gone: the oldest kept
+    EXPECT_NEAR(out.position.x(), n - static_cast<double>(CursorHistory::kSlots - 1), 1e-9);
+}
+
+TEST(CursorHistory, AReaderBesideTheWriterNeverSeesATornSample) {
+    // The haptic thread pushes while the simulation's reads: every read is a sample the writer
+    // wrote or lies between two (x, 2x, 3x stays on its line, with the earlier one's buttons),
+    // never half of one. TSan checks the rest.
+    CursorHistory h;
+    std::atomic<bool> done{false};
+    std::atomic<int> bad{0}, reads{0};
+    std::thread reader([&] {
+        DeviceSample out;
+        double t = 0;
+        while (!done.load()) {
+            if (h.at(t, out)) {
+                reads.fetch_add(1);
+                const Vec3 p = out.position;
+                if (std::abs(p.y() - 2 * p.x()) > 1e-6 * (1 + std::abs(p.x())) || std::abs(p.z() - 3 * p.x()) > 1e-6 * (1 + std::abs(p.x())))
+                    bad.fetch_add(1);
+                // the buttons of the sample at or before t, whose index is floor(x)
+                if (out.buttons != (static_cast<long>(std::floor(p.x())) % 3 == 0 ? 1u : 0u)) bad.fetch_add(1);
+            }
+            t += 3.7;
+        }
+    });
+    for (int i = 0; i < 200000 || reads.load() < 10000; ++i) h.push(i, sampleAt(i, i % 3 == 0 ? 1u : 0u));
+    done.store(true);
+    reader.join();
+    EXPECT_EQ(bad.load(), 0);
+    EXPECT_GT(reads.load(), 0);
+}
+
+TEST(MultirateReplay, StatesReachTheHapticLoopWhenTheirStepAndLatencyAreOver) {
+    auto device = ropeStroke(0.5);
+    auto a = scene(24);
+    const MultirateTicks now = replayMultirate(*a, *device, 0.5, MultirateSettings{});
+    for (size_t i = 2; i < now.t.size(); ++i) EXPECT_NEAR(now.stateTime[i], now.t[i], 1e-9) << i;  // cost 0: every tick's own state
+    MultirateSettings late;
+    late.latency = 0.004;
+    auto b = scene(24);
+    const MultirateTicks behind = replayMultirate(*b, *device, 0.5, late);
+    for (size_t i = 10; i < behind.t.size(); ++i) EXPECT_NEAR(behind.stateTime[i], behind.t[i] - 0.004, 1e-9) << i;
+    // the same states, later: the estimate bridges 4 ms from a state with its velocity
+    EXPECT_LT(forceErrorP99(behind, now, 0.1, 0.3), 0.05);
+    MultirateSettings bad;
+    bad.stepCost = -1;
+    EXPECT_THROW(replayMultirate(*a, *device, 0.5, bad), std::invalid_argument);
+}
