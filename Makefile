@@ -391,6 +391,7 @@ uninstall:
 bench: build wheel
 	$(PY) bench/table1.py
 	$(PY) bench/loops.py
+	$(PY) bench/haptic_force.py --latencies 2 8 16
 	$(PY) bench/skip.py
 	$(PY) bench/time_vs_error.py $(CAMPAIGN)
 	$(PY) bench/discretisation.py
