@@ -92,14 +92,23 @@ test-cpp: build
 # The core for Windows x86-64, cross-built with MinGW-w64 (posix threads) from the same sources
 # (what differs is in native_core/src/common/platform/), its C++ tests and fuzz replays run under
 # Wine; tools/windows_tests.py names and counts what the Linux build has and Windows does not.
+# The Python module too, for a Windows FreeCAD's CPython 3.11, against what tools/windows_python.py
+# makes from CPython's own sources (fetched once into $(HS_CACHE)); tools/windows_wheel.py packs it
+# as the cp311 win_amd64 wheel in $(BUILD)/wheels-windows and checks what it imports and exports.
+WINDOWS_PYTHON := $(BUILD)/windows-python
+# (make wheel's virtual environment, below: its pip checks the Windows wheel)
+WHEEL_VENV     := $(BUILD)/wheel-venv
 build-windows: deps
 	@$(MAKE) --no-print-directory deps APT_PACKAGES="$(WINDOWS_PACKAGES)"
+	@[ -f $(WINDOWS_PYTHON)/libpython311.a ] || $(PY) tools/windows_python.py $(WINDOWS_PYTHON) --cache $(HS_CACHE)
 	cmake -S native_core -B $(BUILD)/windows -G Ninja -DCMAKE_TOOLCHAIN_FILE=$(CURDIR)/native_core/cmake/mingw-w64.cmake \
-	  -DCMAKE_BUILD_TYPE=Release -DHS_PYTHON=OFF -DHS_NATIVE=OFF -DEigen3_DIR=/usr/share/eigen3/cmake
+	  -DCMAKE_BUILD_TYPE=Release -DHS_PYTHON=OFF -DHS_NATIVE=OFF -DEigen3_DIR=/usr/share/eigen3/cmake \
+	  -DHS_WINDOWS_PYTHON=$(CURDIR)/$(WINDOWS_PYTHON)
 	$(TIMED) build-windows cmake --build $(BUILD)/windows -j $(JOBS)
 
-test-windows: build-windows build
+test-windows: build-windows build $(WHEEL_VENV)/.installed
 	$(TIMED) test-windows $(PY) tools/windows_tests.py --build $(BUILD)/windows --linux $(BUILD)/release
+	$(WHEEL_VENV)/bin/python tools/windows_wheel.py $(BUILD)/windows/hapticsculpt_core.cp311-win_amd64.pyd $(BUILD)/wheels-windows
 
 test-asan: build-asan
 	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
@@ -134,7 +143,6 @@ test-gui: build ocp-venv
 # build's requirements are pinned in the wheel's own virtual environment, not a fresh one of pip's
 # in /tmp each time (--no-build-isolation): pybind11's headers then have the same path in every
 # clone, and the compiler cache serves the bindings too (3 minutes a wheel when it could not).
-WHEEL_VENV := $(BUILD)/wheel-venv
 WHEEL_BUILD_REQUIRES := scikit-build-core==1.1.2 pybind11==3.1.0
 $(WHEEL_VENV)/.installed:
 	$(PY) -m venv $(WHEEL_VENV)

@@ -88,6 +88,18 @@ def test_install_refuses_a_wheel_for_another_python(tmp_path, capsys):
     assert "take the wheel whose name has -cp3" in capsys.readouterr().err
 
 
+def test_a_windows_freecad_takes_the_windows_wheel_and_linux_the_others():
+    windows = {"user": "C:/u/", "version": [1, 0], "python": [3, 11], "windows": True}
+    linux = {"user": "/h/", "version": [0, 20], "python": [3, 11], "windows": False}
+    win_wheel, linux_wheel = ("hapticsculpt_core-0.2.0-cp311-cp311-win_amd64.whl",
+                              "hapticsculpt_core-0.2.0-cp311-cp311-manylinux_2_34_x86_64.whl")
+    assert install_core.wrong_wheel(win_wheel, windows) is None
+    assert install_core.wrong_wheel(linux_wheel, linux) is None
+    assert "-win_amd64.whl" in install_core.wrong_wheel(linux_wheel, windows)
+    assert "not a Windows one" in install_core.wrong_wheel(win_wheel, linux)
+    assert "-cp313-" in install_core.wrong_wheel(win_wheel, dict(windows, python=[3, 13]))
+
+
 def test_addon_manager_reads_the_core_as_a_python_dependency(tmp_path):
     """FreeCAD's own Addon Manager code (0.20's and 1.0's) lists the wheel's package among the
     Python packages it would pip-install with the addon."""
