@@ -4,8 +4,9 @@
 // loop renders from it) was not the one a step at the haptic rate would give. Taken at the step's
 // end, the cursor is where the hand was then, whatever the lag.
 // One writer (the haptic thread), one reader (the simulation thread); lock-free, allocation-free.
-// Each slot is a sequence lock over relaxed atomics: a slot the writer reuses while it is read is
-// detected and read again, never torn.
+// Each slot is a sequence lock over atomics (release stores, acquire loads: no standalone fences,
+// which ThreadSanitizer cannot follow): a slot the writer reuses while it is read is detected and
+// read again, never torn.
 #pragma once
 #include <array>
 #include <atomic>
@@ -26,14 +27,14 @@ public:
         Slot& slot = slots_[i % kSlots];
         const std::uint64_t seq = slot.seq.load(std::memory_order_relaxed);
         slot.seq.store(seq + 1, std::memory_order_relaxed);  // odd: being written
-        std::atomic_thread_fence(std::memory_order_release);
-        slot.v[0].store(t, std::memory_order_relaxed);
-        for (int k = 0; k < 3; ++k) slot.v[1 + k].store(s.position[k], std::memory_order_relaxed);
-        slot.v[4].store(s.orientation.w(), std::memory_order_relaxed);
-        slot.v[5].store(s.orientation.x(), std::memory_order_relaxed);
-        slot.v[6].store(s.orientation.y(), std::memory_order_relaxed);
-        slot.v[7].store(s.orientation.z(), std::memory_order_relaxed);
-        slot.buttons.store(s.buttons, std::memory_order_relaxed);
+        // (release stores: a reader that sees any of the new values sees the odd count after it)
+        slot.v[0].store(t, std::memory_order_release);
+        for (int k = 0; k < 3; ++k) slot.v[1 + k].store(s.position[k], std::memory_order_release);
+        slot.v[4].store(s.orientation.w(), std::memory_order_release);
+        slot.v[5].store(s.orientation.x(), std::memory_order_release);
+        slot.v[6].store(s.orientation.y(), std::memory_order_release);
+        slot.v[7].store(s.orientation.z(), std::memory_order_release);
+        slot.buttons.store(s.buttons, std::memory_order_release);
         slot.seq.store(seq + 2, std::memory_order_release);
         head_.store(i + 1, std::memory_order_release);
     }
@@ -95,13 +96,12 @@ private:
         const Slot& slot = slots_[i % kSlots];
         const std::uint64_t before = slot.seq.load(std::memory_order_acquire);
         if (before & 1u) return false;
-        out.t = slot.v[0].load(std::memory_order_relaxed);
-        for (int k = 0; k < 3; ++k) out.s.position[k] = slot.v[1 + k].load(std::memory_order_relaxed);
-        out.s.orientation = Eigen::Quaterniond(slot.v[4].load(std::memory_order_relaxed), slot.v[5].load(std::memory_order_relaxed),
-                                               slot.v[6].load(std::memory_order_relaxed), slot.v[7].load(std::memory_order_relaxed));
-        out.s.buttons = slot.buttons.load(std::memory_order_relaxed);
+        out.t = slot.v[0].load(std::memory_order_acquire);
+        for (int k = 0; k < 3; ++k) out.s.position[k] = slot.v[1 + k].load(std::memory_order_acquire);
+        out.s.orientation = Eigen::Quaterniond(slot.v[4].load(std::memory_order_acquire), slot.v[5].load(std::memory_order_acquire),
+                                               slot.v[6].load(std::memory_order_acquire), slot.v[7].load(std::memory_order_acquire));
+        out.s.buttons = slot.buttons.load(std::memory_order_acquire);
         out.s.valid = true;
-        std::atomic_thread_fence(std::memory_order_acquire);
         return slot.seq.load(std::memory_order_relaxed) == before &&
                head_.load(std::memory_order_acquire) - i <= kSlots - 1;  // not lapped since
     }
