@@ -190,7 +190,7 @@ def main() -> None:
             show(*row(mesh, f"threaded {load}", device, ref, threaded(mesh, device, args.seconds, load)))
     out = os.path.join(ROOT, "bench", "results")
     os.makedirs(out, exist_ok=True)
-    with open(os.path.join(out, args.name + ".json"), "w") as f:
+    with open(os.path.join(out, args.name + ".json"), "w", encoding="utf-8") as f:
         json.dump({"rows": rows, "machine": f"{os.cpu_count()} cores"}, f, indent=1)
     plot(rows, data, os.path.join(out, args.name + ".png"))
     print(f"wrote bench/results/{args.name}.json, bench/results/{args.name}.png")

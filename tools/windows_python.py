@@ -54,7 +54,7 @@ def exported_names(include: str) -> tuple[set[str], set[str]]:
         for name in files:
             if not name.endswith(".h"):
                 continue
-            text = re.sub(r"/\*.*?\*/", "", open(os.path.join(root, name), errors="replace").read(), flags=re.S)
+            text = re.sub(r"/\*.*?\*/", "", open(os.path.join(root, name), encoding="utf-8", errors="replace").read(), flags=re.S)
             functions.update(re.findall(r"PyAPI_FUNC\s*\((?:[^()]|\([^()]*\))*\)\s*(\w+)\s*\(", text))
             data.update(re.findall(r"PyAPI_DATA\s*\((?:[^()]|\([^()]*\))*\)\s*(\w+)", text))
     # (CPython's names start Py or _Py; the headers also declare pthread stubs for WASI, which no
@@ -90,7 +90,7 @@ def main(argv: list[str]) -> int:
     shutil.copytree(PYBIND11, os.path.join(out, "pybind11", "pybind11"))
     functions, data = exported_names(include)
     definition = os.path.join(out, "python311.def")
-    with open(definition, "w") as f:
+    with open(definition, "w", encoding="utf-8") as f:
         f.write(f"LIBRARY {DLL}\nEXPORTS\n")
         f.writelines(f"    {n}\n" for n in sorted(functions))
         f.writelines(f"    {n} DATA\n" for n in sorted(data))

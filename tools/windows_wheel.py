@@ -36,7 +36,7 @@ SYSTEM_DLLS = {"kernel32.dll", "user32.dll", "advapi32.dll", "msvcrt.dll", "ucrt
 
 
 def version() -> str:
-    text = open(os.path.join(ROOT, "HapticSculpt", "version.py")).read()
+    text = open(os.path.join(ROOT, "HapticSculpt", "version.py"), encoding="utf-8").read()
     return re.search(r'^__version__ = "([^"]+)"', text, re.M).group(1)
 
 
@@ -59,7 +59,7 @@ def pack(pyd: str, outdir: str) -> str:
     ver = version()
     info = f"{MODULE}-{ver}.dist-info"
     files = {
-        f"{MODULE}.{TAG.split('-')[0]}-win_amd64.pyd": open(pyd, "rb").read(),
+        f"{MODULE}.cp311-win_amd64.pyd": open(pyd, "rb").read(),
         f"{info}/METADATA": (f"Metadata-Version: 2.1\nName: hapticsculpt-core\nVersion: {ver}\n"
                              "Summary: The dynamics core of the HapticSculpt FreeCAD workbench (Windows build, "
                              "cross-built with MinGW-w64)\nLicense: LGPL-2.1-or-later\nRequires-Python: >=3.11,<3.12\n"
