@@ -95,20 +95,25 @@ test-cpp: build
 # The Python module too, for a Windows FreeCAD's CPython 3.11, against what tools/windows_python.py
 # makes from CPython's own sources (fetched once into $(HS_CACHE)); tools/windows_wheel.py packs it
 # as the cp311 win_amd64 wheel in $(BUILD)/wheels-windows and checks what it imports and exports.
+# hidapi, simdjson and libwebsockets come from Debian's sources by tools/windows_deps.py.
 WINDOWS_PYTHON := $(BUILD)/windows-python
+WINDOWS_DEPS   := $(BUILD)/windows-deps
 # (make wheel's virtual environment, below: its pip checks the Windows wheel)
 WHEEL_VENV     := $(BUILD)/wheel-venv
 build-windows: deps
 	@$(MAKE) --no-print-directory deps APT_PACKAGES="$(WINDOWS_PACKAGES)"
 	@[ -f $(WINDOWS_PYTHON)/libpython311.a ] || $(PY) tools/windows_python.py $(WINDOWS_PYTHON) --cache $(HS_CACHE)
+	@[ -f $(WINDOWS_DEPS)/libwebsockets/lib/libwebsockets_static.a ] || \
+	  $(PY) tools/windows_deps.py $(WINDOWS_DEPS) --toolchain native_core/cmake/mingw-w64.cmake --cache $(HS_CACHE)
 	cmake -S native_core -B $(BUILD)/windows -G Ninja -DCMAKE_TOOLCHAIN_FILE=$(CURDIR)/native_core/cmake/mingw-w64.cmake \
 	  -DCMAKE_BUILD_TYPE=Release -DHS_PYTHON=OFF -DHS_NATIVE=OFF -DEigen3_DIR=/usr/share/eigen3/cmake \
-	  -DHS_WINDOWS_PYTHON=$(CURDIR)/$(WINDOWS_PYTHON)
+	  -DHS_WINDOWS_PYTHON=$(CURDIR)/$(WINDOWS_PYTHON) -DHS_WINDOWS_DEPS=$(CURDIR)/$(WINDOWS_DEPS)
 	$(TIMED) build-windows cmake --build $(BUILD)/windows -j $(JOBS)
 
 test-windows: build-windows build $(WHEEL_VENV)/.installed
 	$(TIMED) test-windows $(PY) tools/windows_tests.py --build $(BUILD)/windows --linux $(BUILD)/release
-	$(WHEEL_VENV)/bin/python tools/windows_wheel.py $(BUILD)/windows/hapticsculpt_core.cp311-win_amd64.pyd $(BUILD)/wheels-windows
+	$(WHEEL_VENV)/bin/python tools/windows_wheel.py $(BUILD)/windows/hapticsculpt_core.cp311-win_amd64.pyd $(BUILD)/wheels-windows \
+	  --deps $(WINDOWS_DEPS)
 
 test-asan: build-asan
 	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""What the Windows Python module is built against, with no Windows Python here (make wheel-windows):
+"""What the Windows Python module is built against, with no Windows Python here (make build-windows):
 CPython 3.11's own headers (Include/ and PC/pyconfig.h, from Debian's python3.11 source package,
 the version FreeCAD's Windows builds bundle), an import library for python311.dll made from the
 functions and data those headers export (PyAPI_FUNC, PyAPI_DATA) by MinGW's dlltool, and
@@ -13,38 +13,20 @@ tarball is fetched once into --cache and checked against its SHA-256.
 from __future__ import annotations
 
 import argparse
-import hashlib
 import os
 import re
 import shutil
 import subprocess
 import sys
-import tarfile
-import urllib.request
 
-SOURCE = "python3.11_3.11.2.orig.tar.gz"
-URL = "https://deb.debian.org/debian/pool/main/p/python3.11/" + SOURCE
+from debian_source import extract, fetch
+
+SOURCE = "p/python3.11/python3.11_3.11.2.orig.tar.gz"
 SHA256 = "2411c74bda5bbcfcddaf4531f66d1adc73f247f529aee981b029513aefdbf849"
 TOP = "Python-3.11.2/"
 DLL = "python311.dll"
 PYBIND11 = "/usr/include/pybind11"
 DLLTOOL = "x86_64-w64-mingw32-dlltool"
-
-
-def fetch(cache: str) -> str:
-    """The source tarball, downloaded into cache once and checked."""
-    os.makedirs(cache, exist_ok=True)
-    path = os.path.join(cache, SOURCE)
-    if not os.path.exists(path):
-        partial = path + ".part"
-        with urllib.request.urlopen(URL, timeout=120) as response, open(partial, "wb") as out:
-            shutil.copyfileobj(response, out)
-        os.replace(partial, path)
-    digest = hashlib.sha256(open(path, "rb").read()).hexdigest()
-    if digest != SHA256:
-        os.remove(path)
-        raise SystemExit(f"{SOURCE}: SHA-256 {digest}, expected {SHA256} (removed; run again)")
-    return path
 
 
 def exported_names(include: str) -> tuple[set[str], set[str]]:
@@ -74,19 +56,12 @@ def main(argv: list[str]) -> int:
         raise SystemExit(f"{DLLTOOL} not found (Debian: apt install binutils-mingw-w64-x86-64)")
     if not os.path.isdir(PYBIND11):
         raise SystemExit(f"{PYBIND11} not found (Debian: apt install pybind11-dev)")
-    tarball = fetch(args.cache)
+    tarball = fetch(args.cache, SOURCE, SHA256)
     out = os.path.abspath(args.out)
     shutil.rmtree(out, ignore_errors=True)
     include = os.path.join(out, "include")
-    os.makedirs(include)
-    with tarfile.open(tarball) as tar:
-        for member in tar.getmembers():
-            if member.isfile() and (member.name.startswith(TOP + "Include/") or member.name == TOP + "PC/pyconfig.h"):
-                relative = member.name[len(TOP + "Include/"):] if member.name.startswith(TOP + "Include/") else "pyconfig.h"
-                target = os.path.join(include, relative)
-                os.makedirs(os.path.dirname(target), exist_ok=True)
-                with tar.extractfile(member) as src, open(target, "wb") as dst:
-                    shutil.copyfileobj(src, dst)
+    extract(tarball, TOP + "Include/", [""], include)
+    extract(tarball, TOP + "PC/", ["pyconfig.h"], include)
     shutil.copytree(PYBIND11, os.path.join(out, "pybind11", "pybind11"))
     functions, data = exported_names(include)
     definition = os.path.join(out, "python311.def")

@@ -22,9 +22,6 @@ NOT_ON_WINDOWS = {
     "RealtimeKit": "RealtimeKit over D-Bus is how Linux grants real-time priority (Windows: MMCSS)",
     "DBusWriter": "the D-Bus client RealtimeKit needs, Linux's",
     "DBusReply": "the D-Bus client RealtimeKit needs, Linux's",
-    "HaplyDevice": "Haply's Inverse Service needs a WebSocket client, libwebsockets, not built for Windows yet",
-    "HaplyMessages": "Haply's messages are read with simdjson, not built for Windows yet",
-    "Fuzz.fuzz_haply_messages": "Haply's messages are read with simdjson, not built for Windows yet",
 }
 #: The replay drivers and their inputs (as native_core/CMakeLists.txt's add_test lines give them).
 FIXTURES = ROOT / "tests" / "fixtures"
@@ -33,6 +30,8 @@ REPLAYS = {
     "fuzz_spacemouse_report": sorted((FIXTURES / "hid").glob("*.hid")),
     "fuzz_hid_recording": sorted((FIXTURES / "hid").glob("*.hid")),
     "fuzz_falcon_frames": [FIXTURES / "falcon" / "status_stream.bin"],
+    "fuzz_haply_messages": [FIXTURES / "haply" / "inventory.json", FIXTURES / "haply" / "state.json",
+                            *sorted((ROOT / "native_core" / "fuzz" / "findings" / "fuzz_haply_messages").glob("*"))],
 }
 
 
@@ -93,7 +92,7 @@ def main() -> int:
     linux_tests = pathlib.Path(args.linux).resolve() / "hscore_tests"
     if linux_tests.is_file():
         linux = set(gtest_names([str(linux_tests)]))
-        linux |= {f"Fuzz.{h}" for h in (*REPLAYS, "fuzz_haply_messages")}
+        linux |= {f"Fuzz.{h}" for h in REPLAYS}
         missing = sorted(linux - windows)
         unexplained = [t for t in missing if t.split(".")[0] not in NOT_ON_WINDOWS and t not in NOT_ON_WINDOWS]
         print(f"on Windows (Wine): {len(windows)} tests; not on Windows: {len(missing)} of the Linux build's "

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The Windows wheel for FreeCAD's Python 3.11 (make wheel-windows, part of make test-windows): packs
+"""The Windows wheel for FreeCAD's Python 3.11 (make test-windows): packs
 the cross-built hapticsculpt_core.cp311-win_amd64.pyd into hapticsculpt_core-VERSION-cp311-cp311-
 win_amd64.whl and checks it as far as a machine without Windows can:
 
@@ -54,8 +54,13 @@ def record_line(arcname: str, data: bytes) -> str:
     return f"{arcname},sha256={digest},{len(data)}"
 
 
-def pack(pyd: str, outdir: str) -> str:
-    """The wheel: the module at its root, the metadata pip needs."""
+#: The licences of what the module links in (tools/windows_deps.py's folders), under the wheel's
+#: dist-info/licenses/.
+BUNDLED_LICENCES = {"hidapi": ["LICENSE.txt", "LICENSE-bsd.txt"], "simdjson": ["LICENSE"], "libwebsockets": ["LICENSE"]}
+
+
+def pack(pyd: str, outdir: str, deps: str) -> str:
+    """The wheel: the module at its root, the metadata pip needs, the bundled libraries' licences."""
     ver = version()
     info = f"{MODULE}-{ver}.dist-info"
     files = {
@@ -67,6 +72,10 @@ def pack(pyd: str, outdir: str) -> str:
         f"{info}/WHEEL": f"Wheel-Version: 1.0\nGenerator: tools/windows_wheel.py\nRoot-Is-Purelib: false\nTag: {TAG}\n".encode(),
         f"{info}/LICENSE": open(os.path.join(ROOT, "LICENSE"), "rb").read(),
     }
+    for library, names in BUNDLED_LICENCES.items():
+        for name in names:
+            with open(os.path.join(deps, library, name), "rb") as f:
+                files[f"{info}/licenses/{library}-{name}"] = f.read()
     record = "\n".join(record_line(n, d) for n, d in files.items()) + f"\n{info}/RECORD,,\n"
     os.makedirs(outdir, exist_ok=True)
     path = os.path.join(outdir, f"{MODULE}-{ver}-{TAG}.whl")
@@ -81,6 +90,7 @@ def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("pyd", help=f"{MODULE}.cp311-win_amd64.pyd as the cross build made it")
     parser.add_argument("outdir", help="where to write the wheel")
+    parser.add_argument("--deps", required=True, help="what tools/windows_deps.py made (the bundled libraries' licences)")
     args = parser.parse_args(argv)
     dlls, exports = imports_and_exports(args.pyd)
     foreign = [d for d in dlls if d.lower() not in SYSTEM_DLLS and d.lower() != "python311.dll"
@@ -95,7 +105,7 @@ def main(argv: list[str]) -> int:
     if problems:
         print(f"{args.pyd}: " + "; ".join(problems), file=sys.stderr)
         return 1
-    wheel = pack(args.pyd, args.outdir)
+    wheel = pack(args.pyd, args.outdir, args.deps)
     with tempfile.TemporaryDirectory() as target:
         pip = subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--disable-pip-version-check", "--no-deps",
                               "--platform", "win_amd64", "--python-version", "3.11", "--implementation", "cp",

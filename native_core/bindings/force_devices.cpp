@@ -12,9 +12,7 @@
 #include "devices/vendor/dhd_device.hpp"
 #include "devices/falcon/falcon_device.hpp"
 #include "devices/falcon/falcon_usb.hpp"
-#ifndef HS_NO_HAPLY
 #include "devices/haply/haply_device.hpp"
-#endif
 #include "devices/vendor/openhaptics_device.hpp"
 
 namespace py = pybind11;
@@ -115,14 +113,6 @@ void bindForceDevices(py::module_& m) {
         return out;
     }, "The force devices' limits (N, N s/m, kg, Hz, N/m at each rate) and where they come from.");
 
-#ifdef HS_NO_HAPLY
-    // (the Windows module: no WebSocket client for Haply's Inverse Service there yet, docs/development.md)
-    const auto noHaply = [](const py::args&, const py::kwargs&) -> py::object {
-        throw std::runtime_error("Haply Inverse3: its Inverse Service's WebSocket client is not built for Windows yet");
-    };
-    m.def("haply_devices", noHaply, "Haply's Inverse Service is not reachable from the Windows module yet.");
-    m.def("HaplyDevice", noHaply, "Haply's Inverse Service is not reachable from the Windows module yet.");
-#else
     m.def("haply_devices", [](const std::string& host, int port, double timeout) {
         std::vector<haply::Inverse3Info> found;
         {
@@ -162,8 +152,6 @@ void bindForceDevices(py::module_& m) {
         .def_property_readonly("device_id", &HaplyDevice::deviceId)
         .def_property_readonly("updates", &HaplyDevice::updates)
         .def_property_readonly("malformed", &HaplyDevice::malformed);
-
-#endif
 
     py::class_<FalconDevice, Device, std::shared_ptr<FalconDevice>>(m, "FalconDevice",
         "A Novint Falcon on USB (libusb loaded at run time); its firmware is loaded from `firmware` if it is not running.")

@@ -12,9 +12,7 @@
 #include "bindings.hpp"
 #include "convert.hpp"
 #include "devices/hid/hid_report_descriptor.hpp"
-#ifndef HS_NO_HIDAPI
 #include "devices/hid/hidapi_transport.hpp"
-#endif
 #include "devices/hid/pid_emulator.hpp"
 #include "devices/hid/pid_force.hpp"
 #include "devices/hid/recorded_transport.hpp"
@@ -59,18 +57,9 @@ HidRecording loadRecording(const std::string& path) {
     return parseHidRecording(text);
 }
 
-// The system's HID interfaces through hidapi. The Windows module is built without it (hidapi is not
-// built for Windows here yet, docs/development.md): there each says so instead.
-#ifdef HS_NO_HIDAPI
-[[noreturn]] void noHidapi() {
-    throw std::runtime_error("HID devices (SpaceMouse, HID PID force output): hidapi is not built for Windows yet");
-}
-std::vector<HidInfo> hidInterfaces() { noHidapi(); }
-std::unique_ptr<HidTransport> openHid(const std::string&) { noHidapi(); }
-#else
+// The system's HID interfaces through hidapi.
 std::vector<HidInfo> hidInterfaces() { return enumerateHid(); }
 std::unique_ptr<HidTransport> openHid(const std::string& path) { return std::make_unique<HidapiTransport>(path); }
-#endif
 }  // namespace
 
 void bindHidDevices(py::module_& m) {

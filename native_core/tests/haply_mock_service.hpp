@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <mutex>
@@ -30,7 +32,13 @@ public:
         lws_set_log_level(LLL_ERR, nullptr);
         lws_context_creation_info info{};
         info.port = 0;  // the kernel picks
-        info.iface = "lo";  // loopback only (an interface name: libwebsockets 4.3 takes no address here)
+        // Loopback only: an interface name on Linux (libwebsockets 4.3 takes no address here); Windows
+        // names no interface "lo", and the 4.1 built for it takes the address.
+#ifdef _WIN32
+        info.iface = "127.0.0.1";
+#else
+        info.iface = "lo";
+#endif
         info.options = LWS_SERVER_OPTION_DISABLE_IPV6;
         info.protocols = protocols;
         info.user = this;
@@ -56,6 +64,10 @@ public:
     fake::Mechanism mechanism;  // Haply's frame, m
     long malformedEvery = 0, closeAfter = -1;
     bool inUse = false;
+    // The mechanism steps once per command (a tick-by-tick test's clock), or with the wall clock, as
+    // an Inverse3 runs whatever the link's rate (a session: Wine's sockets carry a few hundred
+    // commands a second, which would slow the hand's script as much).
+    bool realTime = false;
     // what the test looks at (under lock)
     long commands = 0, repliesSent = 0, connections = 0;
     std::string firstCommand;
@@ -124,7 +136,15 @@ private:
         double f[3] = {0, 0, 0};
         if (v) std::sscanf(v, "\"set_cursor_force\":{\"vector\":{\"x\":%lf,\"y\":%lf,\"z\":%lf", &f[0], &f[1], &f[2]);
         for (int i = 0; i < 3; ++i) lastForce[i] = mechanism.force[i] = f[i];
-        mechanism.step();
+        int steps = 1;
+        if (realTime) {
+            const auto now = std::chrono::steady_clock::now();
+            if (commands == 1) clock_ = now;
+            const auto dt = std::chrono::duration<double>(mechanism.dt);
+            steps = static_cast<int>(std::min(50.0, std::floor((now - clock_) / dt)));
+            clock_ = steps == 50 ? now : clock_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(steps * dt);
+        }
+        for (int k = 0; k < steps; ++k) mechanism.step();
     }
 
     std::size_t message(bool inventory, char* out, std::size_t room) const {
@@ -157,6 +177,7 @@ private:
     std::size_t rxLength_ = 0;
     long pending_ = 0;
     bool inventoryDue_ = false;
+    std::chrono::steady_clock::time_point clock_;  // the mechanism's time, when realTime
 };
 
 }  // namespace hs::haply

@@ -136,6 +136,7 @@ TEST(HaplyDevice, ARopeStrokeInAThreadedSessionThenTheLinkDrops) {
     // the hand takes the grip 20 mm up over 0.6 s with the button held, lets go at 0.8 s
     script(service, {{0, 0, 0, 0, 1}, {0.6, 0, 0, 0.02, 1}, {0.8, 0, 0, 0.02, 0}, {5, 0, 0, 0.02, 0}});
     service.closeAfter = 1400;
+    service.realTime = true;
     expectLostAfterAStroke(sessionUntilItStops(std::make_shared<HaplyDevice>(at(service))));
     std::lock_guard<std::recursive_mutex> g(service.lock);
     EXPECT_GT(service.mechanism.largestForce, 0.05);  // and pulled the grip back

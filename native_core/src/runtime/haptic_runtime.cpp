@@ -272,9 +272,9 @@ void HapticRuntime::stop() {
     snapshots_.resize(snapshotCount_);
 }
 
-void HapticRuntime::takeRealtimePriority() {
+void HapticRuntime::takeRealtimePriority(const std::string& wakeups) {
     const PriorityGrant g = takeHapticPriority(settings_.realtime);
-    realtimeHow_ = g.how;
+    realtimeHow_ = wakeups.empty() ? g.how : g.how + "; " + wakeups;
     realtimeOk_.store(g.ok, std::memory_order_relaxed);
     realtimeKnown_.store(true, std::memory_order_release);
 }
@@ -284,8 +284,8 @@ std::string HapticRuntime::realtimeHow() const {
 }
 
 void HapticRuntime::hapticLoop() {
-    takeRealtimePriority();
     const PreciseWakeups wakeups;
+    takeRealtimePriority(wakeups.how());
     const auto spin = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(settings_.spin));
     const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / settings_.hapticRate));
     const auto idlePeriod = settings_.idleRate > 0
@@ -302,11 +302,11 @@ void HapticRuntime::hapticLoop() {
             // seen within 1/idleRate and the next tick is back at full rate.
             next += idle ? idlePeriod : period;
             if (spin.count() > 0 && !idle) {
-                std::this_thread::sleep_until(next - spin);
+                wakeups.sleepUntil(next - spin);
                 while (Clock::now() < next) {
                 }
             } else {
-                std::this_thread::sleep_until(next);
+                wakeups.sleepUntil(next);
             }
             const auto tick = Clock::now();
             if (!first && !idle && !wasIdle) {

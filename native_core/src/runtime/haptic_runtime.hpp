@@ -202,7 +202,7 @@ private:
     void hapticLoop();
     /// SCHED_FIFO for the calling (haptic) thread: directly where the rtprio limit allows, else from
     /// RealtimeKit; says how, or why not (realtimeHow()).
-    void takeRealtimePriority();
+    void takeRealtimePriority(const std::string& wakeups);  // (wakeups: how the thread is woken, if worth saying)
     void simLoop();
     double now() const;
     void fail(const char* message);

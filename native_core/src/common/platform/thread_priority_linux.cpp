@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <thread>
 
 #include "common/platform/dbus_connection.hpp"
 #include "common/platform/realtime_kit.hpp"
@@ -52,6 +53,10 @@ PreciseWakeups::PreciseWakeups() {
 }
 
 PreciseWakeups::~PreciseWakeups() = default;
+
+void PreciseWakeups::CloseTimer::operator()(void*) const {}  // (no timer handle on Linux)
+
+void PreciseWakeups::sleepUntil(std::chrono::steady_clock::time_point t) const { std::this_thread::sleep_until(t); }
 
 void lowerThreadPriority(int steps) {
     if (steps > 0) setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), std::min(steps, 19));

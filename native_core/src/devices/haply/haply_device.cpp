@@ -37,7 +37,7 @@ struct HaplyDevice::Link {
     std::mutex lock;  // guards phase, why and inventory for start() (setup, not the ticks)
     std::condition_variable changed;
     Phase phase = Phase::Connecting;
-    std::string why, deviceId;
+    std::string why, deviceId, where;  // (where: host:port, for messages)
     std::vector<haply::Inverse3Info> inventory;
     bool inventoryRead = false;
     haply::State last;  // the I/O thread's own copy of the newest state
@@ -107,6 +107,16 @@ struct HaplyDevice::Link {
             set(Phase::Closed, "Haply: the link to the service broke");
     }
 
+    void unreachable(const std::string& reason) {
+        set(Phase::Failed, "Haply: cannot reach the Inverse Service at " + where + " (" + reason + "): is it running?");
+    }
+    // A link that closes before it was ever up could not reach the service (libwebsockets on Windows
+    // reports a refused connection so, with no connection error first).
+    void closed(const char* reason) {
+        if (current() == Phase::Connecting) unreachable("refused");
+        else set(Phase::Closed, reason);
+    }
+
     static int callback(lws* w, lws_callback_reasons reason, void*, void* in, size_t len) {
         auto* self = static_cast<Link*>(lws_context_user(lws_get_context(w)));
         if (!self) return 0;
@@ -133,15 +143,14 @@ struct HaplyDevice::Link {
                 if (self->wsi && self->wantSend.exchange(false) && self->current() == Phase::Running) lws_callback_on_writable(self->wsi);
                 break;
             case LWS_CALLBACK_CLIENT_CONNECTION_ERROR:
-                self->set(Phase::Failed, std::string("Haply: cannot reach the Inverse Service (") +
-                                             (in ? static_cast<const char*>(in) : "no reason") + "): is it running?");
+                self->unreachable(in ? static_cast<const char*>(in) : "no reason");
                 break;
             case LWS_CALLBACK_CLIENT_CLOSED:
-                self->set(Phase::Closed, "Haply: the service closed the link");
+                self->closed("Haply: the service closed the link");
                 break;
             case LWS_CALLBACK_WSI_DESTROY:
                 self->wsi = nullptr;
-                self->set(Phase::Closed, "Haply: the link to the service closed");
+                self->closed("Haply: the link to the service closed");
                 break;
             default:
                 break;
@@ -150,6 +159,7 @@ struct HaplyDevice::Link {
     }
 
     bool connect(const std::string& host, int port) {
+        where = host + ":" + std::to_string(port);
         static const lws_protocols protocols[] = {{"haply", &Link::callback, 0, 0, 0, nullptr, 0}, {nullptr, nullptr, 0, 0, 0, nullptr, 0}};
         lws_set_log_level(LLL_ERR, nullptr);
         lws_context_creation_info info{};
@@ -170,7 +180,7 @@ struct HaplyDevice::Link {
         ci.origin = host.c_str();
         ci.pwsi = &wsi;
         if (!lws_client_connect_via_info(&ci)) {
-            set(Phase::Failed, "Haply: cannot connect to " + host + ":" + std::to_string(port));
+            set(Phase::Failed, "Haply: cannot connect to " + where);
             return false;
         }
         return true;
