@@ -142,3 +142,53 @@ TEST(MultirateReplay, StatesReachTheHapticLoopWhenTheirStepAndLatencyAreOver) {
     bad.stepCost = -1;
     EXPECT_THROW(replayMultirate(*a, *device, 0.5, bad), std::invalid_argument);
 }
+
+// Passivity with a lagging simulation (issue 49): over a stroke that pulls the hand up and down
+// three times, the work the rendered force does on the hand (a zero-order hold: each tick's force
+// over the hand's move to the next tick) never adds up above zero, whether the simulation keeps
+// pace, falls behind and drops its backlog (a step costing 3 or 20 times its simulated time) or
+// its states arrive 50 ms late. A force estimated from stale states that led the hand instead of
+// lagging it would give energy back and fail this.
+TEST(MultirateReplay, NoEnergyIsMadeWhenTheSimulationLags) {
+    const double seconds = 1.5, pi = 3.14159265358979;
+    const int n = static_cast<int>(seconds * 1000) + 1;
+    std::vector<double> t(static_cast<size_t>(n));
+    Points xyz(n, 3);
+    Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> q(n, 4);
+    std::vector<std::uint32_t> buttons(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+        const double ti = i * 1e-3, tau = std::max(0.0, ti - 0.1);
+        t[static_cast<size_t>(i)] = ti;
+        xyz.row(i) << 12.3 + 3 * std::sin(3 * pi * tau), -7.1, 6 * std::pow(std::sin(4 * pi * tau), 2);
+        q.row(i) << 1, 0, 0, 0;
+        buttons[static_cast<size_t>(i)] = ti >= 0.05 && ti < seconds - 0.2 ? 1 : 0;
+    }
+    const auto device = std::make_shared<ReplayDevice>(t, xyz, q, buttons);
+    struct Lag {
+        double cost, latency;
+    };
+    for (const char* tool : {"rope", "magnet"})
+        for (const Lag lag : {Lag{0, 0}, Lag{0.003, 0}, Lag{0.02, 0.02}, Lag{0, 0.05}}) {
+            auto surface = scene(32);
+            surface->setTool(tool);
+            MultirateSettings s;
+            s.stepCost = lag.cost;
+            s.latency = lag.latency;
+            const MultirateTicks run = replayMultirate(*surface, *device, seconds, s);
+            double work = 0, most = 0, moved = 0;
+            for (Eigen::Index k = 0; k + 1 < run.cursor.rows(); ++k) {
+                const double dw = run.force.row(k).dot(run.cursor.row(k + 1) - run.cursor.row(k));
+                work += dw;
+                moved += std::abs(dw);
+                most = std::max(most, work);
+            }
+            const std::string what = std::string(tool) + ", step cost " + std::to_string(lag.cost) + " s, latency " +
+                                     std::to_string(lag.latency) + " s";
+            ASSERT_TRUE(run.force.allFinite()) << what;
+            EXPECT_GT(moved, 1.0) << what << ": the force did work";  // (N mm: the stroke was felt)
+            EXPECT_LE(most, 1e-9 * moved) << what << ": the device gave the hand energy";
+            if (lag.cost > 0) {
+                EXPECT_GT(run.droppedSimTime, 0.1) << what << ": the simulation fell behind";
+            }
+        }
+}
