@@ -135,6 +135,9 @@ public:
     /// The force's slope on anchor() as last applied (0 when it pulled nothing): the local/global
     /// step takes a one-point tool implicitly with it.
     virtual double anchorSlope() const { return 0.0; }
+    /// Whether the local/global step takes this tool implicitly on its anchor (with anchorSlope);
+    /// the others' forces are explicit there.
+    virtual bool implicitOnAnchor() const { return false; }
     /// Fills the local model the haptic loop renders between steps (positions, law, parameters;
     /// velocities are left to the caller). The default holds the last reaction.
     void describe(const MeshView& mesh, const Reaction& last, HapticEstimate& e) const;

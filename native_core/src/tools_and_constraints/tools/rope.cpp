@@ -40,6 +40,7 @@ public:
     }
     double slope() const override { return gain_ * std::max(p(Stiffness), p(StiffStiffness)); }
     double anchorSlope() const override { return appliedScale_ * slopeNow_; }
+    bool implicitOnAnchor() const override { return true; }
     double readout(int i) const override { return i == RestLength ? restLengthAt(time_) : i == Gain ? gain_ : 0.0; }
 
 protected:
