@@ -360,6 +360,40 @@ def closest_parameters(surface: Any, poles: np.ndarray, points: np.ndarray, star
     return uv, np.linalg.norm(points - r.apply(r.s, poles), axis=1)
 
 
+#: Where the surface's normals under a curve are within this (degrees) of the normal of the plane
+#: its net lies nearest, the curve's points are taken across to the surface along that normal, not
+#: to their closest points (see make()).
+ACROSS_SPREAD_DEGREES = 60.0
+
+
+def across_parameters(surface: Any, poles: np.ndarray, points: np.ndarray, start: np.ndarray,
+                      direction: np.ndarray) -> tuple[np.ndarray, bool]:
+    """The parameters of the surface's points straight across from ``points`` along ``direction``
+    (a unit vector: the gap S(u, v) - x parallel to it), by Gauss-Newton steps from ``start`` kept
+    inside the domain; and whether every point found one (no gap left across the direction)."""
+    uv = np.array(start, dtype=float)
+    (u0, u1), (v0, v1) = surface.domain
+    flat = np.eye(3) - np.outer(direction, direction)  # (what of a vector lies across the direction)
+    for _ in range(50):
+        r = rows(surface, uv)
+        s, su, sv = (r.apply(c, poles) @ flat for c in (r.s, r.su, r.sv))
+        e = points @ flat - s
+        g = np.stack([(su * su).sum(1), (su * sv).sum(1), (sv * sv).sum(1)], axis=1)
+        b = np.stack([(su * e).sum(1), (sv * e).sum(1)], axis=1)
+        det = g[:, 0] * g[:, 2] - g[:, 1] ** 2
+        det = np.where(np.abs(det) > 0, det, 1.0)
+        step = np.column_stack([(g[:, 2] * b[:, 0] - g[:, 1] * b[:, 1]) / det,
+                                (g[:, 0] * b[:, 1] - g[:, 1] * b[:, 0]) / det])
+        new = np.column_stack([np.clip(uv[:, 0] + step[:, 0], u0, u1), np.clip(uv[:, 1] + step[:, 1], v0, v1)])
+        done = np.abs(new - uv).max() <= 1e-15
+        uv = new
+        if done:
+            break
+    r = rows(surface, uv)
+    left = np.linalg.norm((points - r.apply(r.s, poles)) @ flat, axis=1)
+    return uv, bool(left.max() <= 1e-9 * max(1.0, float(np.abs(points).max())))
+
+
 def _unit(vectors: np.ndarray, what: str) -> np.ndarray:
     """The vectors scaled to length 1; ValueError saying ``what`` is missing where one is (next to)
     zero: a degenerate surface or curve there."""
@@ -441,19 +475,35 @@ def _pivots(a: np.ndarray, tolerance: float) -> list[int]:
         chosen.append(j)
 
 
+#: The most a pull onto a curve may move a pole, in multiples of the farthest the curve is from the
+#: surface: a B-spline's poles stand a few times further out than the bump they make, and past
+#: this the conditions' nearly blind directions are doing the work (a line over a clamped patch's
+#: bump, its ends by the held tangent planes, threw poles 700 m and the GUI's view with them).
+MOVE_PER_GAP = 10.0
+
+
 def _least_move(a: np.ndarray, gap: np.ndarray, tolerance: float) -> np.ndarray:
     """The smallest pole move x with a x = gap to ``tolerance`` (largest row), leaving out the
     directions the conditions barely see (singular values below 1e-4, then 1e-6 ... 1e-12 of the
-    largest, the first that reaches it): with the conditions as ill-conditioned as they are, a
-    tiny gap along those (a curve a micrometre off the surface) would throw far poles by metres."""
+    largest, the first that reaches it) and never moving a pole more than MOVE_PER_GAP times the
+    largest gap, each coordinate on its own: with the conditions as ill-conditioned as they are, a
+    tiny gap along those (a curve a micrometre off the surface) would throw far poles by metres.
+    Where no move within that reaches the tolerance, the last one within it (the caller finds it
+    misses the curve: a finer net, or held poles freed, gives the freedom)."""
     u, singular, vt = np.linalg.svd(a, full_matrices=False)
     projected = u.T @ gap
-    for cut in (1e-4, 1e-6, 1e-8, 1e-10, 1e-12):
-        keep = singular > cut * singular[0]
-        move = vt[keep].T @ (projected[keep] / singular[keep, None])
-        if np.abs(a @ move - gap).max() <= tolerance:
-            break
-    return move
+    best = np.zeros((a.shape[1], gap.shape[1]))
+    for c in range(gap.shape[1]):
+        limit = MOVE_PER_GAP * np.abs(gap[:, c]).max() + tolerance
+        for cut in (1e-4, 1e-6, 1e-8, 1e-10, 1e-12):
+            keep = singular > cut * singular[0]
+            move = vt[keep].T @ (projected[keep, c] / singular[keep])
+            if np.abs(move).max() > limit:
+                break
+            best[:, c] = move
+            if np.abs(a @ move - gap[:, c]).max() <= tolerance:
+                break
+    return best
 
 
 def fit(dynamic: core.DynamicSurface, records: list[CurveConstraint], held: list[int],
@@ -589,6 +639,18 @@ def make(dynamic: core.DynamicSurface, curve: Any, continuity: str, normal: Any,
     count = max(SAMPLES, 2 * (p + q + 1) * cells)
     points, along, _ = curve_samples(curve, count)
     uv, _ = closest_parameters(surface, poles, points, nearest_mesh_parameters(dynamic, points))
+    # Where the surface under the curve faces the way its net does (the normal of the plane the
+    # poles lie nearest), each point is held straight across from it that way, and the pull onto
+    # the curve is across the sheet. Its closest points lie on the slopes of a bump the curve passes
+    # under, and the pull to them went sideways (poles thrown past a clamped patch's edge). Where
+    # the surface turns away under it (a round), the closest points.
+    facing = normals(surface, poles, uv)
+    across = np.linalg.svd(poles - poles.mean(axis=0), full_matrices=False)[2][-1]
+    across = across if across @ facing.mean(axis=0) >= 0 else -across
+    if np.degrees(np.arccos(np.clip((facing @ across).min(), -1.0, 1.0))) <= ACROSS_SPREAD_DEGREES:
+        straight, found = across_parameters(surface, poles, points, uv, across)
+        if found:
+            uv = straight
     dense, _ = curve_points(curve, 3 * count)  # (the check's points, between the conditions' samples too)
     record = CurveConstraint(cid, continuity, label, uv, points, normal=None if normal is None else normal.tolist(),
                              tolerance=tolerance)
