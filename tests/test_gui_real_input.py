@@ -89,21 +89,49 @@ class Desktop:
         raise AssertionError(f"timed out waiting for the window {title!r} to have the keyboard")
 
     def save_as(self, path: str) -> dict:
-        """ctrl+s into FreeCAD's save dialog: the path typed, then Return until the document has it
-        (the dialog's file-name completer can pop up as the path is typed, and a Return then only
-        closes the popup, as it does for a user, who presses it again). The state."""
+        """ctrl+s into FreeCAD's save dialog, the path typed and Return pressed, as a user does it:
+        with the path read in the field first, and the field's completer popup gone (a Return
+        into a shown popup takes its highlighted entry: under load it took the folder's name and
+        FreeCAD saved the document as that plus .FCStd). A popup that stays is closed with Escape,
+        as a user does; should that close the dialog instead, ctrl+s opens it again. The state."""
+
+        def saved(s: dict) -> bool:
+            return s["docs"][s["active"]]["file"] == path
+
+        def field(s: dict) -> dict:
+            return s["file_dialog"] or {}
+
         self.shortcut("ctrl+s", "Std_Save")
         self.wait_window("Save FreeCAD Document")
         self.xdo("type", path)
         for attempt in range(3):
+            s = self.wait(lambda s: s["file_dialog"] is not None or saved(s), "the save dialog's field", timeout=4.0,
+                          shot=False) if attempt else self.wait(lambda s: s["file_dialog"] is not None,
+                                                                "the save dialog's field")
+            if saved(s):
+                return s
+            if s["file_dialog"] is None:  # (an Escape closed the dialog, not the popup)
+                self.shortcut("ctrl+s", "Std_Save")
+                self.wait_window("Save FreeCAD Document")
+                self.xdo("type", path)
+            try:
+                self.wait(lambda s: field(s).get("text") == path, "the path in the field", timeout=4.0, shot=False)
+            except AssertionError:
+                self.xdo("key", "ctrl+a")
+                self.xdo("type", path)
+                self.wait(lambda s: field(s).get("text") == path, "the path typed again into the field")
+            try:
+                self.wait(lambda s: not field(s).get("popup"), "the completer's popup gone", timeout=2.0, shot=False)
+            except AssertionError:
+                self.xdo("key", "Escape")
+                continue
             self.xdo("key", "Return")
             try:
-                return self.wait(lambda s: s["docs"][s["active"]]["file"] == path, "the document saved",
-                                 timeout=4.0 if attempt < 2 else 20.0, shot=attempt == 2)
+                return self.wait(saved, "the document saved", timeout=4.0 if attempt < 2 else 20.0, shot=attempt == 2)
             except AssertionError:
                 if attempt == 2:
                     raise
-        raise AssertionError("unreachable")
+        raise AssertionError(f"the save dialog did not take {path} in 3 tries; {self.alive_or_exit()}")
 
     def focus(self) -> None:
         """Keyboard focus to FreeCAD's main window (what clicking its title bar does on a desktop),

@@ -367,16 +367,22 @@ REPORT_CHARS = 6000
 
 
 def _console_panels_and_questions():
-    """Four things found in one walk of the main window's widgets: [x, y, width, height] on the
+    """Five things found in one walk of the main window's widgets: [x, y, width, height] on the
     screen of the Python console if it is shown (else None), of each shown panel FreeCAD lays over
     the 3D view (FreeCAD 1.1's Tasks panel on the view's right: a wheel turned over it does not reach
     the view, FreeCAD issue 21141; none before 1.0), and the buttons of a question FreeCAD shows (a
-    QMessageBox: "Save all changes...?") by text, at their centres in screen pixels, and the end of
-    the report view's text (REPORT_CHARS)."""
+    QMessageBox: "Save all changes...?") by text, at their centres in screen pixels, the end of
+    the report view's text (REPORT_CHARS), and what a shown file dialog's file name field holds
+    (else None) with whether its completer's popup list is shown."""
     console, panels, buttons, report, stack = None, [], {}, "", [(Gui.getMainWindow(), False)]
+    file_name = None
     while stack:
         w, in_box = stack.pop()
         name = w.metaObject().className()
+        if w.objectName() == "fileNameEdit" and w.inherits("QLineEdit") and w.isVisible():
+            # (Qt's own file dialog names its field so; the completer's popup is a window of its own)
+            completer = w.completer()
+            file_name = {"text": w.text(), "popup": bool(completer and completer.popup().isVisible())}
         if name == "Gui::DockWnd::ReportOutput":
             report = w.toPlainText()[-REPORT_CHARS:]
         if name == "Gui::OverlayTabWidget" and w.isVisible():
@@ -388,7 +394,7 @@ def _console_panels_and_questions():
             centre, ratio = w.mapToGlobal(w.rect().center()), w.devicePixelRatioF()
             buttons[w.text().replace("&", "")] = [round(centre.x() * ratio), round(centre.y() * ratio)]
         stack.extend((c, in_box) for c in w.children() if c.isWidgetType())
-    return console, panels, buttons, report
+    return console, panels, buttons, report, file_name
 
 
 def _focus():
@@ -412,7 +418,8 @@ def write(*_):
              "focus": _focus(), "focus_field": _focus_is_field(), "selection": [[o.ObjectName, list(o.SubElementNames)]
                                               for o in Gui.Selection.getSelectionEx()],
              "preselection": _preselection(), "points": _probed_points()}
-    state["console"], state["overlay_panels"], state["message_buttons"], state["report"] = _console_panels_and_questions()
+    (state["console"], state["overlay_panels"], state["message_buttons"], state["report"],
+     state["file_dialog"]) = _console_panels_and_questions()
     for name, doc in FreeCAD.listDocuments().items():
         facts = _shape_facts(doc)
         state["docs"][name] = {"undo": list(doc.UndoNames), "redo": list(doc.RedoNames), "file": doc.FileName,
