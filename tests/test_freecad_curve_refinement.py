@@ -196,3 +196,14 @@ class TestCurveRefusals(SolidChecks):
         box = obj.Shape.Faces[0].BoundBox
         self.assertLessEqual(max(abs(box.XMin), abs(box.XMax), abs(box.YMin), abs(box.YMax)), 50.0 + 1e-6, box)
         self.assertLess(box.ZMax, before[:, 2].max())  # (pulled down onto the line, not up)
+
+    def test_a_line_over_a_fresh_clamped_patch_is_followed_by_refining_its_free_middle(self):
+        """A clamped 8 x 8 patch leaves 4 x 4 poles free; a line 5 mm over it across its middle needs
+        more, and was refused as "no pole is left free" without trying a finer net (a new designer's
+        GUI session). It is refined like any net too coarse, and followed."""
+        obj = hs.make_sculpt(self.doc, controls=(8, 8), edges="held", name="Clamped")
+        line = Part.LineSegment(V(-30, -20, 5), V(30, 20, 5)).toShape()
+        hs.add_curve_constraint(obj, line)
+        done = obj.Proxy.live.last_curve
+        self.assertGreater(done["refined_to"][0] * done["refined_to"][1], 64, done)
+        self.assertLessEqual(curve_distance(obj.Shape.Faces[0], line), TOLERANCE)

@@ -83,11 +83,15 @@ def test_no_view_object_keeps_nothing():
 
 
 def test_the_last_strokes_line_says_why_it_barely_moved():
-    def line(moved: float, pulled: float, stiffness: float = 100.0, held: int = 0) -> str:
-        return stroke_text({"moved_mm": moved, "pulled_mm": pulled, "stiffness": stiffness, "held": held})
+    def line(moved: float, pulled: float, stiffness: float = 100.0, held: int = 0, curves: int = 0) -> str:
+        return stroke_text({"moved_mm": moved, "pulled_mm": pulled, "stiffness": stiffness, "held": held,
+                            "curves": curves})
     assert line(0.034, 23.0, 95000.0, 28) == ("last stroke moved it 0.034 mm of a 23 mm pull: stiffness 95000 holds "
                                               "it, lower it in the slider panel")
     assert "held poles pin it there (Hold edges, P)" in line(0.75, 30.0, held=100)
+    # a stroke beside a followed curve (a new designer was told of held poles only)
+    assert ": the curves it follows and held poles pin it there (Follow curve: off, Hold edges, P)" in \
+        line(0.0033, 23.0, held=28, curves=1)
     assert line(0.75, 30.0) == "last stroke moved it 0.75 mm of a 30 mm pull: the material is heavy or damped (slider panel)"
     assert line(12.0, 23.0, 95000.0) == "last stroke moved it 12 mm"
     # a pull the frames did not see (console mode, or a grab between two frames) gives no reason

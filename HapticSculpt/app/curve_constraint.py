@@ -561,7 +561,10 @@ def fit(dynamic: core.DynamicSurface, records: list[CurveConstraint], held: list
         masters = [(int(m), float(w)) for m, w in zip(master_poles, weights[k, nonzero])]
         if not masters:
             if spare is None:
-                raise ValueError(f"curve: the surface cannot follow '{records[-1].label}': no pole is left free")
+                # (a finer net has poles to spare: refined like any net too coarse)
+                raise NetTooCoarse(f"'{records[-1].label}'", "no pole is left free to move (held edges and the curves "
+                                   "it follows hold them all)", "free the edges near it (Hold edges), or give it more "
+                                   "controls", records[-1].uv)
             masters = [(spare, 0.0)]
         made.append((pole, masters, tuple(float(x) for x in offset)))
     return moved, made

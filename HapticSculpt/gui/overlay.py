@@ -703,8 +703,10 @@ def stroke_text(last: dict[str, float]) -> str:
         text += f" of a {pulled:.2g} mm pull"
         if stiffness > STIFF:
             text += f": stiffness {rounded(stiffness, 2):g} holds it, lower it in the slider panel"
-        elif last["held"]:
-            text += ": held poles pin it there (Hold edges, P), or it is heavy or damped"
+        elif last["held"] or last.get("curves"):
+            causes = [c for c, on in (("the curves it follows", last.get("curves")), ("held poles", last["held"])) if on]
+            remedies = [r for r, on in (("Follow curve: off", last.get("curves")), ("Hold edges, P", last["held"])) if on]
+            text += f": {' and '.join(causes)} pin it there ({', '.join(remedies)}), or it is heavy or damped"
         else:
             text += ": the material is heavy or damped (slider panel)"
     return text

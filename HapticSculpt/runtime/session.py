@@ -25,7 +25,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .. import core
-from ..app import sculpt_state
+from ..app import curve_constraint, sculpt_state
 from ..app.sculpt_feature import is_sculpt
 from ..app.undo import transaction
 from ..core import native as _core
@@ -455,7 +455,8 @@ class Session:
                         moved = np.linalg.norm((after - was).reshape(-1, 3), axis=1)
                         self.last_stroke = {"moved_mm": float(moved.max(initial=0.0)), "pulled_mm": self._pulled,
                                             "stiffness": float(np.mean(now.arrays["StiffnessMap"])),
-                                            "held": float(len(now.settings.get("held_poles", [])))}
+                                            "held": float(len(now.settings.get("held_poles", []))),
+                                            "curves": float(len(curve_constraint.records_of(obj)))}
                 told = bool(strokes) or _differs(before, obj.Proxy.live.stored())  # (else the edit's own call gives it)
                 if told:
                     _tell_commit(obj, before, title, strokes)
