@@ -24,7 +24,9 @@ def add_curve_constraint(obj: Any, curve: Any, continuity: str = "G0", normal: A
     natural cubic spline through them, by chord length).
 
     A curve off the surface (up to a quarter of its size away) pulls it onto itself, the poles
-    moving as little as possible; the pulled shape is the new rest shape. Where the net has too
+    moving as little as possible, straight across the sheet where it faces one way (along the
+    normal of the plane its net lies nearest), no pole further than 10 times the curve's largest
+    distance; the pulled shape is the new rest shape. Where the net has too
     little freedom along the curve to come within the tolerance, it is refined there: knots
     inserted in the spans the curve crosses and their neighbours (the shape unchanged by the
     insertion), pass after pass, up to half the sculpt's mesh points per direction; the sculpt's
