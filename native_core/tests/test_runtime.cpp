@@ -186,15 +186,18 @@ TEST(HapticRuntime, ReplayRunsToTheEndAndCommitsTheStroke) {
     EXPECT_EQ(st.force.norm(), 0.0);  // zero at exit
     const auto errors = rt.forceErrors();
     ASSERT_GT(errors.size(), 100u);
-    // The estimate's accuracy: the median holds on any machine; the tail only while the simulation
-    // kept pace (a loaded machine makes it drop backlog, and the estimate then extrapolates across it).
+    // The estimate's accuracy: the median holds on any machine; the tail (p99) only while the
+    // simulation kept pace with steps of simDt in all but 1 % of them (a loaded machine makes it
+    // drop backlog, and the estimate then extrapolates across it, or keep pace by steps of twice
+    // simDt, whose rope force differs from simDt's: bench/haptic_force.py. Seen under Wine with the
+    // other lanes running: 6.2 %, no drop; Wine beside two builds doubled 1 to 8 of about 600).
     std::vector<double> sorted = errors;
     std::sort(sorted.begin(), sorted.end());
     const double median = sorted[sorted.size() / 2], p99 = sorted[sorted.size() * 99 / 100];
     if (!kSanitized) {
         EXPECT_LT(median, 0.01);
-        if (st.droppedSimTime == 0) {
-            EXPECT_LT(p99, 0.05);
+        if (st.droppedSimTime == 0 && 100 * st.doubledSteps <= st.simSteps) {
+            EXPECT_LT(p99, 0.05) << st.simSteps << " steps";
         }
     }
 }
