@@ -335,45 +335,13 @@ def nearest_mesh_parameters(dynamic: core.DynamicSurface, points: np.ndarray) ->
     return np.column_stack([us[nearest // len(vs)], vs[nearest % len(vs)]])
 
 
-def closest_parameters(surface: Any, poles: np.ndarray, points: np.ndarray, start: np.ndarray
-                       ) -> tuple[np.ndarray, np.ndarray]:
-    """The parameters of the surface's closest points to ``points`` (K, 3) and their distances:
-    Gauss-Newton steps on |S(u, v) - x|^2 from ``start`` (K, 2), kept inside the domain."""
+def _projected(surface: Any, poles: np.ndarray, points: np.ndarray, start: np.ndarray,
+               flat: np.ndarray) -> np.ndarray:
+    """The parameters minimising |(S(u, v) - x) flat|^2 for each of ``points`` (K, 3): Gauss-Newton
+    steps from ``start`` (K, 2), kept inside the domain. ``flat`` (3, 3) is the identity for the
+    closest points, a projector across a direction for the points straight across along it."""
     uv = np.array(start, dtype=float)
     (u0, u1), (v0, v1) = surface.domain
-    for _ in range(50):
-        r = rows(surface, uv)
-        s, su, sv = (r.apply(c, poles) for c in (r.s, r.su, r.sv))
-        e = points - s
-        g = np.stack([(su * su).sum(1), (su * sv).sum(1), (sv * sv).sum(1)], axis=1)
-        b = np.stack([(su * e).sum(1), (sv * e).sum(1)], axis=1)
-        det = g[:, 0] * g[:, 2] - g[:, 1] ** 2
-        det = np.where(np.abs(det) > 0, det, 1.0)
-        step = np.column_stack([(g[:, 2] * b[:, 0] - g[:, 1] * b[:, 1]) / det,
-                                (g[:, 0] * b[:, 1] - g[:, 1] * b[:, 0]) / det])
-        new = np.column_stack([np.clip(uv[:, 0] + step[:, 0], u0, u1), np.clip(uv[:, 1] + step[:, 1], v0, v1)])
-        done = np.abs(new - uv).max() <= 1e-15
-        uv = new
-        if done:
-            break
-    r = rows(surface, uv)
-    return uv, np.linalg.norm(points - r.apply(r.s, poles), axis=1)
-
-
-#: Where the surface's normals under a curve are within this (degrees) of the normal of the plane
-#: its net lies nearest, the curve's points are taken across to the surface along that normal, not
-#: to their closest points (see make()).
-ACROSS_SPREAD_DEGREES = 60.0
-
-
-def across_parameters(surface: Any, poles: np.ndarray, points: np.ndarray, start: np.ndarray,
-                      direction: np.ndarray) -> tuple[np.ndarray, bool]:
-    """The parameters of the surface's points straight across from ``points`` along ``direction``
-    (a unit vector: the gap S(u, v) - x parallel to it), by Gauss-Newton steps from ``start`` kept
-    inside the domain; and whether every point found one (no gap left across the direction)."""
-    uv = np.array(start, dtype=float)
-    (u0, u1), (v0, v1) = surface.domain
-    flat = np.eye(3) - np.outer(direction, direction)  # (what of a vector lies across the direction)
     for _ in range(50):
         r = rows(surface, uv)
         s, su, sv = (r.apply(c, poles) @ flat for c in (r.s, r.su, r.sv))
@@ -389,6 +357,31 @@ def across_parameters(surface: Any, poles: np.ndarray, points: np.ndarray, start
         uv = new
         if done:
             break
+    return uv
+
+
+def closest_parameters(surface: Any, poles: np.ndarray, points: np.ndarray, start: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """The parameters of the surface's closest points to ``points`` (K, 3) and their distances,
+    from ``start`` (K, 2)."""
+    uv = _projected(surface, poles, points, start, np.eye(3))
+    r = rows(surface, uv)
+    return uv, np.linalg.norm(points - r.apply(r.s, poles), axis=1)
+
+
+#: Where the surface's normals under a curve are within this (degrees) of the normal of the plane
+#: its net lies nearest, the curve's points are taken across to the surface along that normal, not
+#: to their closest points (see make()).
+ACROSS_SPREAD_DEGREES = 60.0
+
+
+def across_parameters(surface: Any, poles: np.ndarray, points: np.ndarray, start: np.ndarray,
+                      direction: np.ndarray) -> tuple[np.ndarray, bool]:
+    """The parameters of the surface's points straight across from ``points`` along ``direction``
+    (a unit vector: the gap S(u, v) - x parallel to it), from ``start``; and whether every point
+    found one (no gap left across the direction)."""
+    flat = np.eye(3) - np.outer(direction, direction)  # (what of a vector lies across the direction)
+    uv = _projected(surface, poles, points, start, flat)
     r = rows(surface, uv)
     left = np.linalg.norm((points - r.apply(r.s, poles)) @ flat, axis=1)
     return uv, bool(left.max() <= 1e-9 * max(1.0, float(np.abs(points).max())))

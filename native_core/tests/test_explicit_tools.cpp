@@ -12,29 +12,13 @@
 #include <vector>
 
 #include "devices/replay_device.hpp"
+#include "replay_strokes.hpp"
 #include "runtime/multirate_replay.hpp"
 #include "solvers/dynamic_surface.hpp"
 
 using namespace hs;
 
 namespace {
-// bench/haptic_force.py's stroke, shortened: grab, pull up and around, let go.
-std::shared_ptr<ReplayDevice> stroke(double seconds) {
-    const int n = static_cast<int>(seconds * 1000) + 1;
-    std::vector<double> t(static_cast<size_t>(n));
-    Points xyz(n, 3);
-    Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> q(n, 4);
-    std::vector<std::uint32_t> buttons(static_cast<size_t>(n));
-    for (int i = 0; i < n; ++i) {
-        const double ti = i * 1e-3, tau = std::max(0.0, ti - 0.1);
-        t[static_cast<size_t>(i)] = ti;
-        xyz.row(i) << 12.3 + 8 * std::sin(1.3 * tau), -7.1 + 6 * std::sin(0.9 * tau), 14 * std::pow(std::sin(1.2 * tau), 2) + 4 * tau;
-        q.row(i) << 1, 0, 0, 0;
-        buttons[static_cast<size_t>(i)] = ti >= 0.05 && ti < seconds - 0.1 ? 1 : 0;
-    }
-    return std::make_shared<ReplayDevice>(t, xyz, q, buttons);
-}
-
 MultirateTicks pulled(const char* tool, ReplayDevice& device, double seconds, double dt) {
     DynamicSurface s(BSplineSurface::plane(16, 16, 3, 3, 100, 100), 64, 64);
     s.dampingMap().setUniform(5.0);
@@ -47,7 +31,7 @@ MultirateTicks pulled(const char* tool, ReplayDevice& device, double seconds, do
 
 TEST(ExplicitTools, PullAtTheDefaultStepAsTheConvergedStepDoes) {
     const double seconds = 0.8;
-    const auto device = stroke(seconds);
+    const auto device = replayStroke(seconds, seconds - 0.1, pulledUpAndAround);
     for (const char* tool : {"magnet", "flatten", "orientation"}) {
         const MultirateTicks coarse = pulled(tool, *device, seconds, 1e-3), fine = pulled(tool, *device, seconds, 2.5e-4);
         double largest = 0;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "devices/replay_device.hpp"
+#include "replay_strokes.hpp"
 #include "runtime/cursor_history.hpp"
 #include "runtime/multirate_replay.hpp"
 #include "solvers/dynamic_surface.hpp"
@@ -26,23 +27,8 @@ DeviceSample sampleAt(double x, std::uint32_t buttons) {
     return s;
 }
 
-// A rope stroke: the cursor rests on the patch, grabs, pulls up and around, lets go 0.2 s before
-// the end (bench/haptic_force.py's).
-std::shared_ptr<ReplayDevice> ropeStroke(double seconds) {
-    const int n = static_cast<int>(seconds * 1000) + 1;
-    std::vector<double> t(static_cast<size_t>(n));
-    Points xyz(n, 3);
-    Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> q(n, 4);
-    std::vector<std::uint32_t> buttons(static_cast<size_t>(n));
-    for (int i = 0; i < n; ++i) {
-        const double ti = i * 1e-3, tau = std::max(0.0, ti - 0.1);
-        t[static_cast<size_t>(i)] = ti;
-        xyz.row(i) << 12.3 + 8 * std::sin(1.3 * tau), -7.1 + 6 * std::sin(0.9 * tau), 14 * std::pow(std::sin(1.2 * tau), 2) + 4 * tau;
-        q.row(i) << 1, 0, 0, 0;
-        buttons[static_cast<size_t>(i)] = ti >= 0.05 && ti < seconds - 0.2 ? 1 : 0;
-    }
-    return std::make_shared<ReplayDevice>(t, xyz, q, buttons);
-}
+// A rope stroke (bench/haptic_force.py's), let go 0.2 s before the end.
+std::shared_ptr<ReplayDevice> ropeStroke(double seconds) { return replayStroke(seconds, seconds - 0.2, pulledUpAndAround); }
 
 std::unique_ptr<DynamicSurface> scene(int mesh) {
     auto s = std::make_unique<DynamicSurface>(BSplineSurface::plane(mesh / 4, mesh / 4, 3, 3, 100, 100), mesh, mesh);
@@ -151,19 +137,10 @@ TEST(MultirateReplay, StatesReachTheHapticLoopWhenTheirStepAndLatencyAreOver) {
 // lagging it would give energy back and fail this.
 TEST(MultirateReplay, NoEnergyIsMadeWhenTheSimulationLags) {
     const double seconds = 1.5, pi = 3.14159265358979;
-    const int n = static_cast<int>(seconds * 1000) + 1;
-    std::vector<double> t(static_cast<size_t>(n));
-    Points xyz(n, 3);
-    Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> q(n, 4);
-    std::vector<std::uint32_t> buttons(static_cast<size_t>(n));
-    for (int i = 0; i < n; ++i) {
-        const double ti = i * 1e-3, tau = std::max(0.0, ti - 0.1);
-        t[static_cast<size_t>(i)] = ti;
-        xyz.row(i) << 12.3 + 3 * std::sin(3 * pi * tau), -7.1, 6 * std::pow(std::sin(4 * pi * tau), 2);
-        q.row(i) << 1, 0, 0, 0;
-        buttons[static_cast<size_t>(i)] = ti >= 0.05 && ti < seconds - 0.2 ? 1 : 0;
-    }
-    const auto device = std::make_shared<ReplayDevice>(t, xyz, q, buttons);
+    const auto device = replayStroke(seconds, seconds - 0.2, [pi](double t) {
+        const double tau = t > 0.1 ? t - 0.1 : 0.0;
+        return Vec3(12.3 + 3 * std::sin(3 * pi * tau), -7.1, 6 * std::pow(std::sin(4 * pi * tau), 2));
+    });
     struct Lag {
         double cost, latency;
     };
