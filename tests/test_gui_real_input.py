@@ -380,8 +380,10 @@ class Desktop:
         for sx, sy in ((400, 400), (800, 600)):
             before = active(self.state())["cursor"]
             self.xdo("mousemove", str(sx), str(sy))
-            s = self.wait(lambda s: active(s)["cursor"] != before, "the view to see the mouse move")
-            pts.append(((sx, sy), active(s)["cursor"]))
+            self.wait(lambda s: active(s)["cursor"] != before, "the view to see the mouse move")
+            # (and settle: under load the first change seen was a motion still on its way, and a map
+            # from it put a click 485 pixels left of the screen)
+            pts.append(((sx, sy), self.wait_still(lambda s: tuple(active(s)["cursor"]), "the view's mouse to settle", 3)))
         (s0, v0), (s1, v1) = pts
         self._map = [(s0[k], v0[k], (s1[k] - s0[k]) / (v1[k] - v0[k])) for k in (0, 1)]
 
