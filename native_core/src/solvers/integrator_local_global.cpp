@@ -141,8 +141,9 @@ StepReport LocalGlobalIntegrator::step(StepModel& m, double dt) {
     // A tool taken explicitly (every one but the rope, whose anchor joins the solve) and too stiff
     // for BDF2 makes the step backward Euler while it holds (kBdf2ExplicitToolLimit).
     const Tool& tool = forces.tool();
-    const bool stiffTool = tool.grabbed() && !tool.implicitOnAnchor() && std::isfinite(m.toolSlope()) &&
-                           dt * dt * m.toolSlope() > kBdf2ExplicitToolLimit * material.minMass();
+    const double toolRho = dt * dt * m.toolSlope() / material.minMass();  // (infinite: slope unknown)
+    const bool stiffTool = tool.grabbed() && !tool.implicitOnAnchor() && std::isfinite(toolRho) &&
+                           toolRho > kBdf2ExplicitToolLimit;
     const bool bdf2 = m.settings.timeOrder == 2 && !stiffTool;
     const double h = bdf2 ? systemStep(m.settings, dt) : dt;
     m.ensureStepSystem(h);
@@ -178,7 +179,7 @@ StepReport LocalGlobalIntegrator::step(StepModel& m, double dt) {
     if (w > 0)  // the predicted motion over the step (mesh)
         H.forSpans([&](const auto& q) { q(motion) = dt * q(s.av) + (0.5 * dt) * (q(s.av) - q(history_.av)); });
     if (stiffTool) H.forSpans([&](const auto& q) { q(motion) = dt * q(s.av); });
-    const double toolWeight = extrapolationWeight(dt * dt * m.toolSlope() / material.minMass());
+    const double toolWeight = extrapolationWeight(toolRho);
     const double wt = stiffTool ? toolWeight : w > 0 && tool.grabbed() ? std::min(w, toolWeight) : 0.0;
     if (wt > 0) {
         H.forSpans([&](const auto& q) { q(tmp) = q(s.d) + wt * q(motion); });
