@@ -1,5 +1,6 @@
 """Curve constraints (hs.add_curve_constraint): a sculpt passes through a sketch or an edge (G0),
-or runs along it with its normal kept (G1), exactly, through strokes; pulled onto a curve off it;
+or runs along it with its normal kept (G1), through strokes (within HELD: the links hold what moves
+the curve, the smooth moves that barely touch it stay free); pulled onto a curve off it;
 undo, remove, save and reopen, sculpted solids; every refusal. Measured independently: OCCT's
 distance from the document's face to the curve's own points, and FreeCAD's surface normals."""
 from __future__ import annotations
@@ -16,6 +17,9 @@ from test_freecad_sculpted_solid import SolidChecks, face_named, pull
 import HapticSculpt as hs
 
 V = FreeCAD.Vector
+#: How near a held curve stays through the strokes here (mm; a tenth of the default tolerance): the
+#: smooth pole moves left free drift it by 3e-6 to 6e-5 mm in these tests.
+HELD = 1e-4
 
 
 def sketch(doc, geometry, z=0.0, name="Sketch"):
@@ -71,7 +75,7 @@ class TestCurveConstraints(SolidChecks):
         face = obj.Shape.Faces[0]
         self.assertGreater(face.Surface.value(0.5, 0.5).z - middle, 3.0)  # the stroke lifted the rest
         self.assertLessEqual(curve_distance(face, curve.Shape), 1e-6 * size)
-        self.assertLessEqual(hs.curve_constraints_of(obj)[0]["distance_mm"], 1e-9 * size)
+        self.assertLessEqual(hs.curve_constraints_of(obj)[0]["distance_mm"], HELD)
         # without the constraint the same stroke moves the curve: the check can fail
         free = hs.make_sculpt(self.doc, controls=(12, 12), mesh=(36, 36), name="Free")
         stroke(free, lift=20.0)
@@ -213,8 +217,8 @@ class TestCurveConstraints(SolidChecks):
         self.assertGreater(obj.Shape.Faces[0].Surface.value(*obj.Shape.Faces[0].Surface.parameter(V(15, -5, 0))).z, 2.0)
         size = obj.Proxy.surface.size
         for c in hs.curve_constraints_of(obj):
-            self.assertLessEqual(c["distance_mm"], 1e-9 * size)
-            self.assertLessEqual(c["normal_deg"], 1e-6)
+            self.assertLessEqual(c["distance_mm"], HELD)
+            self.assertLessEqual(c["normal_deg"], 1e-3)  # (a tenth of the 0.01 degrees allowed)
         self.assertLessEqual(curve_distance(obj.Shape.Faces[0], line), 1e-6 * size)
         n = self.doc.UndoCount
         hs.remove_constraint(obj, first)
@@ -222,7 +226,7 @@ class TestCurveConstraints(SolidChecks):
         self.assertEqual([c["id"] for c in hs.curve_constraints_of(obj)], [second])
         pull(obj, (15.0, -10.0, 0.0), (0.0, 0.0, 15.0))
         left = {c["id"]: c for c in hs.curve_constraints_of(obj)}
-        self.assertLessEqual(left[second]["distance_mm"], 1e-9 * size)
+        self.assertLessEqual(left[second]["distance_mm"], HELD)
         self.assertGreater(curve_distance(obj.Shape.Faces[0], line), 0.1)  # the removed one is free again
 
     def test_save_and_reopen(self):
@@ -238,7 +242,7 @@ class TestCurveConstraints(SolidChecks):
         self.assertEqual([c["id"] for c in hs.curve_constraints_of(back)], [cid])
         stroke(back, lift=20.0)
         [info] = hs.curve_constraints_of(back)
-        self.assertLessEqual(info["distance_mm"], 1e-9 * back.Proxy.surface.size)
+        self.assertLessEqual(info["distance_mm"], HELD)
         self.assertLessEqual(curve_distance(back.Shape.Faces[0], self.doc.getObject("Sketch").Shape),
                              1e-6 * back.Proxy.surface.size)
         hs.remove_constraint(back, cid)

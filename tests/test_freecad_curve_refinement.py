@@ -35,6 +35,29 @@ def pull(obj, at, by, integrator=None):
     return hs.run(obj, 1.0, device=dev, tool="rope", integrator=integrator)
 
 
+def section_curvature(face, at, across, n=800):
+    """The face's normal curvature (1/mm) along its section by the vertical plane through ``at``
+    along ``across`` (a horizontal unit vector), at n points of OCCT's section, ordered by the
+    distance along ``across``: (distance, z, curvature), signed with the normal turned up (> 0
+    curving up), from FreeCAD's own surface derivatives."""
+    across = V(*across)
+    plane_normal = across.cross(V(0, 0, 1))
+    surface, out = face.Surface, []
+    for edge in face.section(Part.Plane(V(*at), plane_normal).toShape()).Edges:
+        for p in edge.discretize(Number=n):
+            u, v = surface.parameter(p)
+            su, sv = surface.getDN(u, v, 1, 0), surface.getDN(u, v, 0, 1)
+            normal = su.cross(sv).normalize()
+            if normal.z < 0:
+                normal = -normal
+            t = normal.cross(plane_normal).normalize()  # (the section's direction)
+            du, dv = np.linalg.lstsq(np.array([su, sv]).T, np.array(t), rcond=None)[0]
+            second = surface.getDN(u, v, 2, 0) * du * du + surface.getDN(u, v, 1, 1) * (2 * du * dv) + \
+                surface.getDN(u, v, 0, 2) * dv * dv
+            out.append(((p - V(*at)).dot(across), p.z, normal.dot(second) / (su * du + sv * dv).Length ** 2))
+    return np.array(sorted(out)).T
+
+
 def net(obj):
     """The sculpt's stored net: poles, knots in u and in v (the document's properties)."""
     return np.array(obj.Poles), np.array(obj.KnotsU), np.array(obj.KnotsV)
@@ -147,6 +170,27 @@ class TestCurveRefinement(SolidChecks):
         self.doc.undo()
         for was, now in zip(before, net(sculpt)):
             self.assertTrue(np.array_equal(was, now))
+
+
+class TestNoFoldBesideACurve(SolidChecks):
+    def test_a_pull_beside_an_oblique_line_lifts_a_smooth_bump(self):
+        # A line across a clamped clay patch, not a line of its net: held exactly, its conditions
+        # locked every pole whose support it crosses, and this pull moved nothing (0.00 mm).
+        obj = hs.make_sculpt(self.doc, controls=(10, 10), edges="held", material="clay")
+        a, b = np.array([-45.0, -30.0, 0.0]), np.array([40.0, 35.0, 0.0])
+        line = Part.LineSegment(V(*a), V(*b)).toShape()
+        hs.add_curve_constraint(obj, line)
+        along = (b - a) / np.linalg.norm(b - a)
+        across, middle = np.array([along[1], -along[0], 0.0]), (a + b) / 2
+        pull(obj, middle + 2.0 * across, (0.0, 0.0, 10.0))  # 2 mm beside it, 10 mm up
+        face = obj.Shape.Faces[0]
+        self.assertLessEqual(curve_distance(face, line), TOLERANCE)
+        x, z, k = section_curvature(face, middle, across)
+        pulled = x > 0
+        self.assertGreater(z[pulled].max(), 0.25, "the pull lifted the surface beside the line")
+        self.assertLess(np.abs(k).max(), 0.5, "curvature along the section across the line")
+        signs = np.sign(k[pulled & (np.abs(k) > 1e-3)])  # (through the bump: from the line outwards)
+        self.assertLessEqual(int((np.diff(signs) != 0).sum()), 2, "the curvature's sign changes through the bump")
 
 
 def obj_seams(obj):

@@ -1,5 +1,6 @@
 """Scripting API of curve constraints: a sculpt (or a sculpted solid) that passes through a curve,
-G0, or along it with a normal, G1, held exactly through every stroke (:mod:`curve_constraint`).
+G0, or along it with a normal, G1, held within its tolerance through every stroke
+(:mod:`curve_constraint`).
 
 The conditions live in the core as links; the curves themselves in the Sculpt's
 ``CurveConstraints`` property (JSON), written in the same undo step, so Undo, Redo, save and reopen

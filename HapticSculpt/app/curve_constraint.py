@@ -14,10 +14,12 @@ derivative in a fixed direction ``S_d = d_k . P``. The constraint is then ``A P 
   not conflict with it.
 
 Adding one moves the poles as little as possible (least squares, minimal norm over the free poles)
-so the conditions hold. Then ``r = rank(A)`` of the free poles near the curve follow the others:
+so the conditions hold. Then ``r`` of the free poles near the curve follow the others:
 ``P_s = o + sum w P_m`` (:class:`core.DynamicSurface` links with an offset), chosen by column
-pivoting among the poles that no other link depends on, so every stroke keeps the conditions
-exactly, in every integrator. Held poles and other links are substituted first. With more samples
+pivoting among the poles that no other link depends on, so every stroke keeps the conditions in
+every integrator: ``r`` is the number of pole moves that take the curve's samples away (measured
+against the bending energy of the move, :data:`STIFF_SHARE`); the smooth moves that barely touch
+them stay free, so the surface can rise right beside a curve across the net. Held poles and other links are substituted first. With more samples
 than the surface has freedom along the curve (at least degree_u + degree_v + 1 per knot cell it
 crosses), the surface keeps the whole curve, not only the samples, where the curve's restriction
 is in its space (a line of the domain), and within the check's tolerance elsewhere.
@@ -34,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from .. import core
+from .thin_plate import bending_matrix
 
 CONTINUITIES = ("G0", "G1")
 #: The Sculpt's document property that holds its curve constraints (JSON).
@@ -499,6 +502,37 @@ def _least_move(a: np.ndarray, gap: np.ndarray, tolerance: float) -> np.ndarray:
     return best
 
 
+#: A pole move is left free when it moves the curve's samples by less than this share of the most
+#: any move of the same bending energy does (squared). The conditions of a curve across the net's
+#: spans have full rank on every pole whose support it crosses (their singular values fall smoothly
+#: to 1e-12): held exactly, a band four spans wide beside it is locked, and a pull 2 mm beside an
+#: oblique line across a clamped clay patch moved nothing (0.00 mm). Measured in bending energy,
+#: the moves the samples see least are the smooth ones: this frees 4 of its 32 links and the pull
+#: lifts a smooth bump (0.37 mm, curvature under 0.003 1/mm), the line drifting 9e-7 mm after it
+#: and 3e-6 mm after five. (1e-10 frees 7 and lifts 0.41 mm, but a G1 curve's normal drifted
+#: 0.009 degrees in bench/curve_constraints.py, against the 0.01 allowed.)
+STIFF_SHARE = 1e-12
+
+
+def _stiff_moves(a: np.ndarray, bending: np.ndarray | None) -> np.ndarray:
+    """Orthonormal rows spanning the pole moves the links hold: the generalised eigenvectors of
+    (A^T A, K) whose eigenvalue (how far a move of unit bending energy takes the curve's samples)
+    is above STIFF_SHARE of the largest, as rows of K (a move m is held when v^T K m = 0 for each
+    of them: it lies in the span of the smooth moves that barely touch the curve). Without a
+    bending energy (a net of degree 1 in a direction bends only at its knots) the conditions' whole
+    row space: the moves left free would be any the samples barely see, not smooth ones."""
+    if bending is None:
+        _, singular, vt = np.linalg.svd(a, full_matrices=False)
+        return vt[singular > 1e-12 * singular[0]]
+    k = bending + 1e-9 * max(np.trace(bending), 1e-300) / len(bending) * np.eye(len(bending))
+    lower = np.linalg.cholesky(k)  # (the touch: K is positive definite on any part of the net)
+    whiten = np.linalg.solve(lower, a.T).T  # A L^-T
+    _, singular, vt = np.linalg.svd(whiten, full_matrices=False)
+    keep = singular ** 2 > STIFF_SHARE * singular[0] ** 2
+    q, _ = np.linalg.qr(lower @ vt[keep].T)  # (K v = L L^T v = L w for v = L^-T w)
+    return q.T
+
+
 def fit(dynamic: core.DynamicSurface, records: list[CurveConstraint], held: list[int],
         links: list[tuple[Any, ...]], poles: np.ndarray) -> tuple[np.ndarray, list[tuple[Any, ...]]]:
     """Holds ``records``, together, on top of ``held`` and ``links``: the poles moved as little as
@@ -521,12 +555,10 @@ def fit(dynamic: core.DynamicSurface, records: list[CurveConstraint], held: list
     moved = poles.copy()
     if gap.any():
         moved[free] += _least_move(af, gap, 1e-2 * G0_SHARE * dynamic.size)
-    # The conditions' row space, orthonormal (Q = V_r^T): slaves picked among its columns keep the
-    # link weights bounded however weakly a pole far from the curve takes part (A itself is
-    # ill-conditioned: its singular values fall gradually to 1e-11 before the null space).
-    _, singular, vt = np.linalg.svd(af, full_matrices=False)
-    rank = int((singular > 1e-12 * singular[0]).sum())
-    basis = vt[:rank]
+    # The moves the links forbid, orthonormal rows (Q): slaves picked among its columns keep the
+    # link weights bounded however weakly a pole far from the curve takes part.
+    basis = _stiff_moves(af, bending_matrix(surface, free) if min(surface.degree) >= 2 else None)
+    rank = len(basis)
     masters = {m for link in links for m, _ in link[1]}
     eligible = np.array([i for i, pole in enumerate(free) if int(pole) not in masters], dtype=int)
     chosen = eligible[_pivots(basis[:, eligible], 1e-6)] if eligible.size else eligible

@@ -24,6 +24,7 @@ from . import sculpt_state
 from .api import _add_sculpt, _document, _material, _sculpt_state
 from .curve_api import _writer
 from .source_surface import SourceSurface, refined
+from .thin_plate import bending_matrix, design
 from .undo import transaction
 
 #: Boundary curves whose ends are farther apart than this share of the loop's size do not close.
@@ -134,25 +135,12 @@ def _knots(n: int, p: int = 3) -> np.ndarray:
     return np.concatenate([np.zeros(p), np.linspace(0.0, 1.0, n - p + 1), np.ones(p)])
 
 
-def _design(knots: np.ndarray, x: np.ndarray, p: int = 3, derivative: int = 0) -> np.ndarray:
-    """The B-spline basis (or its ``derivative``) at ``x``: (len(x), poles)."""
-    from scipy.interpolate import BSpline
-    n = len(knots) - p - 1
-    out = np.zeros((len(x), n))
-    for j in range(n):
-        c = np.zeros(n)
-        c[j] = 1.0
-        b = BSpline(knots, c, p, extrapolate=False)
-        out[:, j] = np.nan_to_num((b.derivative(derivative) if derivative else b)(x))
-    return out
-
-
 def fitted_net(grid: np.ndarray, controls: tuple[int, int]) -> core.BSplineSurface:
     """The cubic B-spline surface of ``controls`` poles (clamped, uniform) nearest ``grid`` (n, n, 3)
     in least squares at the grid's parameters."""
     n = grid.shape[0]
     t = np.linspace(0.0, 1.0, n)
-    bu, bv = _design(_knots(controls[0]), t), _design(_knots(controls[1]), t)
+    bu, bv = design(_knots(controls[0]), t), design(_knots(controls[1]), t)
     pu, pv = np.linalg.pinv(bu), np.linalg.pinv(bv)
     poles = np.einsum("ia,abk,jb->ijk", pu, grid, pv)
     return core.BSplineSurface(poles, (3, 3), list(_knots(controls[0])), list(_knots(controls[1])), None)
@@ -164,13 +152,13 @@ def _edge_fit(points: np.ndarray, knots: np.ndarray, first: np.ndarray, last: np
     length) with its ends at ``first`` and ``last`` (the corners): the row and its largest distance
     from the points (at them and between them)."""
     s = _arc(points)
-    b = _design(knots, s)
+    b = design(knots, s)
     inner = b[:, 1:-1]
     rhs = points - np.outer(b[:, 0], first) - np.outer(b[:, -1], last)
     middle = np.linalg.lstsq(inner, rhs, rcond=None)[0]
     row = np.vstack([first, middle, last])
     dense = np.linspace(0.0, 1.0, 4 * len(points))
-    off = np.linalg.norm(_design(knots, dense) @ row - _at(points, s, dense), axis=1).max()
+    off = np.linalg.norm(design(knots, dense) @ row - _at(points, s, dense), axis=1).max()
     return row, float(max(off, np.linalg.norm(b @ row - points, axis=1).max()))
 
 
@@ -203,25 +191,6 @@ def edge_fitted_net(sides: list[np.ndarray], controls: tuple[int, int], toleranc
         controls = grown
 
 
-def _bending(surface: core.BSplineSurface, per_span: int = 4) -> np.ndarray:
-    """The thin-plate energy's matrix K over the poles (the integral over the parameters of
-    |S_uu|^2 + 2 |S_uv|^2 + |S_vv|^2, Gauss points in every span): E = tr(P^T K P)."""
-    g, w = np.polynomial.legendre.leggauss(per_span)
-
-    def points(knots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        breaks = np.unique(knots)
-        a, b = breaks[:-1, None], breaks[1:, None]
-        return (0.5 * (a + b) + 0.5 * (b - a) * g).ravel(), (0.5 * (b - a) * w).ravel()
-
-    ku, kv = np.asarray(surface.knots_u, float), np.asarray(surface.knots_v, float)
-    (xu, wu), (xv, wv) = points(ku), points(kv)
-    n0, n1, n2 = (_design(ku, xu, derivative=d) for d in (0, 1, 2))
-    m0, m1, m2 = (_design(kv, xv, derivative=d) for d in (0, 1, 2))
-    weight = np.sqrt(np.outer(wu, wv).ravel())[:, None]
-    rows = [weight * np.kron(n2, m0), np.sqrt(2.0) * weight * np.kron(n1, m1), weight * np.kron(n0, m2)]
-    return sum(r.T @ r for r in rows)
-
-
 def faired(poles: np.ndarray, surface: core.BSplineSurface, links: list[Any], held: Sequence[int] = ()
            ) -> np.ndarray:
     """The poles (n, 3) of least bending energy with the ``held`` poles where they are and the
@@ -245,7 +214,7 @@ def faired(poles: np.ndarray, surface: core.BSplineSurface, links: list[Any], he
                 t[pole, column[m]] += w
             else:
                 c[pole] += w * poles[m]
-    k = _bending(surface)
+    k = bending_matrix(surface)
     a = t.T @ k @ t
     touch = 1e-9 * np.trace(a) / max(len(free), 1)
     q = np.linalg.solve(a + touch * np.eye(len(free)), -t.T @ k @ c + touch * poles[free])
