@@ -1,8 +1,9 @@
 """New patch from curves as a designer does it in FreeCAD's GUI, with real X events: a file with a
 sketch drawing a 100 x 80 loop, a sketch standing across it (an arc 12 mm high) and a stray line
-outside it. The loop's four edges and the stray line clicked in the 3D view, New patch from curves:
-refused in one line, nothing made; the loop's edges and the arc: a patch on the loop through the arc in one undo step; a
-mouse stroke beside the arc leaves the patch on it; Undo twice: the stroke, then the patch.
+outside it. Pressed with two of the loop's edges: it says what to select. The loop's four edges
+and the stray line clicked in the 3D view, New patch from curves: refused in one line, nothing
+made; the loop's edges and the arc: a patch on the loop through the arc in one undo step; a mouse
+stroke beside the arc leaves the patch on it; Undo twice: the stroke, then the patch.
 Screenshots in build/screenshots/real_network_*.png (look at them)."""
 from __future__ import annotations
 
@@ -61,8 +62,16 @@ def test_new_patch_from_curves_refuses_a_stray_curve_makes_a_patch_through_the_a
         d.calibrate()
         d.wait_still(lambda s: s["docs"][s["active"]]["screen"]["Loop"], "the loop on screen after the fit")
         before = d.shot("network_before")
-        # the loop and a line outside it: refused, one line in the report view, nothing made
+        # pressed with two edges selected: it says what to select (it was greyed out, with no reason)
         loop = [("Loop", k) for k in range(4)]
+        pick_in_view(d, loop[:2])
+        d.click_button("NewFromCurves")
+        d.wait(lambda s: "New patch from curves: 2 curves selected: select 3 or 4 curves that close into a loop"
+               in (s.get("report") or ""), "what to select, in the report view")
+        empty = d.to_screen([20, next(v for v in d.state()["views"] if v["active"])["size"][1] // 2])  # (beside it all)
+        d.xdo("mousemove", str(empty[0]), str(empty[1]), "click", "1")
+        d.wait(lambda s: s["selection"] == [], "nothing selected")
+        # the loop and a line outside it: refused, one line in the report view, nothing made
         pick_in_view(d, loop + [("Stray", 0)])
         d.click_button("NewFromCurves")
         s = d.wait(lambda s: "New patch from curves: curve: 'Stray Edge1' runs off the face" in (s.get("report") or ""),
@@ -70,7 +79,6 @@ def test_new_patch_from_curves_refuses_a_stray_curve_makes_a_patch_through_the_a
         assert "Traceback" not in s["report"], s["report"][-2000:]
         assert not s["docs"][s["active"]]["sculpts"] and undo(s) == [], undo(s)
         # the loop and the arc: a patch on the loop through the arc, one undo step
-        empty = d.to_screen([20, next(v for v in s["views"] if v["active"])["size"][1] // 2])  # (beside it all)
         d.xdo("mousemove", str(empty[0]), str(empty[1]), "click", "1")
         d.wait(lambda s: s["selection"] == [], "nothing selected")
         pick_in_view(d, loop + [("Ridge", 0)])

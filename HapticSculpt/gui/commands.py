@@ -143,11 +143,12 @@ class NewClampedPatch(NewPatch):
                            "frees them)"}
 
 
-def _network_selection() -> list[tuple[str, Any]] | None:
+def _network_selection() -> tuple[list[tuple[str, Any]] | None, str]:
     """The selected curves as (how a script names one, the curve) when the selection is curves only
     (sketches, wires, edges of parts; no sculpt, no face) and holds three or more: a sketch or wire
     picked whole is one curve, or its edges when they close into a loop of 3 or 4 (a boundary drawn
-    in one sketch), or its wires when it has several; an edge picked in the view is that edge."""
+    in one sketch), or its wires when it has several; an edge picked in the view is that edge.
+    Else None and why, as a designer reads it."""
     from ..app.sculpt_feature import is_sculpt
     from ..app.sculpted_solid import is_sculpted_solid
     from .echo import ref
@@ -155,13 +156,14 @@ def _network_selection() -> list[tuple[str, Any]] | None:
     for pick in Gui.Selection.getSelectionEx():
         obj, shape = pick.Object, getattr(pick.Object, "Shape", None)
         if is_sculpt(obj) or is_sculpted_solid(obj) or shape is None or shape.isNull() or not shape.Edges:
-            return None
+            return None, f"'{obj.Label}' is not a curve"
         if pick.SubElementNames:
             if not all(n.startswith("Edge") for n in pick.SubElementNames):
-                return None
+                return None, f"{', '.join(n for n in pick.SubElementNames if not n.startswith('Edge'))} of " \
+                             f"'{obj.Label}' is not a curve (pick its edges)"
             curves += [(f"({ref(obj)}, {n!r})", (obj, n)) for n in pick.SubElementNames]
         elif shape.Faces:
-            return None
+            return None, f"'{obj.Label}' has faces: pick its edges"
         elif len(shape.Wires) == 1 and len(shape.Wires[0].Edges) == len(shape.Edges):
             wire = shape.Wires[0]
             if wire.isClosed() and len(shape.Edges) in (3, 4):  # (the boundary, drawn as one sketch)
@@ -172,7 +174,9 @@ def _network_selection() -> list[tuple[str, Any]] | None:
             curves.append((ref(obj), obj))
         else:
             curves += [(f"({ref(obj)}, 'Wire{k + 1}')", (obj, f"Wire{k + 1}")) for k in range(len(shape.Wires))]
-    return curves if len(curves) >= 3 else None
+    if len(curves) < 3:
+        return None, (f"{len(curves)} curve{'' if len(curves) == 1 else 's'} selected" if curves else "nothing selected")
+    return curves, ""
 
 
 class NewFromCurves:
@@ -190,14 +194,18 @@ class NewFromCurves:
                            "is sculpted"}
 
     def IsActive(self) -> bool:
-        return _network_selection() is not None
+        # (enabled with a document: pressed with the wrong selection it says what to select, where
+        # greyed out it left a designer guessing why)
+        return FreeCAD.ActiveDocument is not None
 
     def Activated(self) -> None:
         from ..app.curve_api import curve_constraints_of
         from ..app.curve_network import split_network
         from .echo import run_echoed
-        picked = _network_selection()
+        picked, why = _network_selection()
         if picked is None:
+            refuse(self.MENU_TEXT, ValueError(f"{why}: select 3 or 4 curves that close into a loop (sketches, "
+                                              f"wires or edges of parts, with ctrl+click) and any curves inside it"))
             return
         doc = Gui.Selection.getSelection()[0].Document
         boundary, interior = split_network([curve for _, curve in picked])
