@@ -645,6 +645,8 @@ def test_a_recorded_macro_replays_in_console_mode_to_the_same_state(tmp_path):
     # taking the macro from what that call does on the document to what the session committed)
     strokes = [line for line in text.splitlines() if "replay_stroke" in line]
     assert len(strokes) + text.count("HapticSculpt.paint(") == len(commits) + 2, (commits, text)
+    named = [line.split("  # ")[1] for line in strokes if "  # " in line]  # (a line not a stroke's says whose)
+    assert "Add normal constraint" in named and "Material: clay" in named, "\n".join(strokes)
     assert all(len(line) <= 200 for line in text.splitlines() if "HapticSculpt." in line), text
     out = run_freecadcmd(f"""
         import sys

@@ -32,4 +32,7 @@ def echo_stroke(obj: Any, before: Any, title: str, strokes: int, echo: bool = Tr
     from ..app import stroke_log
     name = stroke_log.record(obj, before, title, strokes)
     if echo:
-        run_echoed(f"HapticSculpt.replay_stroke({ref(obj)}, {name!r})")
+        # (not a stroke: an edit a session took, after its own call, with what moved meanwhile, or a
+        # long paint stroke: named, where a bare line read as a stroke nobody made)
+        said = "" if strokes else f"  # {title}"
+        run_echoed(f"HapticSculpt.replay_stroke({ref(obj)}, {name!r}){said}")
