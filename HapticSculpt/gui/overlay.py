@@ -81,7 +81,7 @@ class Overlay:
         self.legend: tuple[str, tuple[float, float]] | None = None  # the HUD legend's display and range
         self._live_deviation: str | None = None  # the HUD's line as the scan's points last measured it
         self._trims: dict[tuple[int, int], list[int] | None] = {}  # grid size -> cells on the trimmed face
-        self._curve_rows: tuple[str, list[tuple[str, Any]]] = ("", [])  # CurveConstraints text -> (kind, rows)
+        self._curve_rows: tuple[Any, list[tuple[str, Any]]] = (None, [])  # (CurveConstraints text, net) -> (kind, rows)
         self.hud: Hud | None = None  # the screen-space layer, made when the overlay first draws
         self.speaks: Any = lambda overlay: True  # whether its HUD is the view's one (set by the Controller)
         self.mouse: Any = lambda overlay: None  # the mouse's cursor it shows, if any (set by the Controller)
@@ -658,9 +658,12 @@ class Overlay:
         from pivy import coin
         sep = coin.SoSeparator()
         text = self._curves_text()
-        if self._curve_rows[0] != text:
-            self._curve_rows = (text, [(r.continuity, curve_constraint.rows(s.surface, r.uv))
-                                       for r in curve_constraint.records_from_json(text)])
+        # (keyed by the net too: Follow curve refines it in the same step as it writes the curve, and
+        # rows of the coarser net applied to the finer one's poles drew a squiggle off the curve)
+        key = (text, tuple(s.surface.controls), tuple(s.surface.knots_u), tuple(s.surface.knots_v))
+        if self._curve_rows[0] != key:
+            self._curve_rows = (key, [(r.continuity, curve_constraint.rows(s.surface, r.uv))
+                                      for r in curve_constraint.records_from_json(text)])
         poles = np.asarray(s.poles, float).reshape(-1, 3)
         for kind, rows in self._curve_rows[1]:
             points = rows.apply(rows.s, poles)
