@@ -97,6 +97,29 @@ class TestCurveNetwork(SolidChecks):
         self.assertTrue(np.all(mean < 0), (mean.min(), mean.max()))  # a dome: one sign
         self.assertLess(peak.max(), 0.1)  # (0.064)
 
+    def test_an_inside_curve_the_default_mesh_cannot_follow_gets_a_finer_one(self):
+        """A 10 mm arc from the base to the middle of a side of a bowed triangle needs more than the
+        20 x 20 controls its 40 x 40 mesh took (0.008 mm short, refused): the mesh grows for it."""
+        tri = [Part.LineSegment(V(-40, -30, 0), V(40, -30, 0)).toShape(), arc(V(40, -30, 0), V(0, 40, 0), 8.0),
+               arc(V(0, 40, 0), V(-40, -30, 0), 8.0)]
+        spine = arc(V(0, -30, 0), V(20, 5, 8), 10.0)
+        obj = hs.make_sculpt_from_curves(self.doc, tri, [spine], name="Tri")
+        face = obj.Shape.Faces[0]
+        for curve in tri + [spine]:
+            self.assertLessEqual(curve_distance(face, curve), TOLERANCE)
+        self.assertGreater(max(obj.Proxy.surface.surface.controls), 20)
+
+    def test_an_inside_curve_into_a_corner_out_of_its_tangent_plane_is_refused_saying_so(self):
+        """A flat triangle and an arc 5 mm high ending at its apex: no smooth patch holds it (it was
+        refused as a curve the net could not follow, "use more controls"); nothing is made."""
+        corners = [V(-40, -30, 0), V(40, -30, 0), V(0, 40, 0)]
+        tri = [Part.LineSegment(corners[k], corners[(k + 1) % 3]).toShape() for k in range(3)]
+        spine = arc(V(0, -30, 0), V(0, 40, 0), 5.0)
+        n = len(self.doc.Objects)
+        with self.assertRaisesRegex(ValueError, r"ends at the corner where .* meet, 16.2 degrees out of the plane"):
+            hs.make_sculpt_from_curves(self.doc, tri, [spine])
+        self.assertEqual(len(self.doc.Objects), n)
+
     def test_networks_that_do_not_make_a_patch_are_refused_and_nothing_is_made(self):
         sides, middle = self.dome()
         line = [Part.LineSegment(V(0, 0, 0), V(10, 0, 0)).toShape(), Part.LineSegment(V(10, 0, 0), V(20, 0, 0)).toShape(),

@@ -34,6 +34,14 @@ CLOSE_SHARE = 1e-3
 ROOM_PASSES = 1
 #: Samples per curve for the loop, the Coons patch and its fit.
 SAMPLES = 200
+#: An inside curve that ends at a corner of the loop must leave it in the plane the two boundary
+#: curves' tangents span there (a smooth patch has one tangent plane at a point): past this angle
+#: (degrees) it is refused, saying so (it was refused as a curve the net could not follow, "use
+#: more controls", which no net fixes).
+CORNER_DEGREES = 1.0
+#: The finest mass-point mesh a network's patch is given (per direction) when its curves need a
+#: finer net than the default mesh takes (half its points): the patch then steps slower.
+MOST_MESH = 64
 #: The most curves :func:`split_network` sorts (its search tries every 4 and 3 of them).
 MOST_CURVES = 16
 
@@ -64,6 +72,34 @@ def _loop(curves: list[tuple[np.ndarray, str]]) -> list[tuple[np.ndarray, str]]:
         raise ValueError(f"boundary: the curves do not close: '{loop[-1][1]}' ends {closing:.3g} mm from where "
                          f"'{loop[0][1]}' starts (at most {gap:.3g})")
     return loop
+
+
+def _unit_vector(v: np.ndarray) -> np.ndarray:
+    return v / max(float(np.linalg.norm(v)), 1e-300)
+
+
+def _check_corners(loop: list[tuple[np.ndarray, str]], inside: list[tuple[np.ndarray, str]], size: float) -> None:
+    """ValueError for an inside curve that ends at a corner of the loop out of the plane of the
+    boundary tangents there (see CORNER_DEGREES); a corner where the loop runs straight on has no
+    such plane and takes any."""
+    gap = CLOSE_SHARE * size
+    for k in range(len(loop)):
+        (before, first), (after, second) = loop[k - 1], loop[k]
+        corner = after[0]
+        normal = np.cross(_unit_vector(before[-2] - before[-1]), _unit_vector(after[1] - after[0]))
+        if np.linalg.norm(normal) < np.sin(np.radians(10.0)):
+            continue
+        normal = _unit_vector(normal)
+        for points, label in inside:
+            for end, next_point in ((points[0], points[1]), (points[-1], points[-2])):
+                if np.linalg.norm(end - corner) > gap:
+                    continue
+                out = float(np.degrees(np.arcsin(min(1.0, abs(_unit_vector(next_point - end) @ normal)))))
+                if out > CORNER_DEGREES:
+                    raise ValueError(f"curve: '{label}' ends at the corner where '{first}' and '{second}' meet, "
+                                     f"{out:.3g} degrees out of the plane their tangents span there: a smooth patch "
+                                     f"has one tangent plane at a point, so none passes through all three; end "
+                                     f"'{label}' on a side, or let it leave the corner in that plane")
 
 
 def split_network(curves: Sequence[Any]) -> tuple[list[int], list[int]]:
@@ -255,10 +291,11 @@ def make_sculpt_from_curves(doc: Any, boundary: Sequence[Any], interior: Sequenc
     area = 0.5 * float(np.linalg.norm(normal))
     if area <= 1e-6 * size * size:
         raise ValueError("boundary: the curves lie in one line: the loop they close encloses no area")
+    _check_corners(loop, [cc.curve_points(c, SAMPLES) for c in interior], size)
     mesh = (max(40, 2 * controls[0]), max(40, 2 * controls[1]))
     net = edge_fitted_net(sides, controls, tolerance, (32, 32))
     mesh = (max(mesh[0], 2 * net.controls[0]), max(mesh[1], 2 * net.controls[1]))
-    records, moved, links, dynamic, held = _held(net, list(interior), mesh, material, tolerance)
+    records, moved, links, dynamic, held, mesh = _held(net, list(interior), mesh, material, tolerance)
     for _ in range(ROOM_PASSES):  # (room beside each interior curve: its conditions fix the poles it crosses)
         knots: tuple[list[float], list[float]] = ([], [])
         for record in records:
@@ -267,8 +304,8 @@ def make_sculpt_from_curves(doc: Any, boundary: Sequence[Any], interior: Sequenc
             knots = (sorted(set(knots[0] + more[0])), sorted(set(knots[1] + more[1])))
         if not knots[0] and not knots[1]:
             break
-        records, moved, links, dynamic, held = _held(refined(dynamic.surface, knots), list(interior), mesh, material,
-                                                     tolerance)
+        records, moved, links, dynamic, held, mesh = _held(refined(dynamic.surface, knots), list(interior), mesh,
+                                                           material, tolerance)
     if len(loop) == 4 or interior:
         # (three curves: the least bending of the change from the Coons patch, and with none inside
         # the Coons patch itself: the parameters crowd at the straight corner, where their own energy
@@ -293,12 +330,12 @@ def make_sculpt_from_curves(doc: Any, boundary: Sequence[Any], interior: Sequenc
 
 
 def _held(net: core.BSplineSurface, interior: list[Any], mesh: tuple[int, int], material: str, tolerance: float
-          ) -> tuple[list[cc.CurveConstraint], np.ndarray, list[Any], Any, list[int]]:
+          ) -> tuple[list[cc.CurveConstraint], np.ndarray, list[Any], Any, list[int], tuple[int, int]]:
     """A surface of ``net`` with its edges held (G0: the boundary) and every interior curve held on
-    it (refined along a curve where it must be, up to half the mesh's points per direction): the
-    records, the poles moved onto them, the links, the surface, the held poles."""
+    it (refined along a curve where it must be, up to half the mesh's points per direction, the
+    mesh made finer up to MOST_MESH when that is not enough): the records, the poles moved onto
+    them, the links, the surface, the held poles and the mesh."""
     from .edge_holds import boundary_poles
-    most = (mesh[0] // 2, mesh[1] // 2)
     while True:
         held = boundary_poles(tuple(net.controls), "G0")
         dynamic = sculpt_state.restore(_sculpt_state(SourceSurface(net, "curves", 0.0, ""), mesh, material, held))
@@ -312,12 +349,14 @@ def _held(net: core.BSplineSurface, interior: list[Any], mesh: tuple[int, int], 
                 records.append(record)
                 dynamic.set_poles(moved.reshape(np.asarray(dynamic.poles).shape))
                 dynamic.hold_poles(held, links)
-            return records, moved, links, dynamic, held
+            return records, moved, links, dynamic, held, mesh
         except cc.NetTooCoarse as coarse:
             controls = tuple(net.controls)
-            room = (most[0] - controls[0], most[1] - controls[1])
-            knots = cc.refinement_knots(net, coarse.uv, room)
+            knots = cc.refinement_knots(net, coarse.uv, (mesh[0] // 2 - controls[0], mesh[1] // 2 - controls[1]))
             if not knots[0] and not knots[1]:
-                raise ValueError(f"{coarse} (refined up to {controls[0]} x {controls[1]} controls, the most its "
-                                 f"{mesh[0]} x {mesh[1]} mesh takes)") from None
+                if max(mesh) >= MOST_MESH:
+                    raise ValueError(f"{coarse} (refined up to {controls[0]} x {controls[1]} controls, the most a "
+                                     f"patch from curves takes, on a {mesh[0]} x {mesh[1]} mesh)") from None
+                mesh = (min(MOST_MESH, mesh[0] * 3 // 2), min(MOST_MESH, mesh[1] * 3 // 2))
+                knots = cc.refinement_knots(net, coarse.uv, (mesh[0] // 2 - controls[0], mesh[1] // 2 - controls[1]))
             net = refined(net, knots)
