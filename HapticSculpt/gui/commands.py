@@ -619,8 +619,11 @@ class FollowCurve:
                 overlay.notice(text)
             _ctl().refresh(sculpt)
         after = constraint_along(target, curve)
-        FreeCAD.Console.PrintMessage(f"HapticSculpt: {target.Label} follows {label} {after['continuity']} "
-                                     f"(within {after['distance_mm']:.2g} mm)\n" if after else
+        # (the distance now, beside the tolerance it is held to: "within 2.2e-14 mm" beside the
+        # HUD's "within 0.001 mm" read as two claims that disagree)
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: {target.Label} follows {label} {after['continuity']}: "
+                                     f"{after['distance_mm']:.2g} mm from it now (held within "
+                                     f"{(sculpt.Proxy.live.last_curve or {}).get('tolerance_mm', 0.001):g} mm)\n" if after else
                                      f"HapticSculpt: {target.Label} no longer follows it\n")
 
 
