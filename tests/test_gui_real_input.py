@@ -105,11 +105,18 @@ class Desktop:
         self.wait_window("Save FreeCAD Document")
         self.xdo("type", path)
         for attempt in range(3):
-            s = self.wait(lambda s: s["file_dialog"] is not None or saved(s), "the save dialog's field", timeout=4.0,
-                          shot=False) if attempt else self.wait(lambda s: s["file_dialog"] is not None,
-                                                                "the save dialog's field")
+            s = self.wait(lambda s: s["file_dialog"] is not None or saved(s) or s["docs"][s["active"]]["file"],
+                          "the save dialog's field", timeout=4.0, shot=False) if attempt else \
+                self.wait(lambda s: s["file_dialog"] is not None, "the save dialog's field")
             if saved(s):
                 return s
+            if s["file_dialog"] is None and s["docs"][s["active"]]["file"]:
+                # (the Return took the completer's entry after all, its popup shown again after the
+                # check: saved under the folder's name; Save As again, as a user who sees it does)
+                self.shortcut("ctrl+shift+s", "Std_SaveAs")
+                self.wait_window("Save FreeCAD Document")
+                self.xdo("type", path)
+                s = self.wait(lambda s: s["file_dialog"] is not None, "the save-as dialog's field")
             if s["file_dialog"] is None:  # (an Escape closed the dialog, not the popup)
                 self.shortcut("ctrl+s", "Std_Save")
                 self.wait_window("Save FreeCAD Document")
