@@ -227,12 +227,11 @@ def edge_fitted_net(sides: list[np.ndarray], controls: tuple[int, int], toleranc
         controls = grown
 
 
-def faired(poles: np.ndarray, surface: core.BSplineSurface, links: list[Any], held: Sequence[int] = (),
-           reference: np.ndarray | None = None) -> np.ndarray:
-    """The poles (n, 3) of least bending energy (of their change from ``reference``, when given)
-    with the ``held`` poles where they are and the ``links`` (pole, masters, offset) held: every
-    slave its masters' combination. (A touch of the current shape, 1e-9 of the energy's scale,
-    keeps the directions it does not see where they are.)"""
+def faired(poles: np.ndarray, surface: core.BSplineSurface, links: list[Any], held: Sequence[int] = ()
+           ) -> np.ndarray:
+    """The poles (n, 3) of least bending energy with the ``held`` poles where they are and the
+    ``links`` (pole, masters, offset) held: every slave its masters' combination. (A touch of the
+    current shape, 1e-9 of the energy's scale, keeps the directions it does not see where they are.)"""
     n = len(poles)
     slaves = {link[0] for link in links}
     fixed = set(held)
@@ -254,8 +253,7 @@ def faired(poles: np.ndarray, surface: core.BSplineSurface, links: list[Any], he
     k = bending_matrix(surface)
     a = t.T @ k @ t
     touch = 1e-9 * np.trace(a) / max(len(free), 1)
-    offset = c if reference is None else c - reference
-    q = np.linalg.solve(a + touch * np.eye(len(free)), -t.T @ k @ offset + touch * poles[free])
+    q = np.linalg.solve(a + touch * np.eye(len(free)), -t.T @ k @ c + touch * poles[free])
     return t @ q + c
 
 
@@ -307,15 +305,9 @@ def make_sculpt_from_curves(doc: Any, boundary: Sequence[Any], interior: Sequenc
         records, moved, links, dynamic, held, mesh = _held(refined(dynamic.surface, knots), list(interior), mesh,
                                                            material, tolerance)
     if len(loop) == 4 or interior:
-        # (three curves: the least bending of the change from the Coons patch, and with none inside
-        # the Coons patch itself: the parameters crowd at the straight corner, where their own energy
-        # bends the patch, 0.4 1/mm against the Coons patch's 0.037, 0.32 with a curve inside)
-        reference = None
-        if len(loop) == 3:
-            final = dynamic.surface
-            reference = np.asarray(refined(net, (np.unique(final.knots_u), np.unique(final.knots_v))).poles,
-                                   float).reshape(-1, 3)
-        dynamic.set_poles(faired(moved, dynamic.surface, links, held, reference).reshape(np.asarray(dynamic.poles).shape))
+        # (three curves and none inside: the Coons patch itself; the parameters' energy bends it at the
+        # straight corner where they crowd, 0.4 1/mm against the Coons patch's 0.037)
+        dynamic.set_poles(faired(moved, dynamic.surface, links, held).reshape(np.asarray(dynamic.poles).shape))
     dynamic.hold_poles(held, links)
     dynamic.relax()
     state = sculpt_state.capture(dynamic)
