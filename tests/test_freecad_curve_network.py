@@ -84,15 +84,17 @@ class TestCurveNetwork(SolidChecks):
         self.assertLess(peak.max(), 0.05)  # (0.037)
 
     def test_an_inside_curve_the_default_mesh_cannot_follow_gets_a_finer_one(self):
-        """A 10 mm arc from the base to the middle of a side of a bowed triangle needs more than the
-        20 x 20 controls its 40 x 40 mesh took (0.008 mm short, refused): the mesh grows for it."""
-        tri = [Part.LineSegment(V(-40, -30, 0), V(40, -30, 0)).toShape(), arc(V(40, -30, 0), V(0, 40, 0), 8.0),
-               arc(V(0, 40, 0), V(-40, -30, 0), 8.0)]
-        spine = arc(V(0, -30, 0), V(20, 5, 8), 10.0)
-        obj = hs.make_sculpt_from_curves(self.doc, tri, [spine], name="Tri")
+        """Three waves 3 mm high across a square need more than the 20 x 20 controls its 40 x 40
+        mesh takes (refused): the mesh grows for them (30 x 28 controls)."""
+        p = [V(-50, -50, 0), V(50, -50, 0), V(50, 50, 0), V(-50, 50, 0)]
+        sides = [Part.LineSegment(p[k], p[(k + 1) % 4]).toShape() for k in range(4)]
+        curve = Part.BSplineCurve()
+        curve.interpolate([V(x, 0, 3 * np.sin(3 * np.pi * (x + 50) / 100)) for x in np.linspace(-50, 50, 41)])
+        wave = curve.toShape()
+        obj = hs.make_sculpt_from_curves(self.doc, sides, [wave], name="Wave")
         face = obj.Shape.Faces[0]
-        for curve in tri + [spine]:
-            self.assertLessEqual(curve_distance(face, curve), TOLERANCE)
+        for c in sides + [wave]:
+            self.assertLessEqual(curve_distance(face, c), TOLERANCE)
         self.assertGreater(max(obj.Proxy.surface.surface.controls), 20)
 
     def test_an_inside_curve_into_a_corner_out_of_its_tangent_plane_is_refused_saying_so(self):
