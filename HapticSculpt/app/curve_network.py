@@ -346,9 +346,10 @@ def _held(net: core.BSplineSurface, interior: list[Any], mesh: tuple[int, int], 
             controls = tuple(net.controls)
             knots = cc.refinement_knots(net, coarse.uv, (mesh[0] // 2 - controls[0], mesh[1] // 2 - controls[1]))
             if not knots[0] and not knots[1]:
-                if max(mesh) >= MOST_MESH:
-                    raise ValueError(f"{coarse} (refined up to {controls[0]} x {controls[1]} controls, the most a "
-                                     f"patch from curves takes, on a {mesh[0]} x {mesh[1]} mesh)") from None
+                if max(mesh) >= MOST_MESH:  # (the advice a sculpt gets, more controls, is this one's own limit)
+                    raise ValueError(f"curve: the patch cannot follow {coarse.curve} on the most controls a patch "
+                                     f"from curves takes: {coarse.why}; make the curve smoother, or give a larger "
+                                     f"tolerance") from None
                 mesh = (min(MOST_MESH, mesh[0] * 3 // 2), min(MOST_MESH, mesh[1] * 3 // 2))
                 knots = cc.refinement_knots(net, coarse.uv, (mesh[0] // 2 - controls[0], mesh[1] // 2 - controls[1]))
             net = refined(net, knots)
