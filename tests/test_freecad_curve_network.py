@@ -83,6 +83,21 @@ class TestCurveNetwork(SolidChecks):
         _, peak = curvatures(face)
         self.assertLess(peak.max(), 0.05)  # (0.037)
 
+    def test_three_curves_and_one_inside_to_a_sides_middle_make_a_fair_patch(self):
+        """The longest curve is split away from where the inside curve ends: split at its middle,
+        where the inside curve ends too, the crowded parameters bent the patch there (mean
+        curvature turned, peak 0.18 1/mm on FreeCAD 1.0 and 1.1)."""
+        tri = [Part.LineSegment(V(-50, -40, 0), V(50, -40, 0)).toShape(), arc(V(50, -40, 0), V(0, 45, 0), 8.0),
+               arc(V(0, 45, 0), V(-50, -40, 0), 8.0)]
+        inside = arc(V(-30, -40, 0), V(25, 2.5, 8.0), 10.0)  # (from the base to the middle of a side)
+        obj = hs.make_sculpt_from_curves(self.doc, tri, [inside], name="Tri")
+        face = obj.Shape.Faces[0]
+        for curve in tri + [inside]:
+            self.assertLessEqual(curve_distance(face, curve), TOLERANCE)
+        mean, peak = curvatures(face)
+        self.assertTrue(np.all(mean < 0), (mean.min(), mean.max()))  # a dome: one sign
+        self.assertLess(peak.max(), 0.1)
+
     def test_an_inside_curve_the_default_mesh_cannot_follow_gets_a_finer_one(self):
         """Three waves 3 mm high across a square need more than the 20 x 20 controls its 40 x 40
         mesh takes (refused): the mesh grows for them (30 x 28 controls)."""
