@@ -173,24 +173,30 @@ class TestCurveRefinement(SolidChecks):
 
 
 class TestNoFoldBesideACurve(SolidChecks):
-    def test_a_pull_beside_an_oblique_line_lifts_a_smooth_bump(self):
-        # A line across a clamped clay patch, not a line of its net: held exactly, its conditions
-        # locked every pole whose support it crosses, and this pull moved nothing (0.00 mm).
-        obj = hs.make_sculpt(self.doc, controls=(10, 10), edges="held", material="clay")
-        a, b = np.array([-45.0, -30.0, 0.0]), np.array([40.0, 35.0, 0.0])
-        line = Part.LineSegment(V(*a), V(*b)).toShape()
-        hs.add_curve_constraint(obj, line)
-        along = (b - a) / np.linalg.norm(b - a)
-        across, middle = np.array([along[1], -along[0], 0.0]), (a + b) / 2
-        pull(obj, middle + 2.0 * across, (0.0, 0.0, 10.0))  # 2 mm beside it, 10 mm up
-        face = obj.Shape.Faces[0]
-        self.assertLessEqual(curve_distance(face, line), TOLERANCE)
-        x, z, k = section_curvature(face, middle, across)
-        pulled = x > 0
-        self.assertGreater(z[pulled].max(), 0.25, "the pull lifted the surface beside the line")
-        self.assertLess(np.abs(k).max(), 0.5, "curvature along the section across the line")
-        signs = np.sign(k[pulled & (np.abs(k) > 1e-3)])  # (through the bump: from the line outwards)
-        self.assertLessEqual(int((np.diff(signs) != 0).sum()), 2, "the curvature's sign changes through the bump")
+    def test_a_pull_beside_a_line_lifts_a_smooth_bump(self):
+        """A rope pulled 10 mm up, 2 mm beside a followed line on a clamped clay patch: along the
+        section across the line through the grab, curvature under 0.5 1/mm, and its sign (where it
+        is above a tenth of its peak along the section) changes at most twice on the pulled side.
+        Across the net (an oblique line): held exactly, its conditions locked every pole whose
+        support it crosses, and this pull moved nothing (0.00 mm); along a line of the net."""
+        lines = {"oblique": ((-45.0, -30.0), (40.0, 35.0)), "along the net": ((-35.0, -45.0), (-35.0, 45.0))}
+        for name, (a, b) in lines.items():
+            with self.subTest(line=name):
+                obj = hs.make_sculpt(self.doc, controls=(10, 10), edges="held", material="clay", name="Pulled")
+                a, b = np.array([*a, 0.0]), np.array([*b, 0.0])
+                line = Part.LineSegment(V(*a), V(*b)).toShape()
+                hs.add_curve_constraint(obj, line)
+                along = (b - a) / np.linalg.norm(b - a)
+                across, middle = np.array([along[1], -along[0], 0.0]), (a + b) / 2
+                pull(obj, middle + 2.0 * across, (0.0, 0.0, 10.0))  # 2 mm beside it, 10 mm up
+                face = obj.Shape.Faces[0]
+                self.assertLessEqual(curve_distance(face, line), TOLERANCE)
+                x, z, k = section_curvature(face, middle, across)
+                pulled = x > 0
+                self.assertGreater(z[pulled].max(), 0.25, "the pull lifted the surface beside the line")
+                self.assertLess(np.abs(k).max(), 0.5, "curvature along the section across the line")
+                signs = np.sign(k[pulled & (np.abs(k) > 0.1 * np.abs(k).max())])
+                self.assertLessEqual(int((np.diff(signs) != 0).sum()), 2, "the curvature's sign changes")
 
 
 def obj_seams(obj):
