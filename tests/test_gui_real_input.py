@@ -1091,8 +1091,9 @@ def test_a_mouse_session_keeps_to_its_sculpt_its_drags_and_what_it_shows(tmp_pat
 @pytest.mark.parametrize("view,key,up", [("top", "2", 1.0), ("bottom", "5", -1.0)])
 def test_a_drag_up_in_a_view_onto_the_patch_lifts_it_toward_the_eye(tmp_path, view, key, up):
     """A new clamped patch seen from the top (or the bottom), a session, a drag up the screen: the
-    patch rises toward the eye. (In the plane facing the screen, which is the patch's own from
-    there, the grab slid along the patch, unseen: a top view's drag lifted nothing.)"""
+    patch rises toward the eye, and the HUD says so while the button is held. (In the plane facing
+    the screen, which is the patch's own from there, the grab slid along the patch, unseen: a top
+    view's drag lifted nothing.)"""
     d = Desktop(str(tmp_path), "CAD")
     try:
         d.xdo("mousemove", "640", "500")
@@ -1104,8 +1105,13 @@ def test_a_drag_up_in_a_view_onto_the_patch_lifts_it_toward_the_eye(tmp_path, vi
         centre = d.to_screen(sculpt(s)["screen"][0])
         flat = np.array(sculpt(s)["poles"]).reshape(-1, 3)
         path = [(centre[0], centre[1] - 10 * k) for k in range(1, 13)]
-        d.drag([centre] + path + path[-1:] * 4, seconds=1.0)
+        d.drag([centre] + path + path[-1:] * 4, seconds=1.0, release=False)
+        # the HUD says so while the button is held (from here the cursor ball seems to stay put)
+        d.wait(lambda s: any("lifting toward you:" in o["status_text"] for o in s["overlays"]), "the lift in the HUD")
+        d.shot(f"{view}_view_lifting")
+        d.xdo("mouseup", "1")
         s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke's undo step")
+        assert not any("lifting toward you" in o["status_text"] for o in s["overlays"]), "the lift said after the release"
         poles = np.array(sculpt(s)["poles"]).reshape(-1, 3)
         lift = float((poles[:, 2] * up).max())
         slide = float(np.abs(poles[:, :2] - flat[:, :2]).max())

@@ -94,6 +94,14 @@ class MouseDevice:
         except Exception:  # noqa: BLE001 - its view was closed: the cursor stays
             self._pointer = None
 
+    def lifted(self) -> float | None:
+        """How far a grab in a view that looks onto the surface has taken the grab point toward
+        the eye (mm), or None when no such grab is held (what the HUD says: from such a view the
+        grab moves along the line of sight and the cursor ball seems to stay put)."""
+        if not self._buttons or self._lift is None:
+            return None
+        return sum((p - g) * e for p, g, e in zip(self._position, self._lift.grab, self._lift.toward_eye))
+
     @property
     def grabbing(self) -> bool:
         """True while the left button holds a grab (a press not yet moved is no grab)."""

@@ -85,6 +85,7 @@ class Overlay:
         self.hud: Hud | None = None  # the screen-space layer, made when the overlay first draws
         self.speaks: Any = lambda overlay: True  # whether its HUD is the view's one (set by the Controller)
         self.mouse: Any = lambda overlay: None  # the mouse's cursor it shows, if any (set by the Controller)
+        self.lifting: Any = lambda overlay: None  # mm a mouse grab lifted toward the eye, if any (the Controller's)
         self.hidden_scan: Any = None  # the target's mesh the deviation display hid (it draws the points)
         self._root = coin.SoSeparator()
         self._root.setName("HapticSculptOverlay")
@@ -472,7 +473,10 @@ class Overlay:
             if not s.held_poles and not any(c["kind"] == "point" for c in s.constraints):
                 # (a free sheet pulled at a corner swung up whole, flat: it looked broken on a first try)
                 parts.append("edges free: a pull lifts it whole, P pins a point")
-            if session.last_stroke is not None:
+            lifted = self.lifting(self)
+            if lifted is not None:
+                parts.append(f"lifting toward you: {lifted:.1f} mm (seen from above: drag up lifts, sideways moves)")
+            elif session.last_stroke is not None:
                 parts.append(stroke_text(session.last_stroke))
         if self.display == "zebra":
             turn = (f"stripes at {self.stripe_angle:g} deg" if self.stripe_mode == "reflection"

@@ -235,6 +235,7 @@ class Controller:
             self.overlays[key].mode = f"airbrush: {self.painting}" if self.painting else ""
             self.overlays[key].speaks = self.speaks
             self.overlays[key].mouse = self.mouse_cursor
+            self.overlays[key].lifting = self.mouse_lift
         return self.overlays[key]
 
     def speaks(self, overlay: Overlay) -> bool:
@@ -252,6 +253,13 @@ class Controller:
             if active is not None and ov.obj == active:
                 return ov is overlay
         return drawing[0] is overlay
+
+    def mouse_lift(self, overlay: Overlay) -> float | None:
+        """How far the session's mouse grab lifted toward the eye (mm) in a view that looks onto
+        the surface, on the session's sculpt's overlays; else None."""
+        if self.mouse is None or self.session is None or overlay.obj is not self.session.obj:
+            return None
+        return self.mouse.lifted()
 
     def mouse_cursor(self, overlay: Overlay) -> tuple[np.ndarray, np.ndarray, bool] | None:
         """The mouse's cursor (position, orientation, grab) if ``overlay`` shows it: the airbrush's,
