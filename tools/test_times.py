@@ -6,7 +6,8 @@
 Each part of make test runs under tools/timed, which frames it with a start line and an end line
 carrying the clock; parts that ran side by side (the lanes of make test) overlap in the table's
 "from" and "to" columns, seconds since the run's first part started. The total is the wall time
-from the first start to the last end, not the sum of the parts.
+from the first start to the last end, not the sum of the parts. The table ends with the parts that
+failed and the lines of theirs that say what failed (a CI log often keeps only its tail).
 """
 from __future__ import annotations
 
@@ -14,9 +15,14 @@ import argparse
 import json
 import re
 import sys
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
+PREFIX = re.compile(r"\[(\S+) (\S+)\] ")  # tools/timed's in make test's lanes
 START = re.compile(r"== \[part\] (\S+) (\S+): start ([0-9.]+)")
+#: A line of a part that says what failed: pytest's summary, FreeCAD's runner, make, a compiler.
+FAILURE = re.compile(r"^(FAILED |ERROR |FAIL:|ERROR:|make(\[\d+\])?: \*\*\*|.*: error: |.*Timeout|.*Error: )")
+#: How many of a failed part's lines to show.
+FAILURE_LINES = 12
 END = re.compile(r"== \[part\] (\S+) (\S+): (\d+) s,(?: CPU (\d+) s,)? exit (\d+) \(([0-9.]+)\)")
 #: The FreeCAD each Debian has (the roots' and the hosts').
 FREECAD = {"bookworm": "0.20.2", "trixie": "1.0.0", "forky": "1.1.3"}
@@ -30,6 +36,7 @@ class Part:
     end: float | None = None
     exit: int | None = None
     cpu: float | None = None  # user + system seconds, on any core
+    failures: list[str] = field(default_factory=list)  # its lines that say what failed
 
     @property
     def seconds(self) -> float | None:
@@ -42,6 +49,11 @@ def parts_of(lines) -> list[Part]:
     parts: list[Part] = []
     open_parts: dict[tuple[str, str], Part] = {}
     for line in lines:
+        if m := PREFIX.match(line):
+            said = line[m.end():].rstrip("\n")
+            part = open_parts.get((m[1], m[2]))
+            if part is not None and FAILURE.match(said) and len(part.failures) < FAILURE_LINES:
+                part.failures.append(said)
         if m := START.search(line):
             part = Part(m[1], m[2], float(m[3]))
             parts.append(part)
@@ -79,6 +91,10 @@ def table(parts: list[Part]) -> str:
     for suite in dict.fromkeys(p.suite for p in parts):
         done = [p for p in parts if p.suite == suite and p.seconds is not None]
         out.append(f"  {suite}: busy {busy(done):.0f} s ({len(done)} parts; a part inside another counts once)")
+    for p in parts:
+        if p.exit not in (0, None) or p.end is None:
+            out.append(f"\nFAILED: {p.suite} {p.name} ({'did not end' if p.end is None else f'exit {p.exit}'})")
+            out += [f"  {line}" for line in p.failures] or ["  (no line of it says what failed: read its lines in the log)"]
     return "\n".join(out)
 
 
