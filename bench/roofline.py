@@ -78,8 +78,10 @@ def counts(m: int, springs: int, solve: tuple[int, int, bool]) -> dict:
     array = 24 * points  # (three doubles a point)
     read = sum(r for _, r, _ in MESH_PASSES)
     written = sum(w for _, _, w in MESH_PASSES)
-    unknowns, entries, dense = solve
-    solve_bytes = 8 * entries if dense else 2 * 12 * entries  # (dense: the inverse once; sparse: L twice)
+    unknowns, entries, how = solve
+    dense = how == "dense"
+    # (dense: the inverse once; band: L twice, values only; sparse: L twice, values and row indices)
+    solve_bytes = 8 * entries if dense else 2 * (8 if how == "band" else 12) * entries
     solve_bytes += 4 * 24 * unknowns  # (right-hand side, solution, work, its permutation)
     solve_flops = 6 * entries if dense else 12 * entries
     tensor_flops = 2 * 2 * (n + m) * m * (DEGREE + 1) * 3  # (A and A^T: (n + g) h (p + 1) per coordinate)
@@ -186,7 +188,7 @@ def main() -> None:
         level = "private" if c["working_set"] <= private else "shared" if c["working_set"] <= shared else "memory"
         bound = max(c["bytes"] / machine[f"bandwidth_{level}"], c["flops"] / machine["flops"])
         rows.append({"mesh": m, "controls": m // 4, "step_us": seconds * 1e6, "springs": springs,
-                     "solve_unknowns": solve[0], "solve_entries": solve[1], "solve_dense": solve[2], **c,
+                     "solve_unknowns": solve[0], "solve_entries": solve[1], "solve_by": solve[2], **c,
                      "level": level, "bound_us": bound * 1e6, "ratio": seconds / bound,
                      "memory_bound_us": c["bytes"] / machine["bandwidth_memory"] * 1e6})
     print(f"machine: bandwidth {machine['bandwidth_private'] / 1e9:.1f} GB/s in the per-core cache "

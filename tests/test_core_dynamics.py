@@ -577,16 +577,15 @@ def test_painting_rescales_the_verlet_bound():
 
 def test_system_solve_size_says_what_a_step_solves_by():
     """What bench/roofline.py counts: the system's unknowns, the entries a solve reads (the dense
-    inverse's n^2 up to 600 unknowns, else the L factor's) and which of the two it is."""
+    inverse's n^2 up to 600 unknowns, else the L factor's) and which factor it is."""
     small = core.patch((16, 16), mesh=(64, 64), size=(400.0, 400.0))
-    assert small.system_solve_size == (0, 0, False)  # (no implicit step yet)
+    assert small.system_solve_size == (0, 0, "")  # (no implicit step yet)
     small.explicit_when_stable = False
     small.step(DT)
-    assert small.system_solve_size == (256, 256 * 256, True)
+    assert small.system_solve_size == (256, 256 * 256, "dense")
     large = core.patch((32, 32), mesh=(128, 128), size=(400.0, 400.0))
     large.explicit_when_stable = False
     large.step(DT)
-    unknowns, entries, dense = large.system_solve_size
-    assert (unknowns, dense) == (1024, False)
-    # (the factor of a net coupling 7 x 7 poles holds more than the matrix's lower half, far less than dense)
-    assert 24 * 1024 < entries < 1024 * 1023 // 2
+    # A bicubic net's springs couple poles up to four rows apart (a spring joins mesh points in
+    # neighbouring spans): its poles row by row make a band of 4 x 32 + 4 below the diagonal
+    assert large.system_solve_size == (1024, 1024 * 132, "band")

@@ -435,8 +435,8 @@ void bindSolvers(py::module_& m) {
         .def_property_readonly("time", &DynamicSurface::time)
         .def_property_readonly("step_count", &DynamicSurface::stepCount)
         .def_property_readonly("system_solve_size", &DynamicSurface::systemSolveSize,
-                               "(unknowns, matrix entries one solve reads, dense inverse?) of the system the last "
-                               "implicit step solved by; (0, 0, False) before one")
+                               "(unknowns, matrix entries one solve reads, how: 'dense' inverse, 'band' or 'sparse' "
+                               "factor) of the system the last implicit step solved by; (0, 0, '') before one")
         .def_property_readonly("work_done", &DynamicSurface::workDone, "work of external and tool forces so far")
         .def("kinetic_energy", &DynamicSurface::kineticEnergy)
         .def("potential_energy", &DynamicSurface::potentialEnergy, "springs, bending and penalty terms")

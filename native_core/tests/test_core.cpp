@@ -106,6 +106,55 @@ TEST(PrefactoredSolver, MatchesEigenSolve) {
     EXPECT_LT((Eigen::MatrixXd(x) - expect).cwiseAbs().maxCoeff(), 1e-10);
 }
 
+namespace {
+/// A bicubic net's system-like matrix (A^T A plus a varying diagonal) on g x h poles, and a
+/// reference solve of it.
+Eigen::SparseMatrix<double> netSystem(int g, int h) {
+    DynamicSurface s(BSplineSurface::plane(g, h, 3, 3, 50, 30), 3 * g, 3 * h);
+    const Eigen::SparseMatrix<double> A = s.sampling().matrix().toEigen();
+    Eigen::SparseMatrix<double> M = A.transpose() * A;
+    for (int i = 0; i < M.rows(); ++i) M.coeffRef(i, i) += 0.1 * (i % 5 + 1);
+    return M;
+}
+double solveError(const PrefactoredSolver& solver, const Eigen::SparseMatrix<double>& M) {
+    Points b = Points::Random(M.rows(), 3), x(M.rows(), 3);
+    solver.solve(b, x);
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ref(M);
+    return (Eigen::MatrixXd(x) - ref.solve(Eigen::MatrixXd(b))).cwiseAbs().maxCoeff();
+}
+}  // namespace
+
+TEST(PrefactoredSolver, ANetRowByRowIsSolvedAsABand) {
+    // 30 x 30 poles: a band of 3 x 30 + 3 below the diagonal, about AMD's fill.
+    const Eigen::SparseMatrix<double> M = netSystem(30, 30);
+    PrefactoredSolver solver;
+    solver.factor(M, "test");
+    EXPECT_EQ(solver.kind(), PrefactoredSolver::Kind::Band);
+    EXPECT_EQ(solver.entriesRead(), 900 * 93);
+    EXPECT_LT(solveError(solver, M), 1e-10);
+}
+
+TEST(PrefactoredSolver, AMatrixCouplingDistantUnknownsKeepsTheSparseFactor) {
+    // The same net with its first pole tied to its last (as a curve's links can tie distant
+    // poles): the band would span the whole matrix; AMD's factor barely grows.
+    Eigen::SparseMatrix<double> M = netSystem(30, 30);
+    const int n = static_cast<int>(M.rows());
+    M.coeffRef(n - 1, 0) += 0.01;
+    M.coeffRef(0, n - 1) += 0.01;
+    PrefactoredSolver solver;
+    solver.factor(M, "test");
+    EXPECT_EQ(solver.kind(), PrefactoredSolver::Kind::Sparse);
+    EXPECT_LT(solveError(solver, M), 1e-10);
+}
+
+TEST(PrefactoredSolver, AnIndefiniteBandIsRefused) {
+    Eigen::SparseMatrix<double> M = netSystem(30, 30);
+    M.coeffRef(450, 450) = -1.0;
+    PrefactoredSolver solver;
+    EXPECT_THROW(solver.factor(M, "test"), std::runtime_error);
+    EXPECT_FALSE(solver.ready());
+}
+
 TEST(PrefactoredSolver, RejectsSingularMatrix) {
     Eigen::SparseMatrix<double> m(3, 3);
     m.insert(0, 0) = 1;

@@ -173,9 +173,12 @@ public:
     std::uint64_t stepCount() const { return steps_; }
     /// The system matrix the last implicit step solved by: (its unknowns, the entries one solve
     /// reads, whether it keeps the dense inverse); unknowns 0 before such a step.
-    std::tuple<int, Eigen::Index, bool> systemSolveSize() const {
+    /// (unknowns, matrix entries one solve reads, "dense" | "band" | "sparse"), or (0, 0, "") before a solve.
+    std::tuple<int, Eigen::Index, std::string> systemSolveSize() const {
         const PrefactoredSolver& s = systems_.current().solver;
-        return s.ready() ? std::make_tuple(s.size(), s.entriesRead(), s.dense()) : std::make_tuple(0, Eigen::Index{0}, false);
+        if (!s.ready()) return {0, 0, ""};
+        using Kind = PrefactoredSolver::Kind;
+        return {s.size(), s.entriesRead(), s.kind() == Kind::Dense ? "dense" : s.kind() == Kind::Band ? "band" : "sparse"};
     }
     double time() const { return time_; }
     double workDone() const { return work_; }  ///< work of external and tool forces so far
