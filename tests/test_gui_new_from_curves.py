@@ -90,7 +90,7 @@ def test_new_patch_from_curves_refuses_a_stray_curve_makes_a_patch_through_the_a
         poles = np.array(sculpt(s)["poles"]).reshape(-1, 3)
         assert 11.0 < poles[:, 2].max() < 20.0 and poles[:, 2].min() > -1e-6, "raised over the arc, on the loop"
         assert np.ptp(poles[:, 0]) == pytest.approx(100.0) and np.ptp(poles[:, 1]) == pytest.approx(80.0)
-        assert "a patch on 4 boundary curves through 1 inside" in s["report"], s["report"][-1000:]
+        assert "a patch on 4 boundary curves through 1 curve inside" in s["report"], s["report"][-1000:]
         made = d.shot_changed("network_made", before, "the patch")
         # a mouse stroke 25 mm beside the arc: the patch still passes through it
         beside = d.points_to_screen([(25.0, 0.0, 7.0)])[0]

@@ -63,14 +63,14 @@ def _loop(curves: list[tuple[np.ndarray, str]]) -> list[tuple[np.ndarray, str]]:
         if distance > gap:
             raise ValueError(f"boundary: the curves do not close: the end of '{loop[-1][1]}' at "
                              f"({', '.join(f'{x:.4g}' for x in tail)}) is {distance:.3g} mm from every other "
-                             f"curve's end (at most {gap:.3g})")
+                             f"curve's end (they must meet within {gap:.3g} mm)")
         points, label = curves[k]
         loop.append((points if end == 0 else points[::-1], label))
         left.remove(k)
     closing = float(np.linalg.norm(loop[-1][0][-1] - loop[0][0][0]))
     if closing > gap:
         raise ValueError(f"boundary: the curves do not close: '{loop[-1][1]}' ends {closing:.3g} mm from where "
-                         f"'{loop[0][1]}' starts (at most {gap:.3g})")
+                         f"'{loop[0][1]}' starts (they must meet within {gap:.3g} mm)")
     return loop
 
 

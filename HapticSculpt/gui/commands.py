@@ -219,9 +219,9 @@ class NewFromCurves:
         controls = obj.Proxy.surface.surface.controls
         held = curve_constraints_of(obj)
         within = f", each within {max(c['distance_mm'] for c in held):.2g} mm" if held else ""
-        FreeCAD.Console.PrintMessage(
-            f"HapticSculpt: {obj.Label}: a patch on {len(boundary)} boundary curves through {len(interior)} inside"
-            f"{within} ({controls[0]} x {controls[1]} controls)\n")
+        inside = f" through {len(interior)} curve{'s' * (len(interior) > 1)} inside{within}" if interior else ""
+        FreeCAD.Console.PrintMessage(f"HapticSculpt: {obj.Label}: a patch on {len(boundary)} boundary curves{inside} "
+                                     f"({controls[0]} x {controls[1]} controls)\n")
 
 
 def _face_selection() -> tuple[Any, list[str], Any] | None:
