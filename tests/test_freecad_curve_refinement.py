@@ -198,6 +198,24 @@ class TestNoFoldBesideACurve(SolidChecks):
                 signs = np.sign(k[pulled & (np.abs(k) > 0.1 * np.abs(k).max())])
                 self.assertLessEqual(int((np.diff(signs) != 0).sum()), 2, "the curvature's sign changes")
 
+    def test_an_arc_the_coarse_net_holds_exactly_is_refined_to_leave_room_beside_it(self):
+        """A clamped 8 x 8 patch (New clamped patch) and an arc near its held edges, where the net is
+        flat: the net held the arc exactly (1e-14 mm) with no refinement and its conditions pinned
+        every pole beside it: a pull 15 mm inside the arc moved nothing (a fresh-eyes GUI session).
+        The net is refined until a pull there has room, and the pull lifts the surface."""
+        obj = hs.make_sculpt(self.doc, controls=(8, 8), edges="held", material="clay", name="Clamped")
+        arc = Part.ArcOfCircle(Part.Circle(V(0, 10, 0), V(0, 0, 1), 46.0), np.radians(221), np.radians(319)).toShape()
+        hs.add_curve_constraint(obj, arc)
+        done = obj.Proxy.live.last_curve
+        self.assertEqual(done["refined_from"], [8, 8])
+        self.assertGreater(done["refined_to"][0] * done["refined_to"][1], 64, done)
+        before = np.array(obj.Poles).reshape(-1, 3)[:, 2]
+        pull(obj, (8.3, -20.1, 0.0), (0.0, 0.0, 16.0))
+        moved = np.abs(np.array(obj.Poles).reshape(-1, 3)[:, 2] - before).max()
+        self.assertGreater(moved, 2.0, "the pull beside the arc moved it")
+        self.assertLessEqual(curve_distance(obj.Shape.Faces[0], arc), TOLERANCE)
+
+
 
 def obj_seams(obj):
     """The sculpted solid's seam report (its edges with the base's faces)."""

@@ -58,6 +58,14 @@ def add_curve_constraint(obj: Any, curve: Any, continuity: str = "G0", normal: A
     except cc.NetTooCoarse as coarse:
         _follow_refined(sculpt, curve, continuity, normal, cid, records, tolerance, coarse)
         return cid
+    try:
+        _check_room(surface, record, held, all_links)
+    except cc.NetTooCoarse as roomless:
+        try:
+            _follow_refined(sculpt, curve, continuity, normal, cid, records, tolerance, roomless)
+            return cid
+        except ValueError:
+            pass  # (no finer net can be made: held on this one, as it is)
     before = np.asarray(surface.poles, float).reshape(-1, 3)
     pulled = not np.array_equal(moved, before)
     shape = np.asarray(surface.poles).shape
@@ -70,6 +78,17 @@ def add_curve_constraint(obj: Any, curve: Any, continuity: str = "G0", normal: A
     live.last_curve = {"id": cid, "label": record.label, "tolerance_mm": tolerance, "refined_from": list(controls),
                        "refined_to": list(controls)}
     return cid
+
+
+def _check_room(dynamic: Any, record: cc.CurveConstraint, held: list[int], links: list[Any]) -> None:
+    """NetTooCoarse (``roomless``) where the curve's conditions leave a pull beside it no room to
+    move the surface (cc.room_beside): refined like a net that cannot reach the curve, and held on
+    the finest net there is where none gives room."""
+    if cc.room_beside(dynamic.surface, record.uv, held, links) < cc.ROOM_SHARE:
+        coarse = cc.NetTooCoarse(f"'{record.label}' {record.continuity}", "it leaves the surface no room to move beside "
+                                 "it", "use more controls", record.uv)
+        coarse.roomless = True
+        raise coarse
 
 
 def _follow_refined(sculpt: Any, curve: Any, continuity: str, normal: Any, cid: int,
@@ -85,11 +104,15 @@ def _follow_refined(sculpt: Any, curve: Any, continuity: str, normal: Any, cid: 
     start = work.surface
     mesh = tuple(sculpt_state.capture(work).settings["mesh"])
     limit = (max(mesh[0] // 2, start.controls[0]), max(mesh[1] // 2, start.controls[1]))
+    roomless = None  # (the last finer net that held the curve with no room beside it, and what held it)
     while True:
         controls = tuple(work.surface.controls)
         room = (limit[0] - controls[0], limit[1] - controls[1])
         knots = cc.refinement_knots(work.surface, coarse.uv, room)
         made = refined_work(sculpt, work, knots) if knots[0] or knots[1] else None
+        if made is None and roomless is not None:  # (held, with what room the finest net has)
+            finer, held, walls, record, moved, all_links = roomless
+            break
         if made is None:
             first = tuple(start.controls)
             if knots[0] or knots[1]:  # (room, but the holds could not be carried to a finer net)
@@ -104,8 +127,11 @@ def _follow_refined(sculpt: Any, curve: Any, continuity: str, normal: Any, cid: 
         finer, held, links, walls = made
         try:
             record, moved, all_links = cc.make(finer, curve, continuity, normal, cid, held, links, records, tolerance)
+            _check_room(finer, record, held, all_links)
             break
         except cc.NetTooCoarse as again:
+            if again.roomless:
+                roomless = (finer, held, walls, record, moved, all_links)
             finer.hold_poles(held, links)
             if walls:
                 finer.set_walls(walls)
