@@ -9,8 +9,9 @@ from a corner and pulled up, as bench/scale.py's local stroke; the time is the m
 the pull. What a step moves, counted from native_core/src/solvers/integrator_local_global.cpp and
 DynamicSurface::step (see MESH_PASSES): the passes over the mesh's per-point arrays (three doubles
 a point), the springs' rest lengths, the two tensor products by the sampling matrix A, and the
-solve by the factored system: its inverse (up to 600 unknowns) or its L factor read twice, with
-the entries it has for this net (``DynamicSurface.system_solve_size``). Writes are counted once
+solve by the factored system: its inverse (up to 600 unknowns) or its L factor read twice (a band:
+values only; sparse: values and row indices), with the entries it has for this net
+(``DynamicSurface.system_solve_size``). Writes are counted once
 (a cache that allocates on write reads them too: up to a third more).
 
 The machine: streaming bandwidth (numpy copies, bytes read plus written) with the data in the
