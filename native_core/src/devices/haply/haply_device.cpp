@@ -217,7 +217,8 @@ DeviceCaps HaplyDevice::caps() const {
     // Haply publishes no force rating or stiffness for the Inverse3 that this project could find:
     // it gets the table's softest row until one is measured (the service's own force gate and
     // safety monitoring apply on top).
-    const DeviceLimits& row = limitsFor("Inverse3");
+    // (a copy: GCC 14 took the name's temporary string for what a reference would point into)
+    const DeviceLimits row = limitsFor("Inverse3");
     c.maxForce = settings_.mapping.sessionForce(settings_.maxForce > 0 ? settings_.maxForce : row.ratedForce);
     c.maxStiffness = settings_.mapping.sessionStiffness(passiveStiffnessFor(row, settings_.rateHz));
     return c;
