@@ -112,12 +112,16 @@ class Desktop:
                 return s
             if s["file_dialog"] is None and s["docs"][s["active"]]["file"]:
                 # (the Return took the completer's entry after all, its popup shown again after the
-                # check: saved under the folder's name; Save As again, as a user who sees it does)
+                # check: saved under the folder's name; Save As again, as a user who sees it does,
+                # into the main window: without a window manager the closed dialog leaves the
+                # keyboard nowhere, and the keys were lost)
+                self.focus()
                 self.shortcut("ctrl+shift+s", "Std_SaveAs")
                 self.wait_window("Save FreeCAD Document")
                 self.xdo("type", path)
                 s = self.wait(lambda s: s["file_dialog"] is not None, "the save-as dialog's field")
             if s["file_dialog"] is None:  # (an Escape closed the dialog, not the popup)
+                self.focus()
                 self.shortcut("ctrl+s", "Std_Save")
                 self.wait_window("Save FreeCAD Document")
                 self.xdo("type", path)
@@ -127,9 +131,15 @@ class Desktop:
                 self.xdo("key", "ctrl+a")
                 self.xdo("type", path)
                 self.wait(lambda s: field(s).get("text") == path, "the path typed again into the field")
+            # the path in the field and the completer's popup gone, and staying so over several of the
+            # observer's writes: the completer lists the folder in a thread and, under load, showed its
+            # popup again after a single check, and the Return took its entry (the folder's name)
             try:
-                self.wait(lambda s: not field(s).get("popup"), "the completer's popup gone", timeout=2.0, shot=False)
+                settled = self.wait_still(lambda s: (field(s).get("text"), bool(field(s).get("popup"))),
+                                          "the field and its completer settled", writes=8, timeout=6.0)
             except AssertionError:
+                settled = None
+            if settled != (path, False):
                 self.xdo("key", "Escape")
                 continue
             self.xdo("key", "Return")
