@@ -110,6 +110,7 @@ try:
     # A replay stroke through the session path the mouse and the devices use.
     ov = ctl.overlay(obj)
     ctl.set_display("shading")  # (painting left the stiffness map on)
+    shot("constraints")  # (before the stroke: under load the lifted free sheet hid the normal's jack)
     # (held for 3 s: the picture is taken while it is held, even when FreeCAD runs slowly under load)
     stroke = hs.ReplayDevice.stroke((0, 0, 0), (0, 0, 30.0), seconds=0.8, hold=3.0)
     ctl.start_session(stroke)
@@ -295,9 +296,11 @@ def test_overlay_commands_keys_and_pictures(tmp_path):
     def load(name):
         return mpimg.imread(os.path.join(SHOTS, f"overlay_{name}.png"))[..., :3]
 
-    stroke = load("stroke")
-    assert colour_fraction(stroke, lambda r, g, b: (r > 0.8) & (g < 0.25) & (b < 0.25)) > 1e-4  # red point jack
-    assert colour_fraction(stroke, lambda r, g, b: (b > 0.7) & (r < 0.3) & (g < 0.5)) > 1e-4  # blue normal jack
+    constraints, stroke = load("constraints"), load("stroke")
+    assert colour_fraction(constraints, lambda r, g, b: (r > 0.8) & (g < 0.25) & (b < 0.25)) > 1e-4  # red point jack
+    assert colour_fraction(constraints, lambda r, g, b: (b > 0.7) & (r < 0.3) & (g < 0.5)) > 1e-4  # blue normal jack
+    # during the stroke: the point's jack still drawn, and the cursor with its rope
+    assert colour_fraction(stroke, lambda r, g, b: (r > 0.8) & (g < 0.25) & (b < 0.25)) > 1e-4
     assert colour_fraction(stroke, lambda r, g, b: (r > 0.8) & (g > 0.7) & (b < 0.3)) > 1e-4  # yellow cursor/rope
     curvature = load("curvature")
     assert colour_fraction(curvature, lambda r, g, b: (g > 0.5) & (r < 0.2)) > 1e-3  # u in green
