@@ -18,12 +18,12 @@ TREE_SHOWN = ('<FCParamGroup Name="BaseApp"><FCParamGroup Name="MainWindow"><FCP
               '<FCBool Name="Std_ComboView" Value="1"/></FCParamGroup></FCParamGroup>')
 
 
-def tree_shown_desktop(tmp: str) -> Desktop:
-    """FreeCAD under Xvfb with the model tree shown."""
+def tree_shown_desktop(tmp: str, open_file: str | None = None) -> Desktop:
+    """FreeCAD under Xvfb with the model tree shown (and ``open_file`` opened)."""
     home = make_addon_home(os.path.join(tmp, "home"))
     with open(os.path.join(home, "user.cfg"), "w") as f:
         f.write(USER_CFG.format(style=STYLES["CAD"]).replace('<FCParamGroup Name="BaseApp">', TREE_SHOWN))
-    return Desktop(tmp, "CAD")
+    return Desktop(tmp, "CAD", open_file=open_file)
 
 
 @pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD's GUI")

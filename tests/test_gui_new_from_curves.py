@@ -12,6 +12,7 @@ import os
 import numpy as np
 import pytest
 from freecad_support import run_freecad_gui
+from test_gui_focus_keys import tree_shown_desktop
 from test_gui_follow_curve import click_in_view
 from test_gui_real_input import NEEDS, SHOTS, Desktop, sculpt, undo
 
@@ -109,5 +110,44 @@ def test_new_patch_from_curves_refuses_a_stray_curve_makes_a_patch_through_the_a
         d.shortcut("ctrl+z", "Std_Undo")
         d.wait(lambda s: not s["docs"][s["active"]]["sculpts"], "Undo of the patch: no patch")
         d.shot("network_undone")
+    finally:
+        d.close()
+
+
+#: One sketch drawing three sides of a square: a boundary that does not close.
+OPEN_LOOP = """
+import json, os
+import FreeCAD, FreeCADGui, Part
+V = FreeCAD.Vector
+doc = FreeCAD.newDocument("Open")
+sides = doc.addObject("Sketcher::SketchObject", "Sides")
+p = [V(-50, -40, 0), V(50, -40, 0), V(50, 40, 0), V(-50, 40, 0)]
+for k in range(3):
+    sides.addGeometry(Part.LineSegment(p[k], p[k + 1]), False)
+doc.recompute()
+doc.saveAs(PATH)
+json.dump({}, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_one_sketch_whose_sides_do_not_close_is_refused_saying_where(tmp_path):
+    """A sketch of three sides picked in the tree alone, New patch from curves: refused saying
+    which end meets no other (it said "1 curve selected", as for a single line), nothing made."""
+    path = str(tmp_path / "open.FCStd")
+    run_freecad_gui(f"PATH = {path!r}\n" + OPEN_LOOP, str(tmp_path))
+    d = tree_shown_desktop(str(tmp_path), open_file=path)
+    try:
+        item = d.wait(lambda s: "Sides" in s["tree"], "the sketch in the tree")["tree"]["Sides"]
+        d.xdo("mousemove", str(item[0]), str(item[1]), "click", "1")
+        d.wait(lambda s: [o for o, _ in s["selection"]] == ["Sides"], "the sketch selected in the tree")
+        d.click_button("NewFromCurves")
+        s = d.wait(lambda s: "New patch from curves: " in (s.get("report") or ""), "the refusal in the report view")
+        said = s["report"][s["report"].index("New patch from curves: "):]
+        assert "do not close" in said and "'Sides Edge" in said and "selected" not in said.split("\n")[0], said
+        assert "Traceback" not in s["report"], s["report"][-2000:]
+        assert not s["docs"][s["active"]]["sculpts"] and undo(s) == [], undo(s)
+        d.shot("network_open_refused")
     finally:
         d.close()

@@ -166,7 +166,10 @@ def _network_selection() -> tuple[list[tuple[str, Any]] | None, str]:
             return None, f"'{obj.Label}' has faces: pick its edges"
         elif len(shape.Wires) == 1 and len(shape.Wires[0].Edges) == len(shape.Edges):
             wire = shape.Wires[0]
-            if wire.isClosed() and len(shape.Edges) in (3, 4):  # (the boundary, drawn as one sketch)
+            # (the boundary drawn as one sketch; picked alone and open, its edges too: the network
+            # then says where it does not close, where "1 curve selected" left a designer guessing)
+            alone = len(Gui.Selection.getSelectionEx()) == 1
+            if (wire.isClosed() or alone) and len(shape.Edges) in (3, 4):
                 curves += [(f"({ref(obj)}, 'Edge{k + 1}')", (obj, f"Edge{k + 1}")) for k in range(len(shape.Edges))]
             else:
                 curves.append((ref(obj), obj))
