@@ -704,8 +704,8 @@ def make(dynamic: core.DynamicSurface, curve: Any, continuity: str, normal: Any,
     if distance > tolerance or degrees > G1_DEGREES:
         nu, nv = surface.controls
         raise NetTooCoarse(f"'{label}' {continuity}", f"with {nu} x {nv} controls it comes no closer than {distance:.3g} mm "
-                           f"(tolerance {tolerance:.3g} mm)" + (f" and {degrees:.3g} degrees off the normal"
-                                                                 if continuity == "G1" else ""),
+                           f"(tolerance {tolerance:.3g} mm)" + (f" and {degrees:.3g} degrees off the normal (tolerance "
+                                                                 f"{G1_DEGREES:g} degrees)" if continuity == "G1" else ""),
                            "use more controls, or a curve nearer the surface or smoother", uv)
     return record, moved, list(links) + made
 
@@ -762,8 +762,8 @@ def room_beside(surface: Any, uv: np.ndarray, held: list[int], links: list[tuple
         for master, weight in masters:
             if int(master) in column:
                 moves[slave, column[int(master)]] += weight
-    at = uv[np.linspace(0, len(uv) - 1, min(ROOM_POINTS, len(uv))).astype(int)]
-    tangent = np.gradient(uv, axis=0)[np.linspace(0, len(uv) - 1, len(at)).astype(int)]
+    sampled = np.linspace(0, len(uv) - 1, min(ROOM_POINTS, len(uv))).astype(int)
+    at, tangent = uv[sampled], np.gradient(uv, axis=0)[sampled]
     p, q = surface.degree
     knots = (np.asarray(surface.knots_u, float), np.asarray(surface.knots_v, float))
     width = np.empty_like(at)
