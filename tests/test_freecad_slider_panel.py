@@ -44,6 +44,20 @@ class TestSliderValues(DocumentTestCase):
         panel.drag(middle + 60.0, fine=False)  # Shift up: the knob goes back under the mouse
         self.assertEqual(panel.pending, coarse)
 
+    def test_a_fine_drag_counts_from_where_the_mouse_was_before_its_first_move(self):
+        """Pressed, Shift down, then the mouse's first move with Shift already 60 px on (Qt merges
+        moves under load): the knob moves a tenth of 60 px from the press. (It counted from the
+        first move it saw, and a fine drag under make test's load stopped 20 px short.)"""
+        obj = hs.make_sculpt(self.doc)
+        panel, middle = SliderPanel(), (TRACK[0] + TRACK[2]) / 2
+        self.assertTrue(panel.press(middle, 15.0, {"stiffness": TRACK}, obj))
+        at_press = panel.pending
+        panel.drag(middle + 60.0)
+        coarse = panel.pending
+        self.assertTrue(panel.press(middle, 15.0, {"stiffness": TRACK}, obj))
+        panel.drag(middle + 60.0, fine=True)
+        self.assertAlmostEqual(math.log10(panel.pending / at_press), math.log10(coarse / at_press) / FINE, delta=0.01)
+
     def test_a_painted_map_is_scaled_by_its_slider_not_wiped(self):
         """The slider shows a map's mean; its edit of a painted map is scale_map (set_uniform wiped
         the painting)."""

@@ -89,6 +89,7 @@ class SliderPanel:
         self._scale = 1.0  # the held sculpt's tool scale
         self._knob = 0.0  # the held knob's position (0..1)
         self._fine_from: tuple[float, float] | None = None  # (mouse x, knob) where Shift went down
+        self._last_x: float | None = None  # the mouse's last column seen in this drag
 
     # --- values -----------------------------------------------------------------------------------
     @staticmethod
@@ -158,6 +159,7 @@ class SliderPanel:
         if name is None:
             return False
         self.held, self._track, self._scale, self._fine_from = name, tracks[name], _scale(obj), None
+        self._last_x = None
         self.drag(x)
         return True
 
@@ -169,12 +171,15 @@ class SliderPanel:
         x0, _, x1, _ = self._track
         width = max(x1 - x0, 1.0)
         if fine:
+            # (from the last column seen without Shift: the move that came with Shift may already
+            # be 20 px on, Qt having merged the moves in between under load)
             if self._fine_from is None:
-                self._fine_from = (x, self._knob)
+                self._fine_from = (x if self._last_x is None else self._last_x, self._knob)
             f = self._fine_from[1] + (x - self._fine_from[0]) / width / FINE
         else:
             self._fine_from, f = None, (x - x0) / width
         self._knob = float(np.clip(f, 0.0, 1.0))
+        self._last_x = x
         self.pending = rounded(self.from_fraction(self.held, self._knob, self._scale), 3 if fine else 2)
 
     def release(self, obj: Any) -> bool:
