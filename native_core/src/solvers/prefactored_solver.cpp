@@ -45,8 +45,10 @@ void PrefactoredSolver::factor(const Eigen::SparseMatrix<double>& m, const char*
             ready_ = true;
             return;
         }
+        ldlt_.factorize(m);  // (on the ordering analysedEntries made)
+    } else {
+        ldlt_.compute(m);
     }
-    ldlt_.compute(m);
     if (ldlt_.info() != Eigen::Success)
         throw std::runtime_error(std::string(what) + ": factorisation failed (matrix not positive definite)");
     const Eigen::VectorXd D = ldlt_.vectorD();
