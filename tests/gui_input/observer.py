@@ -373,11 +373,11 @@ def _console_panels_and_questions():
     the view, FreeCAD issue 21141; none before 1.0), and the buttons of a question FreeCAD shows (a
     QMessageBox: "Save all changes...?") by text, at their centres in screen pixels, the end of
     the report view's text (REPORT_CHARS), and what a shown file dialog's file name field holds
-    (else None) with whether its completer's popup list is shown."""
-    console, panels, buttons, report, stack = None, [], {}, "", [(Gui.getMainWindow(), False)]
-    file_name = None
+    (else None) with whether its completer's popup list is shown and where its buttons are."""
+    console, panels, buttons, report, stack = None, [], {}, "", [(Gui.getMainWindow(), False, False)]
+    file_name, file_buttons = None, {}
     while stack:
-        w, in_box = stack.pop()
+        w, in_box, in_files = stack.pop()
         name = w.metaObject().className()
         if w.objectName() == "fileNameEdit" and w.inherits("QLineEdit") and w.isVisible():
             # (Qt's own file dialog names its field so; the completer's popup is a window of its own)
@@ -390,10 +390,14 @@ def _console_panels_and_questions():
         if console is None and name == "Gui::PythonConsole" and w.isVisible():
             console = _rect(w)
         in_box = in_box or (w.inherits("QMessageBox") and w.isVisible())
-        if in_box and w.inherits("QPushButton") and w.isVisible() and w.text():
+        in_files = in_files or (w.inherits("QFileDialog") and w.isVisible())
+        if (in_box or in_files) and w.inherits("QPushButton") and w.isVisible() and w.text():
             centre, ratio = w.mapToGlobal(w.rect().center()), w.devicePixelRatioF()
-            buttons[w.text().replace("&", "")] = [round(centre.x() * ratio), round(centre.y() * ratio)]
-        stack.extend((c, in_box) for c in w.children() if c.isWidgetType())
+            at = [round(centre.x() * ratio), round(centre.y() * ratio)]
+            (buttons if in_box else file_buttons)[w.text().replace("&", "")] = at
+        stack.extend((c, in_box, in_files) for c in w.children() if c.isWidgetType())
+    if file_name is not None:
+        file_name["buttons"] = file_buttons  # (the file dialog's own: Save, Cancel)
     return console, panels, buttons, report, file_name
 
 
