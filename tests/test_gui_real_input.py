@@ -224,10 +224,9 @@ class Desktop:
         with open(self.log.name, errors="replace") as f:
             return f.read()[-chars:]
 
-    def wait_still(self, value, what: str, writes: int = 5, timeout: float = 20.0):
-        """``value(state)`` once it has stayed the same over ``writes`` of the observer's writes in a
-        row (a widget's place while its panel still lays itself out is not where a click finds it)."""
-        end, last, same, stamp = time.monotonic() + timeout, None, 0, None
+    def fresh_states(self, timeout: float):
+        """Each state the observer writes from now on, once, for ``timeout`` seconds."""
+        end, stamp = time.monotonic() + timeout, None
         while time.monotonic() < end:
             try:
                 now = os.stat(self.state_file).st_mtime_ns
@@ -235,15 +234,22 @@ class Desktop:
                 now = None
             if now is not None and now != stamp:
                 stamp = now
-                try:
-                    current = value(self.state())
-                except (KeyError, IndexError):
-                    current = None
-                same = same + 1 if current is not None and current == last else 0
-                last = current
-                if same >= writes:
-                    return current
+                yield self.state()
             time.sleep(0.05)
+
+    def wait_still(self, value, what: str, writes: int = 5, timeout: float = 20.0):
+        """``value(state)`` once it has stayed the same over ``writes`` of the observer's writes in a
+        row (a widget's place while its panel still lays itself out is not where a click finds it)."""
+        last, same = None, 0
+        for s in self.fresh_states(timeout):
+            try:
+                current = value(s)
+            except (KeyError, IndexError):
+                current = None
+            same = same + 1 if current is not None and current == last else 0
+            last = current
+            if same >= writes:
+                return current
         self.shot("timeout")
         raise AssertionError(f"timed out waiting for {what} to stay put; last: {last}")
 
@@ -357,22 +363,14 @@ class Desktop:
         with entry ``name``, ``writes`` times in a row. (The observer writes from FreeCAD's GUI
         thread: while a command the click started runs, it writes nothing, and a state that
         stays open then is an old one.)"""
-        end, stamp, seen = time.monotonic() + timeout, None, 0
-        while time.monotonic() < end:
-            try:
-                now = os.stat(self.state_file).st_mtime_ns
-            except OSError:
-                now = None
-            if now is not None and now != stamp:
-                stamp = now
-                s = self.state()
-                shown = s.get("toolbars", {}).get("open", {})
-                if s and group not in shown:
-                    return False
-                seen = seen + 1 if s and name in shown.get(group, {}) else 0
-                if seen >= writes:
-                    return True
-            time.sleep(0.05)
+        seen = 0
+        for s in self.fresh_states(timeout):
+            shown = s.get("toolbars", {}).get("open", {})
+            if s and group not in shown:
+                return False
+            seen = seen + 1 if s and name in shown.get(group, {}) else 0
+            if seen >= writes:
+                return True
         self.shot("timeout")
         raise AssertionError(f"timed out waiting for the drop-down {group} to close or stay open; "
                              f"{self.alive_or_exit()}")
