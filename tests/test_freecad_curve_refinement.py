@@ -216,6 +216,30 @@ class TestNoFoldBesideACurve(SolidChecks):
         self.assertLessEqual(curve_distance(obj.Shape.Faces[0], arc), TOLERANCE)
 
 
+class TestCurveAcrossEarlierWork(SolidChecks):
+    def test_a_line_across_a_bump_keeps_the_bump_beside_it(self):
+        """A clamped 8 x 8 clay patch with a bump pulled up at its middle, and a line at z = 0 along
+        it: on the crest, 40 mm and 20 mm off. The least pole move of the 8 x 8 net held the line
+        and took the bump with it: on the crest its flanks 20 mm beside fell from 2.9 to 0.5 mm; 40 mm
+        off, its crest fell from 4.4 to 2.3 mm (a fresh-eyes GUI session: 10.1 to 6.7 mm). The net is
+        refined until the pull stays near the line: heights 20 mm and more beside it kept."""
+        def height(obj, x):
+            hits = obj.Shape.Faces[0].section(Part.LineSegment(V(x, 0, -100), V(x, 0, 100)).toShape()).Vertexes
+            return max(v.Z for v in hits)
+
+        for off, kept in ((0.0, (-20.0, 20.0)), (40.0, (-20.0, 0.0, 20.0)), (20.0, (-20.0, 0.0))):
+            with self.subTest(line_x=off):
+                obj = hs.make_sculpt(self.doc, controls=(8, 8), edges="held", material="clay", name="Bump")
+                pull(obj, (0.0, 0.0, 0.0), (0.0, 0.0, 10.0))
+                before = {x: height(obj, x) for x in kept}
+                self.assertGreater(before[-20.0], 2.0)
+                line = Part.LineSegment(V(off, -45, 0), V(off, 45, 0)).toShape()
+                hs.add_curve_constraint(obj, line)
+                self.assertLessEqual(curve_distance(obj.Shape.Faces[0], line), TOLERANCE)
+                self.assertGreater(np.prod(obj.Proxy.live.last_curve["refined_to"]), 64)
+                for x, was in before.items():
+                    self.assertGreater(height(obj, x), 0.85 * was, f"the bump's height at x = {x:g} mm")
+
 
 def obj_seams(obj):
     """The sculpted solid's seam report (its edges with the base's faces)."""

@@ -66,8 +66,11 @@ class NetTooCoarse(ValueError):
         super().__init__(f"curve: the surface cannot follow {curve}: {why}; {advice}")
         #: The curve named (its label and continuity), what keeps the net from it, its preimage.
         self.curve, self.why, self.uv = curve, why, uv
-        #: The net holds the curve but leaves no room to move beside it (curve_follow refines it too).
-        self.roomless = False
+        #: The net holds the curve, but a finer one would do better beside it (room to move, a pull
+        #: that stays local): curve_follow refines it too, and holds it on this one where none does.
+        self.held_anyway = False
+        #: How far the pull onto it reaches beside it (reach_beside), where that is what a finer net is for.
+        self.reach: float | None = None
 
 
 @dataclass
@@ -789,6 +792,62 @@ def room_beside(surface: Any, uv: np.ndarray, held: list[int], links: list[tuple
     if not inside.any():
         return 1.0
     return float((np.abs(basis[inside] @ moves).sum(axis=1) / without[inside]).min())
+
+
+#: A pull onto a curve stays local when, far beside the curve, it moves the surface at most this
+#: share of the largest pull at the curve (or the tolerance, if more). Far: two knot spans and more
+#: away (the least pole move leaves a constant share there on every net, measured 0.045 at two
+#: spans and 0.55 at one, so a finer net pulls over less of the surface), and REACH_PER_PULL times
+#: the pull in mm or REACH_SIZE_SHARE of the surface's size, if more, whatever the spans (a line
+#: along a bump's crest flattened its flanks one 20 mm span beside it).
+REACH_SHARE = 0.1
+#: A finer net is kept for its reach only when it brings the reach down to this share of the best
+#: coarser net's: where the curve encloses the far surface (a U over a flat patch lifts its inside
+#: on every net), refining does not help and is not done.
+REACH_GAIN = 0.7
+REACH_PER_PULL = 4.0
+REACH_SIZE_SHARE = 0.1
+#: Two spans narrower than this many times the pull are not far: a pull steeper than that is a
+#: trench any net makes, and refining for it would not end.
+REACH_WIDTH_PER_PULL = 1.5
+#: Samples per knot span (each direction) where the reach is measured, and at most in all.
+REACH_SAMPLES_PER_SPAN, REACH_SAMPLES_MAX = 4, 64
+
+
+def reach_beside(surface: Any, uv: np.ndarray, before: np.ndarray, moved: np.ndarray, tolerance: float,
+                 size: float) -> float:
+    """How far the pull from poles ``before`` to ``moved`` onto a curve whose preimage is ``uv``
+    reaches beside the curve: the largest move of the surface far from it (see REACH_SHARE; ``size``:
+    the surface's), as a share of the largest move at the curve (0 where nothing far moves more than
+    ``tolerance``). More than REACH_SHARE: the pull takes earlier work far beside the curve with it
+    (a bump flattened by a line across it), and a finer net keeps it local."""
+    delta = np.asarray(moved, float).reshape(-1, 3) - np.asarray(before, float).reshape(-1, 3)
+    uv = uv[np.linspace(0, len(uv) - 1, min(len(uv), SAMPLES)).astype(int)]
+    on = rows(surface, uv)
+    pull = np.linalg.norm(on.apply(on.s, delta), axis=1).max(initial=0.0)
+    if pull <= tolerance:
+        return 0.0
+    p, q = surface.degree
+    breaks = [np.unique(np.asarray(k, float)[d:len(k) - d]) for k, d in ((surface.knots_u, p), (surface.knots_v, q))]
+    counts = [min(REACH_SAMPLES_MAX, REACH_SAMPLES_PER_SPAN * (len(b) - 1) + 1) for b in breaks]
+    gu, gv = np.meshgrid(np.linspace(breaks[0][0], breaks[0][-1], counts[0]),
+                         np.linspace(breaks[1][0], breaks[1][-1], counts[1]), indexing="ij")
+    grid = np.column_stack([gu.ravel(), gv.ravel()])
+
+    def in_spans(at: np.ndarray) -> np.ndarray:  # (parameters counted in knot spans)
+        return np.column_stack([np.interp(at[:, d], breaks[d], np.arange(len(breaks[d]))) for d in (0, 1)])
+
+    spans_away = np.min(np.linalg.norm(in_spans(grid)[:, None, :] - in_spans(uv)[None, :, :], axis=2), axis=1)
+    there = rows(surface, grid)
+    on_curve = on.apply(on.s, np.asarray(moved, float).reshape(-1, 3))
+    was = there.apply(there.s, np.asarray(before, float).reshape(-1, 3))
+    mm_away = np.min(np.linalg.norm(was[:, None, :] - on_curve[None, :, :], axis=2), axis=1)
+    far = ((spans_away >= 2.0) & (mm_away >= REACH_WIDTH_PER_PULL * pull)) | \
+        (mm_away >= max(REACH_PER_PULL * pull, REACH_SIZE_SHARE * size))
+    if not far.any():
+        return 0.0
+    reach = np.linalg.norm(there.apply(there.s, delta)[far], axis=1).max()
+    return float(reach / pull) if reach > tolerance else 0.0
 
 
 def refinement_knots(surface: Any, uv: np.ndarray, room: tuple[int, int]) -> tuple[list[float], list[float]]:

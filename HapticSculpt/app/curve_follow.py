@@ -59,10 +59,10 @@ def add_curve_constraint(obj: Any, curve: Any, continuity: str = "G0", normal: A
         _follow_refined(sculpt, curve, continuity, normal, cid, records, tolerance, coarse)
         return cid
     try:
-        _check_room(surface, record, held, all_links)
-    except cc.NetTooCoarse as roomless:
+        _check_beside(surface, record, held, all_links, moved, tolerance)
+    except cc.NetTooCoarse as better:
         try:
-            _follow_refined(sculpt, curve, continuity, normal, cid, records, tolerance, roomless)
+            _follow_refined(sculpt, curve, continuity, normal, cid, records, tolerance, better)
             return cid
         except ValueError:
             pass  # (no finer net can be made: held on this one, as it is)
@@ -80,15 +80,25 @@ def add_curve_constraint(obj: Any, curve: Any, continuity: str = "G0", normal: A
     return cid
 
 
-def _check_room(dynamic: Any, record: cc.CurveConstraint, held: list[int], links: list[Any]) -> None:
-    """NetTooCoarse (``roomless``) where the curve's conditions leave a pull beside it no room to
-    move the surface (cc.room_beside): refined like a net that cannot reach the curve, and held on
-    the finest net there is where none gives room."""
+def _check_beside(dynamic: Any, record: cc.CurveConstraint, held: list[int], links: list[Any], moved: np.ndarray,
+                  tolerance: float) -> None:
+    """NetTooCoarse (``held_anyway``) where the net holds the curve but a finer one would do
+    better beside it: where its conditions leave a pull beside it no room to move the surface
+    (cc.room_beside), or where the pull onto it (``dynamic``'s poles to ``moved``) takes the surface
+    far beside it along (cc.reach_beside: a line across a bump flattened the bump). Refined like a
+    net that cannot reach the curve, and held on the finest net there is where none does better."""
+    reach = None
     if cc.room_beside(dynamic.surface, record.uv, held, links) < cc.ROOM_SHARE:
-        coarse = cc.NetTooCoarse(f"'{record.label}' {record.continuity}", "it leaves the surface no room to move beside "
-                                 "it", "use more controls", record.uv)
-        coarse.roomless = True
-        raise coarse
+        why = "it leaves the surface no room to move beside it"
+    else:
+        reach = cc.reach_beside(dynamic.surface, record.uv, np.asarray(dynamic.poles, float), moved, tolerance,
+                                dynamic.size)
+        if reach <= cc.REACH_SHARE:
+            return
+        why = "the pull onto it moves the surface far beside it"
+    coarse = cc.NetTooCoarse(f"'{record.label}' {record.continuity}", why, "use more controls", record.uv)
+    coarse.held_anyway, coarse.reach = True, reach
+    raise coarse
 
 
 def _follow_refined(sculpt: Any, curve: Any, continuity: str, normal: Any, cid: int,
@@ -104,14 +114,15 @@ def _follow_refined(sculpt: Any, curve: Any, continuity: str, normal: Any, cid: 
     start = work.surface
     mesh = tuple(sculpt_state.capture(work).settings["mesh"])
     limit = (max(mesh[0] // 2, start.controls[0]), max(mesh[1] // 2, start.controls[1]))
-    roomless = None  # (the last finer net that held the curve with no room beside it, and what held it)
+    held_anyway = None  # (the last finer net that held the curve, though not well beside it, and what held it)
+    reach = coarse.reach  # (the best reach so far: refining for reach goes on only while it helps)
     while True:
         controls = tuple(work.surface.controls)
         room = (limit[0] - controls[0], limit[1] - controls[1])
         knots = cc.refinement_knots(work.surface, coarse.uv, room)
         made = refined_work(sculpt, work, knots) if knots[0] or knots[1] else None
-        if made is None and roomless is not None:  # (held, with what room the finest net has)
-            finer, held, walls, record, moved, all_links = roomless
+        if made is None and held_anyway is not None:  # (held as well as the finest net does beside it)
+            finer, held, walls, record, moved, all_links = held_anyway
             break
         if made is None:
             first = tuple(start.controls)
@@ -127,11 +138,17 @@ def _follow_refined(sculpt: Any, curve: Any, continuity: str, normal: Any, cid: 
         finer, held, links, walls = made
         try:
             record, moved, all_links = cc.make(finer, curve, continuity, normal, cid, held, links, records, tolerance)
-            _check_room(finer, record, held, all_links)
+            _check_beside(finer, record, held, all_links, moved, tolerance)
             break
         except cc.NetTooCoarse as again:
-            if again.roomless:
-                roomless = (finer, held, walls, record, moved, all_links)
+            if again.reach is not None and reach is not None and again.reach > cc.REACH_GAIN * reach:
+                if held_anyway is None:  # (the coarser net given holds it as well: held there)
+                    raise ValueError(f"curve: {again.curve}: a finer net reaches no less far beside it") from None
+                finer, held, walls, record, moved, all_links = held_anyway
+                break
+            if again.held_anyway:
+                held_anyway = (finer, held, walls, record, moved, all_links)
+                reach = again.reach
             finer.hold_poles(held, links)
             if walls:
                 finer.set_walls(walls)
