@@ -549,3 +549,67 @@ TEST(HapticRuntime, ASimulationBehindRealTimeCatchesUpWithDoubleSteps) {
         EXPECT_GT(stroke.poles.col(2).maxCoeff(), 0.0) << catchUp;
     }
 }
+
+TEST(ExternalDevice, ABurstIsPassedOnInOrderAndAGrabHeldItsShortestTime) {
+    // A GUI thread busy drawing delivers a whole drag at once: each sample is passed on in turn
+    // (hovers merged into the newest), and the release only once the grab has lasted kShortestGrab.
+    ExternalDevice dev;
+    DeviceSample s;
+    s.valid = true;
+    for (double x : {1.0, 2.0, 3.0}) {  // hovers: only the newest counts
+        s.position = Vec3(x, 0, 0);
+        dev.push(s);
+    }
+    s.buttons = 1;
+    for (double z : {0.0, 5.0, 10.0}) {
+        s.position = Vec3(3, 0, z);
+        dev.push(s);
+    }
+    s.buttons = 0;
+    dev.push(s);
+    DeviceSample out;
+    std::vector<std::pair<double, std::uint32_t>> seen;
+    double t = 1.0;
+    for (int tick = 0; tick < 400; ++tick, t += 1e-3) {
+        ASSERT_TRUE(dev.sample(t, out));
+        if (seen.empty() || seen.back() != std::pair{out.position.z(), out.buttons}) seen.emplace_back(out.position.z(), out.buttons);
+        if (tick == 0) {
+            EXPECT_EQ(out.position.x(), 3.0);
+        }
+        if (tick >= 1 && tick < static_cast<int>(ExternalDevice::kShortestGrab / 1e-3)) {
+            EXPECT_EQ(out.buttons, 1u) << tick;  // (from where the button went down, for the shortest grab)
+        }
+    }
+    const std::vector<std::pair<double, std::uint32_t>> expected{{0.0, 0u}, {0.0, 1u}, {5.0, 1u}, {10.0, 1u}, {10.0, 0u}};
+    EXPECT_EQ(seen, expected);
+}
+
+TEST(HapticRuntime, AWholeDragDeliveredInOneBurstIsStillAStroke) {
+    // The same burst into a resting (idle) session: the device kept only the newest sample, the
+    // release, and the stroke was lost (a mouse session under load on FreeCAD 1.1).
+    auto s = patch(8, 24);
+    auto dev = std::make_shared<ExternalDevice>();
+    DeviceSample d;
+    d.valid = true;
+    d.position = Vec3(20, 0, 0);
+    dev->push(d);
+    HapticRuntime rt(s, dev, RuntimeSettings{});
+    rt.start();
+    ASSERT_TRUE(waitFor([&] {  // at rest: the simulation idles
+        const auto steps = rt.status().simSteps;
+        std::this_thread::sleep_for(std::chrono::milliseconds(60));
+        return rt.status().simSteps == steps;
+    }));
+    d.buttons = 1;
+    for (int i = 0; i <= 5; ++i) {
+        d.position = Vec3(20, 0, 3.0 * i);
+        dev->push(d);
+    }
+    d.buttons = 0;
+    dev->push(d);
+    StrokeSnapshot stroke;
+    ASSERT_TRUE(waitFor([&] { return rt.takeStroke(stroke); }));
+    rt.stop();
+    EXPECT_EQ(rt.status().error, "");
+    EXPECT_GT(stroke.poles.col(2).maxCoeff(), 0.5);
+}

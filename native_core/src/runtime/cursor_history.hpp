@@ -81,6 +81,29 @@ public:
         }
     }
 
+    /// Reader: the earliest sample after time t whose button 1 is down (a grab that began while the
+    /// reader was not looking), false if none is kept.
+    bool firstGrabAfter(double t, DeviceSample& out) const {
+        for (;;) {
+            const std::uint64_t head = head_.load(std::memory_order_acquire);
+            const std::uint64_t oldest = head > kSlots - 1 ? head - (kSlots - 1) : 0;
+            bool found = false, torn = false;
+            Sample s;
+            for (std::uint64_t i = head; i > oldest;) {
+                if (!read(--i, s)) {
+                    torn = true;
+                    break;
+                }
+                if (s.t <= t) break;
+                if (s.s.buttons & 1u) {
+                    out = s.s;
+                    found = true;
+                }
+            }
+            if (!torn) return found;
+        }
+    }
+
 private:
     struct Slot {
         std::atomic<std::uint64_t> seq{0};

@@ -370,6 +370,8 @@ void HapticRuntime::simLoop() {
     Reaction reaction;
     std::uint64_t sequence = 0;
     bool doubleSteps = settings_.catchUp;
+    DeviceSample grabbedWhileIdle;  // (the sample a grab began with while the loop idled)
+    bool woken = false;
     try {
         while (!stopRequested_.load(std::memory_order_acquire)) {
             // Keep pace with real time: step when the interval it represents has passed.
@@ -390,8 +392,10 @@ void HapticRuntime::simLoop() {
                 simTime += drop;
             }
             // The hand where it was at the step's end (cursor_history.hpp), not where it is now.
-            DeviceSample hand;
-            const bool fresh = cursor_.at(simTime + h, hand) && !sameSample(hand, taken_);
+            DeviceSample hand = grabbedWhileIdle;
+            const bool read = woken || cursor_.at(simTime + h, hand);
+            const bool fresh = read && !sameSample(hand, taken_);
+            woken = false;
             if (fresh) {
                 taken_ = hand;
                 button = (hand.buttons & 1u) != 0;
@@ -409,8 +413,12 @@ void HapticRuntime::simLoop() {
                 // reading the device, at idleRate) and look again two of its samples later: a
                 // grab starts within 3/idleRate (30 ms, inside the tool's 50 ms ramp), and each
                 // wake costs ~50 us of CPU on a virtual machine; simulated time follows the clock.
+                // A grab that began meanwhile starts where the button went down, not where the
+                // hand is now: its first step takes that sample.
                 simIdle_.store(true, std::memory_order_relaxed);
+                const double seen = simTime + h;
                 std::this_thread::sleep_for(idleLook);
+                woken = cursor_.firstGrabAfter(seen, grabbedWhileIdle);
                 simTime = std::max(simTime, now() - dt);
                 continue;
             }
