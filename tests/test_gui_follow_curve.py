@@ -310,3 +310,57 @@ def test_follow_curve_refines_a_coarse_net_says_so_and_holds_through_a_stroke_be
         d.shot("follow_refused")
     finally:
         d.close()
+
+
+FOLLOW_IN_SESSION_SCRIPT = """
+import json, os, time, traceback
+import FreeCAD, FreeCADGui as Gui, Part
+out = {}
+def pump(seconds, until=lambda: False):
+    end = time.monotonic() + seconds
+    while time.monotonic() < end and not until():
+        Gui.updateGui()
+        time.sleep(0.02)
+try:
+    Gui.activateWorkbench("HapticSculptWorkbench")
+    import HapticSculpt as hs
+    from HapticSculpt.gui.workbench import controller
+    doc = FreeCAD.newDocument("InSession")
+    obj = hs.make_sculpt(doc, controls=(8, 8))
+    line = doc.addObject("Part::Feature", "Line")
+    line.Shape = Part.LineSegment(FreeCAD.Vector(-30, 0, 0), FreeCAD.Vector(30, 0, 0)).toShape()
+    doc.recompute()
+    Gui.Selection.addSelection(obj)
+    Gui.runCommand("HapticSculpt_Session")
+    pump(10, lambda: controller().session is not None)
+    echoed = []
+    do = Gui.doCommand
+    Gui.doCommand = lambda code: (echoed.append(code), do(code))[1]
+    Gui.Selection.clearSelection()
+    Gui.Selection.addSelection(line)  # (picked in the tree: the view's clicks are the session's)
+    undo = list(doc.UndoNames)
+    Gui.runCommand("HapticSculpt_FollowCurve")
+    pump(1.0)
+    Gui.doCommand = do
+    out["echoed"] = echoed
+    out["hud"] = [o.status_text for o in controller().overlays_of(obj)]
+    out["undo_same"] = list(doc.UndoNames) == undo
+    out["curves"] = len(hs.curve_constraints_of(obj))
+    out["session"] = controller().session is not None
+except Exception:
+    out["error"] = traceback.format_exc()
+json.dump(out, open({answer}, "w"))
+os._exit(0)
+"""
+
+
+@pytest.mark.skipif(not all(NEEDS), reason="needs Xvfb, xdotool, ImageMagick and FreeCAD (make deps installs them)")
+def test_follow_curve_during_a_session_is_refused_in_the_hud_and_not_echoed(tmp_path):
+    """A fresh-eyes GUI session: Follow curve pressed while the session sculpted was refused in the
+    report view only (the designer, device in hand, looks at the HUD), and its call was echoed to
+    the console as if it had been made."""
+    out = run_freecad_gui(FOLLOW_IN_SESSION_SCRIPT, str(tmp_path))
+    assert "error" not in out, out.get("error")
+    assert out["session"] and out["undo_same"] and out["curves"] == 0
+    assert not any("add_curve_constraint" in code for code in out["echoed"]), out["echoed"]
+    assert any("refused" in text and "stop the sculpting session" in text for text in out["hud"]), out["hud"]

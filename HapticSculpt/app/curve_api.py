@@ -41,7 +41,9 @@ def _writer(sculpt: Any, records: list[cc.CurveConstraint]) -> Any:
     return write
 
 
-def _not_in_session(sculpt: Any, what: str) -> Any:
+def not_in_session(sculpt: Any, what: str) -> Any:
+    """``sculpt``'s live state; RuntimeError saying to stop the session first where one sculpts it
+    (``what``: the change refused, "adding a curve constraint")."""
     live = sculpt.Proxy.live
     if live.session is not None:
         raise RuntimeError(f"{sculpt.Label}: stop the sculpting session before {what}")
@@ -103,7 +105,7 @@ def remove_curve_constraint(obj: Any, cid: int) -> None:
     """Removes curve constraint ``cid``: its poles are free again, the other curves still hold.
     One undo step; ValueError for an id it does not have."""
     sculpt = _sculpt(obj)
-    live = _not_in_session(sculpt, "removing a curve constraint")
+    live = not_in_session(sculpt, "removing a curve constraint")
     records = records_of(sculpt)
     kept = [r for r in records if r.id != cid]
     if len(kept) == len(records):

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from . import curve_constraint as cc
-from .curve_api import _not_in_session, _sculpt, _writer, base_links
+from .curve_api import _sculpt, _writer, base_links, not_in_session
 
 #: How near a followed curve the surface passes by default (mm), everywhere along it.
 DEFAULT_TOLERANCE = 0.001
@@ -43,7 +43,7 @@ def add_curve_constraint(obj: Any, curve: Any, continuity: str = "G0", normal: A
     elif isinstance(tolerance, bool) or not isinstance(tolerance, (int, float)) or not 1e-9 <= tolerance <= 1e3:
         raise ValueError(f"tolerance: a length in mm from 1e-9 to 1000, got {tolerance!r}")
     tolerance = float(tolerance)
-    live = _not_in_session(sculpt, "adding a curve constraint")
+    live = not_in_session(sculpt, "adding a curve constraint")
     surface = live.surface
     records = cc.records_of(sculpt)
     cid = max([r.id for r in records], default=cc.FIRST_ID - 1) + 1

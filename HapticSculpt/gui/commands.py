@@ -587,7 +587,7 @@ class FollowCurve:
         return _curve_selection() is not None
 
     def Activated(self) -> None:
-        from ..app.curve_api import constraint_along
+        from ..app.curve_api import constraint_along, not_in_session
         from ..app.sculpted_solid import sculpt_for
         from .echo import ref, run_echoed
         picked = _curve_selection()
@@ -595,9 +595,12 @@ class FollowCurve:
             return
         target, code, curve, label = picked
         try:
+            # (refused before its call is echoed: a console line for a call that did nothing read
+            # as done, and a session's designer looks at the HUD, where refuse() says it too)
+            not_in_session(sculpt_for(target), f"following {label}")
             now = constraint_along(target, curve)
-        except (TypeError, ValueError) as exc:  # (a sketch of several wires: which one is meant?)
-            FreeCAD.Console.PrintWarning(f"HapticSculpt: {target.Label} cannot follow {label}: {exc}\n")
+        except (TypeError, ValueError, RuntimeError) as exc:  # (a sketch of several wires: which one is meant?)
+            refuse(f"{target.Label} cannot follow {label}", exc)
             return
         if now is None:
             call = f"HapticSculpt.add_curve_constraint({ref(target)}, {code})"
@@ -608,7 +611,7 @@ class FollowCurve:
         try:
             run_echoed(call)
         except Exception as exc:  # noqa: BLE001 - doCommand raises what the call raised, as its own type
-            FreeCAD.Console.PrintWarning(f"HapticSculpt: {target.Label} cannot follow it: {exc}\n")
+            refuse(f"{target.Label} cannot follow {label}", exc)
             return
         sculpt = sculpt_for(target)
         _ctl().refresh(sculpt)  # (the curve drawn on the surface)
