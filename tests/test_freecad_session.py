@@ -296,6 +296,24 @@ class TestStop(DocumentTestCase):
         self.assertEqual(obj.Strokes, 1)
 
 
+class TestStrokeThatMovesNothing(DocumentTestCase):
+    def test_a_stroke_that_moves_nothing_adds_no_undo_step(self):
+        """A flatten stroke over a flat sheet moves it by 1e-12 mm: it added a "Sculpt stroke" undo
+        step, and the document was marked modified, for nothing anyone can see (a fresh-eyes GUI
+        session). The HUD still hears of it: the stroke moved it 0 mm."""
+        obj = hs.make_sculpt(self.doc, material="clay")
+        self.doc.recompute()
+        steps, poles = list(self.doc.UndoNames), np.array(obj.Poles)
+        session = hs.Session().start(obj, hs.ReplayDevice.stroke((0, 0, 0), (10, 0, 0), seconds=0.3, hold=0.2),
+                                     tool="flatten", stop_when_finished=True)
+        self.assertTrue(session.wait(timeout=20))
+        session.stop()
+        self.assertEqual(list(self.doc.UndoNames), steps)
+        self.assertEqual((obj.Strokes, session.last_stroke["moved_mm"]), (0, 0.0))
+        self.assertTrue(np.array_equal(np.array(obj.Poles), poles))
+        self.assertEqual(obj.State, ["Up-to-date"])
+
+
 class TestDroppedStroke(DocumentTestCase):
     """Session.drop_stroke (Esc or Undo during a drag in the GUI): the stroke held is not committed
     and the surface goes back to the document's state; the strokes around it are kept."""

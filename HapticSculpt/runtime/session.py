@@ -443,6 +443,11 @@ class Session:
                 title = f"Paint {event['painted']}" if event["painted"] else "Sculpt stroke"
                 state, strokes = obj.Proxy.live.stored(), 1
             before = self._console if self._console is not None else obj.Proxy.live.stored()
+            if strokes and not event["painted"] and not (final is not None and k == last) and \
+                    _poles_kept(before, _with_event(state, event)):
+                # (a grab that moved nothing: no undo step, the document not marked modified)
+                self.last_stroke = self._stroke_facts(obj, obj.Proxy.live.stored(), 0.0)
+                continue
             live.reset_shape()  # (so the transaction records the stored face as what Undo goes back to)
             doc = obj.Document
             with transaction(doc, title):
@@ -453,10 +458,7 @@ class Session:
                     after, was = now.arrays["Poles"], before.arrays["Poles"]
                     if not event["painted"] and after.shape == was.shape:
                         moved = np.linalg.norm((after - was).reshape(-1, 3), axis=1)
-                        self.last_stroke = {"moved_mm": float(moved.max(initial=0.0)), "pulled_mm": self._pulled,
-                                            "stiffness": float(np.mean(now.arrays["StiffnessMap"])),
-                                            "held": float(len(now.settings.get("held_poles", []))),
-                                            "curves": float(len(curve_constraint.records_of(obj)))}
+                        self.last_stroke = self._stroke_facts(obj, now, float(moved.max(initial=0.0)))
                 told = bool(strokes) or _differs(before, obj.Proxy.live.stored())  # (else the edit's own call gives it)
                 if told:
                     _tell_commit(obj, before, title, strokes)
@@ -466,6 +468,13 @@ class Session:
             self._committed = True
             n += strokes
         return n
+
+    def _stroke_facts(self, obj: Any, now: sculpt_state.SculptState, moved: float) -> dict[str, float]:
+        """Session.last_stroke: how far the stroke moved the surface (mm), how far it pulled, and
+        what stood against it (the HUD's stroke line)."""
+        return {"moved_mm": moved, "pulled_mm": self._pulled, "stiffness": float(np.mean(now.arrays["StiffnessMap"])),
+                "held": float(len(now.settings.get("held_poles", []))),
+                "curves": float(len(curve_constraint.records_of(obj)))}
 
     def _commit_final(self, obj: Any) -> None:
         """What moved after the last commit (an elastic patch springing back, a swing settling)
@@ -639,6 +648,12 @@ class _Observer:
             obj = session._obj
             if obj is not None and getattr(obj, "Document", None) is doc and session.running:
                 obj.Proxy.live.restore_into_session()
+
+
+def _poles_kept(before: sculpt_state.SculptState, after: sculpt_state.SculptState) -> bool:
+    """True where ``after``'s poles are ``before``'s (to a nanometre): a stroke that moved nothing."""
+    was, now = before.arrays["Poles"], after.arrays["Poles"]
+    return was.shape == now.shape and bool(np.all(np.abs(now - was) <= 1e-6))
 
 
 def _with_event(state: sculpt_state.SculptState, event: dict[str, Any]) -> sculpt_state.SculptState:
