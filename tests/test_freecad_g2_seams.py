@@ -245,7 +245,8 @@ class TestG2Seams(SolidChecks):
         middle = continuity_check.sample_levels(profile)[int(0.1 * len(profile.points)):-int(0.1 * len(profile.points))]
         self.assertTrue(np.all(middle == continuity_check.LEVELS.index("G2")), middle)
         text = continuity_text({**continuity_check.worst(found), "shares": continuity_check.shares(found, hs.boundary_of(obj))})
-        self.assertIn(f"{seam} G2 over {100 * share['share']:.0f} %", text)
+        self.assertIn(f"of their length: {seam} G2 over {100 * share['share']:.0f} %", text)
+        self.assertIn("g2 jump ", text)
         # the SeamReport says it too: worst point and share within G2
         [row] = [r for r in hs.seam_report_of(obj) if r["edge"] == seam]
         self.assertAlmostEqual(row["g2_within_pct"], 100.0 * share["share"], delta=5.0)

@@ -732,12 +732,14 @@ def continuity_text(worst: dict[str, Any]) -> str:
     def show(value: float | None, unit: str, digits: str) -> str:
         return "-" if value is None else f"{value:{digits}}{unit}"
     text = (f"continuity: worst g0 {show(worst['g0_mm'], ' mm', '.1e')}, g1 {show(worst['g1_deg'], ' deg', '.3g')}, "
-            f"g2 {show(worst['g2_pct'], ' %', '.3g')} ({worst['smooth']} smooth of {worst['edges']} edges)")
+            f"g2 jump {show(worst['g2_pct'], ' %', '.3g')} ({worst['smooth']} smooth of {worst['edges']} edges)")
     held = worst.get("shares") or []
     if held:  # (the least first: where a hold is met over part of an edge only, it says how much)
+        # ("of their length": beside the worst g2 jump of 100 % where a seam fades at its end, a bare
+        # "G2 over 94 %" read as a contradiction)
         listed = [f"{r['edge']} {r['kind']} over {100 * r['share']:.0f} %" for r in held[:SHARES_SHOWN]]
         more = len(held) - SHARES_SHOWN
-        text += "; " + ", ".join(listed) + (f" and {more} more" if more > 0 else "")
+        text += "; of their length: " + ", ".join(listed) + (f" and {more} more" if more > 0 else "")
     return text
 
 
