@@ -148,7 +148,7 @@ def _follow_refined(sculpt: Any, curve: Any, continuity: str, normal: Any, cid: 
                 break
             if again.held_anyway:
                 held_anyway = (finer, held, walls, record, moved, all_links)
-                reach = again.reach
+                reach = again.reach if again.reach is not None else reach
             finer.hold_poles(held, links)
             if walls:
                 finer.set_walls(walls)
