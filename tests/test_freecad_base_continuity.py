@@ -9,7 +9,7 @@ import Part
 from test_freecad_sculpted_solid import SolidChecks, face_named, pull
 
 import HapticSculpt as hs
-from HapticSculpt.app.edge_pick import base_edge_names
+from HapticSculpt.app.edge_pick import base_edge_names, edge_said, own_edge_names
 from HapticSculpt.app.sculpted_solid import chain_of_solid
 from HapticSculpt.app.solid_api import next_holds
 
@@ -139,6 +139,25 @@ class TestHoldEdgesStepByStep(SolidChecks):
                 kinds = hs.boundary_of(obj)
                 seen.append("base" if kinds == base else "/".join(sorted(set(kinds.values()))))
             self.assertEqual(seen, expected, controls)
+
+    def test_messages_name_each_edge_as_the_solid_names_it_too(self):
+        """The Report view and the HUD name edges as the base does ("seam Edge8"), and the designer
+        picking that edge on the SculptedSolid found its Edge15 (a fresh-eyes GUI session): each
+        name said comes with the solid's own name of the edge at that place."""
+        part, top = block(self.doc, rounded=1)
+        round_ = face_named(part.Shape, lambda f: isinstance(f.Surface, Part.Cylinder))
+        obj = hs.sculpt_solid(self.doc, part, [top, round_])
+        own = own_edge_names(obj)
+        self.assertEqual(set(own), set(hs.boundary_of(obj)))  # (every edge and seam held)
+        for base, mine in own.items():
+            self.assertEqual(mine, solid_edge_at(obj, base), base)
+            self.assertEqual(base_edge_names(obj, [mine]), [base])
+        differ = [b for b, m in own.items() if b != m]
+        self.assertTrue(differ, own)  # (else this part shows nothing)
+        self.assertEqual(edge_said(differ[0], obj, own), f"{differ[0]} ({obj.Label} {own[differ[0]]})")
+        same = [b for b, m in own.items() if b == m]
+        for b in same:
+            self.assertEqual(edge_said(b, obj, own), b)
 
     def test_picked_edges_and_seams_change_alone(self):
         part, top = block(self.doc, rounded=1)

@@ -40,3 +40,36 @@ def base_edge_names(solid: Any, picked: Sequence[str]) -> list[str]:
         if best not in names:
             names.append(best)
     return names
+
+
+def own_edge_names(solid: Any, profiles: Sequence[Any] | None = None) -> dict[str, str]:
+    """The SculptedSolid's own names ("Edge15") of its sculpted faces' edges and seams, keyed by
+    the base's names ("Edge8") that holds, reports and the HUD use: the edge a designer picks in
+    the view under each name said (the reverse of :func:`base_edge_names`). ``profiles``: the
+    continuity check's (measured again if not given). An edge not found on the solid is left out."""
+    import Part
+    if profiles is None:
+        profiles = continuity_check.profiles(sculpt_of(solid))
+    box = solid.Shape.BoundBox
+    tolerance = 1e-6 * max(box.DiagonalLength, 1.0) + 1e-4
+    own: dict[str, str] = {}
+    for p in profiles:
+        if not p.edge.startswith("Edge"):
+            continue
+        probes = [Part.Vertex(*p.points[int(round(share * (len(p.points) - 1)))]) for share in PROBES]
+        for k, edge in enumerate(solid.Shape.Edges):
+            # (the middle probe first: most edges are far from it)
+            if edge.distToShape(probes[len(probes) // 2])[0] <= tolerance and \
+                    max(edge.distToShape(q)[0] for q in probes) <= tolerance:
+                own[p.edge] = f"Edge{k + 1}"
+                break
+    return own
+
+
+def edge_said(name: str, solid: Any | None, own: dict[str, str]) -> str:
+    """How a message names the base's edge ``name`` on ``solid`` (a SculptedSolid, or None): with
+    the solid's own name beside it where that differs ("Edge8 (SculptedSolid Edge15)"): the Report
+    view named the Fillet's Edge8 where the view picks SculptedSolid.Edge15."""
+    if solid is None or own.get(name, name) == name:
+        return name
+    return f"{name} ({solid.Label} {own[name]})"

@@ -289,6 +289,7 @@ class SculptFace:
         return picked is not None and not _chain_refusal(picked)
 
     def Activated(self) -> None:
+        from ..app.edge_pick import edge_said, own_edge_names
         from ..app.sculpted_solid import boundary_of, chain_of_solid, held_by_kind
         from .echo import ref, run_echoed
         picked = _face_selection()
@@ -302,7 +303,8 @@ class SculptFace:
             obj = doc.Objects[-1]
             kinds = boundary_of(obj)
             seam_names = chain_of_solid(obj).seam_edges()
-            seams = [f"{e} {kinds[e]}" for e in sorted(seam_names, key=lambda e: int(e[4:]))]
+            own = own_edge_names(obj) if seam_names else {}
+            seams = [f"{edge_said(e, obj, own)} {kinds[e]}" for e in sorted(seam_names, key=lambda e: int(e[4:]))]
             outer = {e: k for e, k in kinds.items() if e not in seam_names}
             FreeCAD.Console.PrintMessage(
                 f"HapticSculpt: {obj.Label}: {', '.join(faces)} of {base.Label} sculpted in place, edges held as "
@@ -513,7 +515,7 @@ def _hold_solid_edges(solid: Any) -> None:
     """Hold edges on a SculptedSolid: the edges and seams of it the designer picked go one step
     further (all its outer edges when none is picked), through set_boundary, echoed; the report
     view says what each now holds, or in one line why nothing changed."""
-    from ..app.edge_pick import base_edge_names
+    from ..app.edge_pick import base_edge_names, edge_said, own_edge_names
     from ..app.sculpted_solid import boundary_of, chain_of_solid, held_by_kind
     from ..app.solid_api import next_holds
     from .echo import ref, run_echoed
@@ -536,7 +538,8 @@ def _hold_solid_edges(solid: Any) -> None:
         return
     kinds = boundary_of(solid)
     seams = chain_of_solid(solid).seam_edges()
-    what = ", ".join(f"{'seam ' if e in seams else ''}{e} held {kinds[e]}" for e in plan) if edges else \
+    own = own_edge_names(solid) if edges else {}
+    what = ", ".join(f"{'seam ' if e in seams else ''}{edge_said(e, solid, own)} held {kinds[e]}" for e in plan) if edges else \
         f"edges held {held_by_kind({e: kinds[e] for e in plan})}"
     FreeCAD.Console.PrintMessage(f"HapticSculpt: {solid.Label}: {what}\n")
 

@@ -57,6 +57,7 @@ class Overlay:
         self.continuity_worst: dict[str, Any] = {}
         # poles, profiles, their samples' levels, when, cost
         self._continuity: tuple[bytes, list[Any], list[np.ndarray], float, float] | None = None
+        self._own_edges: tuple[Any, dict[str, str]] | None = None  # (the solid's names of its edges, see _edge_said)
         self.comb_every = 4  # a comb on every n-th iso-line of the mesh (density)
         self.comb_gain = 1.0  # the longest tooth is this many tenths of the patch size (scale)
         self.panel_visible = False
@@ -180,6 +181,19 @@ class Overlay:
         """Shows ``text`` (what a command did that the designer did not see happen: a net refined)
         in the HUD's status line for NOTICE_SHOWN_S, from its next frame."""
         self._notice = (text, time.monotonic())  # (a session draws each frame; else the caller refreshes)
+
+    def _edge_said(self, name: str, found: list[Any]) -> str:
+        """How the HUD names the base's edge ``name`` (edge_pick.edge_said): found on the solid once
+        per set of edges it has (a session moves the seams; the names stay)."""
+        from ..app.edge_pick import edge_said, own_edge_names
+        from ..app.sculpted_solid import solid_of
+        solid = solid_of(self.obj)
+        if solid is None:
+            return name
+        key = (solid.Name, len(solid.Shape.Edges), tuple(sorted(p.edge for p in found)))
+        if self._own_edges is None or self._own_edges[0] != key:
+            self._own_edges = (key, own_edge_names(solid, found))
+        return edge_said(name, solid, self._own_edges[1])
 
     def alive(self) -> bool:
         """False once its view is closed or its object deleted."""
@@ -627,9 +641,11 @@ class Overlay:
                 found = []
             levels = [continuity_check.sample_levels(p) for p in found]  # (measured once, drawn each frame)
             self._continuity = (key, found, levels, now, time.perf_counter() - now)
+            shares = continuity_check.shares(found, continuity_check.holds(self.obj))
+            for r in shares:  # (with the solid's own names, which the view picks, beside the base's)
+                r["said"] = self._edge_said(r["edge"], found)
             self.continuity_worst = {**continuity_check.worst(found), "profiles": len(found),
-                                     "levels": {p.edge: continuity_check.level(p) for p in found},
-                                     "shares": continuity_check.shares(found, continuity_check.holds(self.obj))}
+                                     "levels": {p.edge: continuity_check.level(p) for p in found}, "shares": shares}
         found, levels_of = self._continuity[1], self._continuity[2]
         sep = coin.SoSeparator()
         kappa = max((float(np.nanmax(np.abs(k))) for p in found for _, k in p.sides if np.isfinite(k).any()),
@@ -737,7 +753,7 @@ def continuity_text(worst: dict[str, Any]) -> str:
     if held:  # (the least first: where a hold is met over part of an edge only, it says how much)
         # ("of their length": beside the worst g2 jump of 100 % where a seam fades at its end, a bare
         # "G2 over 94 %" read as a contradiction)
-        listed = [f"{r['edge']} {r['kind']} over {100 * r['share']:.0f} %" for r in held[:SHARES_SHOWN]]
+        listed = [f"{r.get('said', r['edge'])} {r['kind']} over {100 * r['share']:.0f} %" for r in held[:SHARES_SHOWN]]
         more = len(held) - SHARES_SHOWN
         text += "; of their length: " + ", ".join(listed) + (f" and {more} more" if more > 0 else "")
     return text
