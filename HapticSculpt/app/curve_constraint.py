@@ -795,20 +795,20 @@ def room_beside(surface: Any, uv: np.ndarray, held: list[int], links: list[tuple
 
 
 #: A pull onto a curve stays local when, far beside the curve, it moves the surface at most this
-#: share of the largest pull at the curve (or the tolerance, if more). Far: two knot spans and more
-#: away (the least pole move leaves a constant share there on every net, measured 0.045 at two
-#: spans and 0.55 at one, so a finer net pulls over less of the surface), and REACH_PER_PULL times
-#: the pull in mm or REACH_SIZE_SHARE of the surface's size, if more, whatever the spans (a line
-#: along a bump's crest flattened its flanks one 20 mm span beside it).
+#: share of the largest pull at the curve (or the tolerance, if more). Far: REACH_WIDTH_PER_PULL
+#: times the pull away in mm, and two knot spans away (the least pole move leaves a constant share
+#: there on every net, measured 0.045 at two spans and 0.55 at one, so a finer net pulls over less
+#: of the surface) or REACH_SIZE_SHARE of the surface's size away, whatever the spans (a line along
+#: a bump's crest flattened its flanks one 20 mm span beside it); where the surface stands off its
+#: plane by more than REACH_SHARE of the pull (earlier work).
 REACH_SHARE = 0.1
-#: A finer net is kept for its reach only when it brings the reach down to this share of the best
-#: coarser net's: where the curve encloses the far surface (a U over a flat patch lifts its inside
-#: on every net), refining does not help and is not done.
+#: A finer net is kept for its reach only when it brings the reach down to this share of the net's
+#: as it was: where the curve encloses the far surface (a U over a flat patch lifts its inside on
+#: every net), refining does not help, and the net is kept as it was.
 REACH_GAIN = 0.7
-REACH_PER_PULL = 4.0
 REACH_SIZE_SHARE = 0.1
-#: Two spans narrower than this many times the pull are not far: a pull steeper than that is a
-#: trench any net makes, and refining for it would not end.
+#: Nearer than this many times the pull is not far: a pull steeper than that is a trench any net
+#: makes, and refining for it would not end.
 REACH_WIDTH_PER_PULL = 1.5
 #: Samples per knot span (each direction) where the reach is measured, and at most in all.
 REACH_SAMPLES_PER_SPAN, REACH_SAMPLES_MAX = 4, 64
@@ -842,8 +842,13 @@ def reach_beside(surface: Any, uv: np.ndarray, before: np.ndarray, moved: np.nda
     on_curve = on.apply(on.s, np.asarray(moved, float).reshape(-1, 3))
     was = there.apply(there.s, np.asarray(before, float).reshape(-1, 3))
     mm_away = np.min(np.linalg.norm(was[:, None, :] - on_curve[None, :, :], axis=2), axis=1)
-    far = ((spans_away >= 2.0) & (mm_away >= REACH_WIDTH_PER_PULL * pull)) | \
-        (mm_away >= max(REACH_PER_PULL * pull, REACH_SIZE_SHARE * size))
+    far = (mm_away >= REACH_WIDTH_PER_PULL * pull) & ((spans_away >= 2.0) | (mm_away >= REACH_SIZE_SHARE * size))
+    # Only where there is earlier work to lose: relief off the plane the surface lies nearest (a
+    # fresh flat patch lifted onto a standing arc rises broadly and fair; refined for reach, it rose
+    # as a narrow, rippled ridge).
+    centre = was.mean(axis=0)
+    height = (was - centre) @ np.linalg.svd(was - centre, full_matrices=False)[2][-1]
+    far &= np.abs(height - np.median(height)) > REACH_SHARE * pull
     if not far.any():
         return 0.0
     reach = np.linalg.norm(there.apply(there.s, delta)[far], axis=1).max()

@@ -114,14 +114,19 @@ def _follow_refined(sculpt: Any, curve: Any, continuity: str, normal: Any, cid: 
     start = work.surface
     mesh = tuple(sculpt_state.capture(work).settings["mesh"])
     limit = (max(mesh[0] // 2, start.controls[0]), max(mesh[1] // 2, start.controls[1]))
-    held_anyway = None  # (the last finer net that held the curve, though not well beside it, and what held it)
-    reach = coarse.reach  # (the best reach so far: refining for reach goes on only while it helps)
+    # (the finer net that held the curve best, though not well beside it, with what held it: the one
+    # whose pull reaches least far beside it, else the finest without room; kept over the net given
+    # only where its reach is REACH_GAIN of that net's or less)
+    held_anyway, best = None, (np.inf, 0)
+    given = coarse.reach
     while True:
         controls = tuple(work.surface.controls)
         room = (limit[0] - controls[0], limit[1] - controls[1])
         knots = cc.refinement_knots(work.surface, coarse.uv, room)
         made = refined_work(sculpt, work, knots) if knots[0] or knots[1] else None
-        if made is None and held_anyway is not None:  # (held as well as the finest net does beside it)
+        if made is None and held_anyway is not None:  # (held as well as the nets made do beside it)
+            if given is not None and best[0] > cc.REACH_GAIN * given:  # (the net given holds it as well: held there)
+                raise ValueError(f"curve: {coarse.curve}: no finer net reaches less far beside it")
             finer, held, walls, record, moved, all_links = held_anyway
             break
         if made is None:
@@ -141,14 +146,9 @@ def _follow_refined(sculpt: Any, curve: Any, continuity: str, normal: Any, cid: 
             _check_beside(finer, record, held, all_links, moved, tolerance)
             break
         except cc.NetTooCoarse as again:
-            if again.reach is not None and reach is not None and again.reach > cc.REACH_GAIN * reach:
-                if held_anyway is None:  # (the coarser net given holds it as well: held there)
-                    raise ValueError(f"curve: {again.curve}: a finer net reaches no less far beside it") from None
-                finer, held, walls, record, moved, all_links = held_anyway
-                break
-            if again.held_anyway:
-                held_anyway = (finer, held, walls, record, moved, all_links)
-                reach = again.reach if again.reach is not None else reach
+            rank = (np.inf if again.reach is None else again.reach, -int(np.prod(finer.surface.controls)))
+            if again.held_anyway and rank <= best:
+                held_anyway, best = (finer, held, walls, record, moved, all_links), rank
             finer.hold_poles(held, links)
             if walls:
                 finer.set_walls(walls)

@@ -722,6 +722,8 @@ def stroke_text(last: dict[str, float]) -> str:
     stiffness slider spans five decades; held edges pin rows of poles)."""
     moved, pulled, stiffness = last["moved_mm"], last["pulled_mm"], last["stiffness"]
     text = f"last stroke moved it {moved:.2g} mm"
+    if last.get("tool") == "flatten":  # (it presses toward a plane, pulls nothing: a flat place has nothing to flatten)
+        return text + (": nothing stood above or below its plane there" if moved < 1e-3 else "")
     if pulled >= 1.0 and moved < BARELY_FOLLOWED * pulled:
         text += f" of a {pulled:.2g} mm pull"
         if stiffness > STIFF:

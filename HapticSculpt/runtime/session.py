@@ -446,7 +446,8 @@ class Session:
             if strokes and not event["painted"] and not (final is not None and k == last) and \
                     _poles_kept(before, _with_event(state, event)):
                 # (a grab that moved nothing: no undo step, the document not marked modified)
-                self.last_stroke = self._stroke_facts(obj, obj.Proxy.live.stored(), 0.0)
+                moved = np.abs(_with_event(state, event).arrays["Poles"] - before.arrays["Poles"]).max(initial=0.0)
+                self.last_stroke = self._stroke_facts(obj, obj.Proxy.live.stored(), float(moved))
                 continue
             live.reset_shape()  # (so the transaction records the stored face as what Undo goes back to)
             doc = obj.Document
@@ -474,7 +475,8 @@ class Session:
         what stood against it (the HUD's stroke line)."""
         return {"moved_mm": moved, "pulled_mm": self._pulled, "stiffness": float(np.mean(now.arrays["StiffnessMap"])),
                 "held": float(len(now.settings.get("held_poles", []))),
-                "curves": float(len(curve_constraint.records_of(obj)))}
+                "curves": float(len(curve_constraint.records_of(obj))),
+                "tool": obj.Proxy.live.snapshot().tool.name}
 
     def _commit_final(self, obj: Any) -> None:
         """What moved after the last commit (an elastic patch springing back, a swing settling)
@@ -650,10 +652,15 @@ class _Observer:
                 obj.Proxy.live.restore_into_session()
 
 
+#: mm: a stroke that moves no pole further than this moved nothing (a tenth of a micrometre, ten
+#: times under Follow curve's default tolerance: a flatten stroke over a flat sheet moved 1e-5 mm).
+UNMOVED_MM = 1e-4
+
+
 def _poles_kept(before: sculpt_state.SculptState, after: sculpt_state.SculptState) -> bool:
-    """True where ``after``'s poles are ``before``'s (to a nanometre): a stroke that moved nothing."""
+    """True where ``after``'s poles are ``before``'s within UNMOVED_MM: a stroke that moved nothing."""
     was, now = before.arrays["Poles"], after.arrays["Poles"]
-    return was.shape == now.shape and bool(np.all(np.abs(now - was) <= 1e-6))
+    return was.shape == now.shape and bool(np.all(np.abs(now - was) <= UNMOVED_MM))
 
 
 def _with_event(state: sculpt_state.SculptState, event: dict[str, Any]) -> sculpt_state.SculptState:
