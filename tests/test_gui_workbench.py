@@ -50,7 +50,8 @@ try:
     out["mouse_centre"] = list(mouse.move_to(view, (size[0] // 2, size[1] // 2)))
     out["mouse_corner"] = list(mouse.move_to(view, (2, 2)))
     mouse.press(True)
-    out["mouse_sample"] = mouse.native.sample(0.0)["buttons"]
+    # (the device passes on what was pushed in turn, one sample a tick: the hover, then the press)
+    out["mouse_samples"] = [mouse.native.sample(0.001 * k)["buttons"] for k in range(3)]
     mouse.detach()
     # A threaded session in the GUI: a Coin timer redraws the shape at graphics rate and commits strokes.
     import time
@@ -100,7 +101,7 @@ def test_workbench_loads_and_commands_run(tmp_path):
     assert {"Sculpt", "Thickness"} <= set(out["objects"]) and out["thicken_panel"]
     assert np.all(np.isfinite(out["mouse_centre"])) and np.all(np.isfinite(out["mouse_corner"]))
     assert abs(out["mouse_centre"][2]) < 60.0  # on the sculpt (a bump up to ~35 mm), not the far plane
-    assert out["mouse_sample"] == 1
+    assert out["mouse_samples"] == [0, 1, 1]
     # the shape moved while the threads ran: redrawn at heights between the start and the end (a GUI
     # loop beside three other FreeCADs saw 5 heights, at 3 to 8 where idle)
     assert len(out["live_heights"]) >= 4, out["live_heights"]
