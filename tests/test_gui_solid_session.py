@@ -72,6 +72,9 @@ def test_a_cut_and_a_fillet_on_a_sculpted_solid_follow_each_stroke_of_a_session(
         d.wait(lambda s: s["mouse_point"] is not None and abs(s["mouse_point"][2] - 15) < 0.5, "the mouse on the top")
         before = d.shot("solid_session_before")
         d.press_button("Session", lambda s: s["docs"][s["active"]]["sculpts"][0]["session"], "the session")
+        # (the HUD names the solid, as the tree does, not its hidden face sculpt "SculptedSolidFace")
+        d.wait(lambda s: any("sculpting SculptedSolid with the mouse" in o["status_text"] for o in s["overlays"]),
+               "the HUD to name the solid")
         d.drag([west] + [(west[0], west[1] - 8 * k) for k in range(1, 13)], seconds=0.8)
         s = d.wait(lambda s: undo(s)[0] == "Sculpt stroke", "the stroke committed", timeout=60)
         s = d.wait(settled, "the solid and its features after the release", timeout=60)

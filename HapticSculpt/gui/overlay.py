@@ -481,7 +481,10 @@ class Overlay:
         parts = [f"tool: {s.tool.name}", "clay" if s.plasticity[0] else "elastic"]
         session = self._session()
         if session is not None:
-            parts.append(f"sculpting {self.obj.Label} with the {session.device_name or 'mouse'}")
+            from ..app.sculpted_solid import solid_of
+            # (a SculptedSolid's face sculpt is hidden: the designer knows the solid, as the tree shows it)
+            shown = solid_of(self.obj) or self.obj
+            parts.append(f"sculpting {shown.Label} with the {session.device_name or 'mouse'}")
             if session.device_name not in ("", "mouse") and session.rate_and_priority:
                 parts.append(session.rate_and_priority)
             if not s.held_poles and not any(c["kind"] == "point" for c in s.constraints):
