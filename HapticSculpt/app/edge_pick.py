@@ -18,10 +18,8 @@ PROBES = (0.1, 0.3, 0.5, 0.7, 0.9)
 def base_edge_names(solid: Any, picked: Sequence[str]) -> list[str]:
     """The base's names of the SculptedSolid's edges ``picked`` (its own names: "Edge7"), in order;
     ValueError naming a picked edge that is no edge or seam of the sculpted faces."""
-    import Part
     profiles = [p for p in continuity_check.profiles(sculpt_of(solid)) if p.edge.startswith("Edge")]
-    box = solid.Shape.BoundBox
-    tolerance = 1e-6 * max(box.DiagonalLength, 1.0) + 1e-4
+    tolerance = _tolerance(solid)
     names = []
     for sub in picked:
         try:
@@ -30,8 +28,7 @@ def base_edge_names(solid: Any, picked: Sequence[str]) -> list[str]:
             raise ValueError(f"{solid.Label} has no {sub}") from None
         best, distance = None, np.inf
         for p in profiles:
-            probes = p.points[[int(round(share * (len(p.points) - 1))) for share in PROBES]]
-            d = max(edge.distToShape(Part.Vertex(*q))[0] for q in probes)
+            d = max(edge.distToShape(q)[0] for q in _probes(p))
             if d < distance:
                 best, distance = p.edge, d
         if best is None or distance > tolerance:
@@ -47,16 +44,14 @@ def own_edge_names(solid: Any, profiles: Sequence[Any] | None = None) -> dict[st
     the base's names ("Edge8") that holds, reports and the HUD use: the edge a designer picks in
     the view under each name said (the reverse of :func:`base_edge_names`). ``profiles``: the
     continuity check's (measured again if not given). An edge not found on the solid is left out."""
-    import Part
     if profiles is None:
         profiles = continuity_check.profiles(sculpt_of(solid))
-    box = solid.Shape.BoundBox
-    tolerance = 1e-6 * max(box.DiagonalLength, 1.0) + 1e-4
+    tolerance = _tolerance(solid)
     own: dict[str, str] = {}
     for p in profiles:
         if not p.edge.startswith("Edge"):
             continue
-        probes = [Part.Vertex(*p.points[int(round(share * (len(p.points) - 1)))]) for share in PROBES]
+        probes = _probes(p)
         for k, edge in enumerate(solid.Shape.Edges):
             # (the middle probe first: most edges are far from it)
             if edge.distToShape(probes[len(probes) // 2])[0] <= tolerance and \
@@ -73,3 +68,14 @@ def edge_said(name: str, solid: Any | None, own: dict[str, str]) -> str:
     if solid is None or own.get(name, name) == name:
         return name
     return f"{name} ({solid.Label} {own[name]})"
+
+
+def _tolerance(solid: Any) -> float:
+    """How near (mm) a solid's edge runs to a sculpted edge's samples to be that edge."""
+    return 1e-6 * max(solid.Shape.BoundBox.DiagonalLength, 1.0) + 1e-4
+
+
+def _probes(profile: Any) -> list[Any]:
+    """Vertices at PROBES of a sculpted edge's samples (a continuity-check profile)."""
+    import Part
+    return [Part.Vertex(*profile.points[int(round(share * (len(profile.points) - 1)))]) for share in PROBES]

@@ -443,12 +443,12 @@ class Session:
                 title = f"Paint {event['painted']}" if event["painted"] else "Sculpt stroke"
                 state, strokes = obj.Proxy.live.stored(), 1
             before = self._console if self._console is not None else obj.Proxy.live.stored()
-            if strokes and not event["painted"] and not (final is not None and k == last) and \
-                    _poles_kept(before, _with_event(state, event)):
-                # (a grab that moved nothing: no undo step, the document not marked modified)
-                moved = np.abs(_with_event(state, event).arrays["Poles"] - before.arrays["Poles"]).max(initial=0.0)
-                self.last_stroke = self._stroke_facts(obj, obj.Proxy.live.stored(), float(moved))
-                continue
+            if strokes and not event["painted"] and not (final is not None and k == last):
+                moved = _largest_move(before, _with_event(state, event))
+                if moved is not None and moved <= UNMOVED_MM:
+                    # (a grab that moved nothing: no undo step, the document not marked modified)
+                    self.last_stroke = self._stroke_facts(obj, obj.Proxy.live.stored(), moved)
+                    continue
             live.reset_shape()  # (so the transaction records the stored face as what Undo goes back to)
             doc = obj.Document
             with transaction(doc, title):
@@ -652,15 +652,15 @@ class _Observer:
                 obj.Proxy.live.restore_into_session()
 
 
-#: mm: a stroke that moves no pole further than this moved nothing (a tenth of a micrometre, ten
+#: mm: a stroke that moves no pole coordinate further than this moved nothing (a tenth of a micrometre, ten
 #: times under Follow curve's default tolerance: a flatten stroke over a flat sheet moved 1e-5 mm).
 UNMOVED_MM = 1e-4
 
 
-def _poles_kept(before: sculpt_state.SculptState, after: sculpt_state.SculptState) -> bool:
-    """True where ``after``'s poles are ``before``'s within UNMOVED_MM: a stroke that moved nothing."""
+def _largest_move(before: sculpt_state.SculptState, after: sculpt_state.SculptState) -> float | None:
+    """The largest pole coordinate's change (mm) from ``before`` to ``after``; None where the nets differ."""
     was, now = before.arrays["Poles"], after.arrays["Poles"]
-    return was.shape == now.shape and bool(np.all(np.abs(now - was) <= UNMOVED_MM))
+    return float(np.abs(now - was).max(initial=0.0)) if was.shape == now.shape else None
 
 
 def _with_event(state: sculpt_state.SculptState, event: dict[str, Any]) -> sculpt_state.SculptState:
